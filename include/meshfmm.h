@@ -1,0 +1,303 @@
+/*
+ * meshfmm: geodesic distances and shortest paths on triangle meshes by the
+ * Fast Marching Method of Kimmel & Sethian, "Computing geodesic paths on
+ * manifolds", PNAS 95 (1998) 8431-8435.
+ *
+ * This is the one public header. C99, C ABI. Conventions:
+ *   - vertices: float64, (nv, 3) row-major; faces: int32, (nf, 3) row-major,
+ *     0-based.
+ *   - cost F: |grad T| = F, so a path costs F times its length (a slowness).
+ *     Per vertex or per face; finite and > 0. Default 1: geodesic distance.
+ *   - unreached vertices (other components, beyond max_distance, not settled
+ *     before an early stop) are +inf, never NaN.
+ *   - every function returns an mfmm_status; mfmm_status_string() names it.
+ *     Functions that validate input also fill an optional mfmm_error with
+ *     the offending index and a sentence. The library never prints, aborts
+ *     or exits, and keeps no global mutable state.
+ *   - objects: an mfmm_mesh is immutable after creation and may be shared by
+ *     threads; an mfmm_solver is a workspace for one thread at a time.
+ */
+#ifndef MESHFMM_H
+#define MESHFMM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(_WIN32) && defined(MESHFMM_BUILDING_SHARED)
+#define MFMM_API __declspec(dllexport)
+#elif defined(__GNUC__)
+#define MFMM_API __attribute__((visibility("default")))
+#else
+#define MFMM_API
+#endif
+
+#define MFMM_VERSION_MAJOR 0
+#define MFMM_VERSION_MINOR 1
+#define MFMM_VERSION_PATCH 0
+
+/* ---------------------------------------------------------------- status */
+
+typedef enum mfmm_status {
+    MFMM_OK = 0,
+    MFMM_ERR_NULL_POINTER,        /* a required pointer argument is NULL */
+    MFMM_ERR_BAD_COUNT,           /* a count is negative, zero where it may not be, or too large */
+    MFMM_ERR_NONFINITE_VERTEX,    /* a vertex coordinate is NaN or infinite */
+    MFMM_ERR_INDEX_OUT_OF_RANGE,  /* a face index is < 0 or >= nv */
+    MFMM_ERR_REPEATED_VERTEX,     /* a face names one vertex twice */
+    MFMM_ERR_OUT_OF_MEMORY,       /* an allocation failed */
+    MFMM_ERR_BAD_COST,            /* a cost is not finite or not > 0 */
+    MFMM_ERR_BAD_SOURCE,          /* a source vertex or face id is out of range */
+    MFMM_ERR_DEGENERATE_SOURCE,   /* a source lies on a zero-area face */
+    MFMM_ERR_BAD_BARYCENTRIC,     /* barycentric coordinates not finite, < 0, or not summing to 1 */
+    MFMM_ERR_BAD_ARGUMENT,        /* another argument is invalid (the mfmm_error says which) */
+    MFMM_ERR_WRONG_MESH,          /* the solver was created for another mesh */
+    MFMM_ERR_UNREACHED,           /* a path target has an infinite distance */
+    MFMM_ERR_PATH_STALLED,        /* path tracing stopped descending, or ran out of steps */
+    MFMM_ERR_NO_OPENCL,           /* no OpenCL platform or device is available */
+    MFMM_ERR_OPENCL_BUILD,        /* the OpenCL program failed to build */
+    MFMM_ERR_OPENCL_RUNTIME,      /* an OpenCL call failed (out of resources, ...) */
+    MFMM_ERR_CANCELLED,           /* a callback asked to stop */
+    MFMM_ERR_IO,                  /* a file could not be opened, read or written */
+    MFMM_ERR_PARSE,               /* a mesh file is malformed */
+    MFMM_STATUS_COUNT
+} mfmm_status;
+
+/* A sentence naming a status, e.g. "a face names one vertex twice". Never NULL. */
+MFMM_API const char *mfmm_status_string(mfmm_status status);
+
+/* Details of a failure: filled by functions that take an `mfmm_error *err`
+ * (which may be NULL). `index` is the offending vertex, face, source or file
+ * line (-1 when none applies); `message` a sentence that names it. On success
+ * status is MFMM_OK and message is empty. */
+typedef struct mfmm_error {
+    mfmm_status status;
+    int64_t index;
+    char message[256];
+} mfmm_error;
+
+/* "MAJOR.MINOR.PATCH" of the library linked at run time. */
+MFMM_API const char *mfmm_version(void);
+
+/* ------------------------------------------------------------------ mesh */
+
+typedef struct mfmm_mesh mfmm_mesh;
+
+typedef struct mfmm_mesh_options {
+    /* Most faces one unfolding walk may cross to find the virtual edge of an
+     * obtuse corner (paper section 4.2); a walk that needs more fails and the
+     * corner keeps its plain stencil. Default 64; must be >= 1. */
+    int32_t max_unfold_steps;
+} mfmm_mesh_options;
+
+/* Fills `options` with the defaults. */
+MFMM_API void mfmm_mesh_options_init(mfmm_mesh_options *options);
+
+/* Validates a triangle mesh and precomputes all a solve reuses: vertex
+ * adjacency, edge lengths, corner angles, and a virtual edge for every obtuse
+ * corner, found by unfolding (section 4.2).
+ *   vertices: (nv, 3) float64, row-major; copied.
+ *   faces:    (nf, 3) int32, row-major, 0-based; copied.
+ *   options:  NULL for defaults.
+ *   out:      receives the mesh; NULL on failure.
+ * Refused: nv < 1, nf < 1, NaN/inf coordinates, indices out of range, a face
+ * that repeats a vertex. Accepted: boundaries, several components,
+ * unreferenced vertices, non-manifold edges, zero-area and needle faces. */
+MFMM_API mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv,
+                                      const int32_t *faces, int32_t nf,
+                                      const mfmm_mesh_options *options,
+                                      mfmm_mesh **out, mfmm_error *err);
+
+/* Frees a mesh; NULL is a no-op. Solvers made for it must be gone first. */
+MFMM_API void mfmm_mesh_destroy(mfmm_mesh *mesh);
+
+/* Counts a mesh's diagnostics, computed once at creation. */
+typedef struct mfmm_mesh_info {
+    int32_t n_vertices;              /* nv as given */
+    int32_t n_faces;                 /* nf as given */
+    int32_t n_edges;                 /* distinct undirected edges */
+    int32_t n_boundary_edges;        /* edges with one face */
+    int32_t n_nonmanifold_edges;     /* edges with three or more faces */
+    int32_t n_components;            /* edge-connected components of referenced vertices */
+    int32_t n_unreferenced_vertices; /* vertices no face names (always +inf) */
+    int32_t n_degenerate_faces;      /* faces of (numerically) zero area */
+    int32_t n_obtuse_corners;        /* corners with an angle > 90 degrees */
+    int32_t n_virtual_edges;         /* obtuse corners split by a virtual edge */
+    int32_t n_unfold_failures;       /* obtuse corners whose walk failed (boundary,
+                                        non-manifold edge, or step limit) */
+    double min_edge_length;
+    double max_edge_length;
+    double mean_edge_length;
+    double bbox_diagonal;            /* length of the bounding-box diagonal */
+} mfmm_mesh_info;
+
+MFMM_API mfmm_status mfmm_mesh_get_info(const mfmm_mesh *mesh, mfmm_mesh_info *info);
+
+/* The mesh's sizes (convenience; the same numbers as mfmm_mesh_info). */
+MFMM_API int32_t mfmm_mesh_vertex_count(const mfmm_mesh *mesh);
+MFMM_API int32_t mfmm_mesh_face_count(const mfmm_mesh *mesh);
+
+/* --------------------------------------------------------------- sources */
+
+/* A source: a vertex (face == -1), or a point inside a face given by
+ * barycentric coordinates (w0, w1, w2) of the face's corners (>= 0, summing
+ * to 1 within 1e-9). `value` is T at the source (usually 0): the result is
+ * T(x) = min over sources of (value + cost-weighted distance). */
+typedef struct mfmm_source {
+    int32_t vertex;     /* vertex id when face == -1; ignored otherwise */
+    int32_t face;       /* face id, or -1 for a vertex source */
+    double bary[3];     /* barycentric coordinates in the face; ignored for a vertex */
+    double value;       /* initial value of T at the source */
+} mfmm_source;
+
+/* Where a cost array lives. */
+typedef enum mfmm_cost_location {
+    MFMM_COST_NONE = 0,       /* F = 1 everywhere: geodesic distance */
+    MFMM_COST_PER_VERTEX = 1, /* cost has nv entries; a vertex is updated with its own F */
+    MFMM_COST_PER_FACE = 2    /* cost has nf entries; paths refract at region borders */
+} mfmm_cost_location;
+
+/* ---------------------------------------------------------------- solver */
+
+typedef struct mfmm_solver mfmm_solver;
+
+/* A reusable workspace (heap, labels) for one mesh and one thread: about
+ * 20 bytes per vertex. Solving allocates nothing. */
+MFMM_API mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out);
+
+/* Frees a solver; NULL is a no-op. */
+MFMM_API void mfmm_solver_destroy(mfmm_solver *solver);
+
+typedef struct mfmm_solve_options {
+    const double *cost;              /* NULL: F = 1 */
+    mfmm_cost_location cost_location;/* ignored when cost is NULL */
+    double max_distance;             /* stop past it; vertices beyond are +inf. Default +inf */
+    const int32_t *targets;          /* stop once all these vertices are settled; NULL: none */
+    int32_t n_targets;
+    int32_t unfolding;               /* 1 (default): obtuse corners update through their
+                                        virtual edges; 0: plain stencils (for comparison) */
+} mfmm_solve_options;
+
+/* Fills `options` with the defaults: no cost, no limit, no targets, unfolding on. */
+MFMM_API void mfmm_solve_options_init(mfmm_solve_options *options);
+
+/* Marches from the sources and writes T for every vertex.
+ *   solver:    from mfmm_solver_create for the mesh being solved.
+ *   sources:   n_sources >= 1 sources.
+ *   options:   NULL for defaults.
+ *   distances: (nv,) float64 out. Settled vertices hold T; all others +inf
+ *              (with targets, only settled vertices are final). */
+MFMM_API mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources,
+                                int32_t n_sources, const mfmm_solve_options *options,
+                                double *distances, mfmm_error *err);
+
+/* ----------------------------------------------------------------- paths */
+
+/* A point on the surface: a face and barycentric coordinates in it, with its
+ * position. */
+typedef struct mfmm_surface_point {
+    int32_t face;
+    double bary[3];
+    double xyz[3];
+} mfmm_surface_point;
+
+typedef struct mfmm_path_options {
+    int32_t max_points;   /* most points a path may have; default 100000 */
+    /* Sources the distances came from (as given to mfmm_solve): the path ends
+     * exactly at the nearest one. NULL: it ends at the vertex where T stops
+     * decreasing. */
+    const mfmm_source *sources;
+    int32_t n_sources;
+    const double *cost;               /* the cost the distances were solved with, or NULL */
+    mfmm_cost_location cost_location;
+} mfmm_path_options;
+
+MFMM_API void mfmm_path_options_init(mfmm_path_options *options);
+
+/* Backtracks from `target` along -grad T to the source (paper section 5,
+ * Heun's method).
+ *   distances: (nv,) from mfmm_solve.
+ *   target:    a vertex (face == -1) or a point in a face.
+ *   points:    caller buffer of `capacity` points; receives the polyline from
+ *              the target to the source, one point at each edge crossing.
+ *   n_points:  receives the count (the status is MFMM_ERR_BAD_COUNT when
+ *              capacity is too small, with *n_points the count needed).
+ *   length:    receives the polyline's Euclidean length (may be NULL). */
+MFMM_API mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
+                                     const mfmm_source *target,
+                                     const mfmm_path_options *options,
+                                     mfmm_surface_point *points, int32_t capacity,
+                                     int32_t *n_points, double *length, mfmm_error *err);
+
+/* --------------------------------------------------------- matrix (rows) */
+
+typedef enum mfmm_backend {
+    MFMM_BACKEND_AUTO = 0,   /* OpenCL when a device is usable, else threads */
+    MFMM_BACKEND_SERIAL = 1, /* one solver, this thread */
+    MFMM_BACKEND_THREADS = 2,/* one serial solver per thread */
+    MFMM_BACKEND_OPENCL = 3  /* many sources at once on an OpenCL device */
+} mfmm_backend;
+
+/* Name of a backend: "auto", "serial", "threads", "opencl". */
+MFMM_API const char *mfmm_backend_name(mfmm_backend backend);
+
+typedef enum mfmm_dtype {
+    MFMM_FLOAT32 = 0,
+    MFMM_FLOAT64 = 1
+} mfmm_dtype;
+
+/* Receives finished rows: rows [first_row, first_row + n_rows) of the matrix,
+ * n_rows x nv values of the requested dtype, row-major, valid during the
+ * call. Rows arrive in order. Return 0 to go on, non-zero to cancel
+ * (mfmm_distance_matrix then returns MFMM_ERR_CANCELLED). */
+typedef int (*mfmm_rows_callback)(void *user, int32_t first_row, int32_t n_rows,
+                                  const void *rows);
+
+typedef struct mfmm_matrix_options {
+    mfmm_backend backend;            /* default MFMM_BACKEND_AUTO */
+    mfmm_dtype dtype;                /* output type; arithmetic is always float64. Default float32 */
+    const double *cost;              /* as in mfmm_solve_options */
+    mfmm_cost_location cost_location;
+    double max_distance;             /* default +inf */
+    int32_t unfolding;               /* default 1 */
+    int32_t n_threads;               /* threads backend; 0: all cores */
+    size_t memory_limit;             /* bytes the library may use for workspaces and
+                                        blocks in flight; 0: a default from the device */
+    void *out;                       /* n_sources x nv buffer of dtype to fill, or NULL */
+    mfmm_rows_callback on_rows;      /* called with each finished block, or NULL */
+    void *user;                      /* passed to on_rows */
+    mfmm_backend backend_used;       /* out: the backend that ran */
+} mfmm_matrix_options;
+
+MFMM_API void mfmm_matrix_options_init(mfmm_matrix_options *options);
+
+/* One row per source: row i holds the distances from vertex sources[i] to
+ * every vertex (equal to mfmm_solve's). sources NULL: all vertices, in order
+ * (n_sources must then be nv). Rows go to options->out, to options->on_rows,
+ * or both; the library holds only the blocks in flight, never n_sources x nv.
+ * With backend AUTO, an OpenCL failure falls back to threads;
+ * options->backend_used tells which ran. */
+MFMM_API mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
+                                          int32_t n_sources, mfmm_matrix_options *options,
+                                          mfmm_error *err);
+
+/* ------------------------------------------------------------------- I/O */
+
+/* Reads a triangle mesh: OBJ (v/vt/vn indices, negative indices, polygons
+ * fan-triangulated), OFF (CRLF too), PLY (ascii, binary little/big endian;
+ * faces or tristrips). On success *vertices is (nv,3) float64 and *faces
+ * (nf,3) int32, both allocated by the library: free them with mfmm_free. */
+MFMM_API mfmm_status mfmm_load_mesh(const char *path, double **vertices, int32_t *nv,
+                                    int32_t **faces, int32_t *nf, mfmm_error *err);
+
+/* Frees memory the library handed out (mfmm_load_mesh). NULL is a no-op. */
+MFMM_API void mfmm_free(void *pointer);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* MESHFMM_H */

@@ -1,0 +1,130 @@
+/*
+ * The local update of the Fast Marching Method on triangles (Kimmel &
+ * Sethian 1998, section 4), written once for the C core and the OpenCL
+ * kernel: both include this file, so their rows cannot drift apart.
+ *
+ * OpenCL C 1.2 and C99. Compile without floating-point contraction
+ * (-ffp-contract=off; OpenCL: no -cl-mad-enable, FP_CONTRACT OFF) so that both
+ * paths round identically.
+ */
+#ifndef MFMM_LOCAL_UPDATE_H
+#define MFMM_LOCAL_UPDATE_H
+
+#ifdef __OPENCL_VERSION__
+#pragma OPENCL EXTENSION cl_khr_fp64 : enable
+#pragma OPENCL FP_CONTRACT OFF
+#define MFMM_GLOBAL __global
+#define MFMM_INLINE inline
+#define MFMM_INF ((double)INFINITY)
+typedef int mfmm_i32;
+typedef uchar mfmm_u8;
+#else
+#include <math.h>
+#include <stdint.h>
+#define MFMM_GLOBAL
+#define MFMM_INLINE static inline
+#define MFMM_INF ((double)INFINITY)
+typedef int32_t mfmm_i32;
+typedef uint8_t mfmm_u8;
+#endif
+
+/* virt of a corner: a vertex id >= 0 (the corner is obtuse and split by the
+ * virtual edge to that vertex, section 4.2), or one of these. */
+#define MFMM_VIRT_NONE (-1)       /* not obtuse: the plain stencil */
+#define MFMM_VIRT_FAILED (-2)     /* obtuse, walk failed: plain stencil */
+#define MFMM_VIRT_DEGENERATE (-3) /* zero-area face: edge updates only */
+
+/* One corner C of a face, with what its update needs: the face's other
+ * vertices A and B (a = |BC|, b = |AC|, angle theta at C) and, for an
+ * obtuse corner, the virtual vertex V of the unfolded patch, with |CV| and the
+ * cosines of the two angles the virtual edge splits theta into (A-C-V and
+ * V-C-B). 64 bytes, the same layout in C and OpenCL C. */
+typedef struct mfmm_corner {
+    mfmm_i32 c, a, b, virt;
+    double len_a;      /* |BC| */
+    double len_b;      /* |AC| */
+    double cos_c;      /* cos theta at C */
+    double virt_len;   /* |CV| in the unfolded plane */
+    double virt_cos_a; /* cos of angle A-C-V */
+    double virt_cos_b; /* cos of angle V-C-B */
+} mfmm_corner;
+
+/* Vertex labels of section 2 (Far, Close, Alive), plus a flag for targets. */
+#define MFMM_FAR 0
+#define MFMM_CLOSE 1
+#define MFMM_ALIVE 2
+#define MFMM_STATE_MASK 3
+#define MFMM_TARGET 4
+
+/* T(C) from triangle ABC with T(A) = ta, T(B) = tb both known; a = |BC|,
+ * b = |AC|, cos_c = cos theta at C; f = cost F.
+ * Eq. 4 gives t = T(C) - T(A) with u = T(B) - T(A) >= 0 (A the smaller); it is
+ * accepted when u < t and the update comes from within the triangle, Eq. 5:
+ * a cos theta < b(t-u)/t < a / cos theta. That test is used multiplied through
+ * by cos theta (a cos theta < x and x cos theta < a, x = b(t-u)/t), which is
+ * Eq. 5 for acute theta and stays meaningful for obtuse theta (where the
+ * literal form rejects everything). Otherwise the edge updates
+ * min(T(A) + bF, T(B) + aF) (the paper prints cF, but BC has length a). */
+MFMM_INLINE double mfmm_triangle_update(double ta, double tb, double a, double b,
+                                        double cos_c, double f)
+{
+    if (ta > tb) { /* let A be the vertex reached first */
+        double s = ta; ta = tb; tb = s;
+        s = a; a = b; b = s;
+    }
+    double edge = fmin(ta + b * f, tb + a * f);
+    double u = tb - ta;
+    double sin2 = (1.0 - cos_c) * (1.0 + cos_c);
+    /* Eq. 4: q2 t^2 + q1 t + q0 = 0, q2 = c^2 = a^2 + b^2 - 2ab cos theta */
+    double q2 = a * a + b * b - 2.0 * a * b * cos_c;
+    double q1 = 2.0 * b * u * (a * cos_c - b);
+    double q0 = b * b * (u * u - f * f * a * a * sin2);
+    if (!(q2 > 0.0))
+        return edge;
+    double disc = q1 * q1 - 4.0 * q2 * q0;
+    disc = disc > 0.0 ? disc : 0.0; /* clamp: never the root of a negative */
+    double s = sqrt(disc);
+    /* the larger root, without cancellation */
+    double t = q1 <= 0.0 ? (s - q1) / (2.0 * q2) : (2.0 * q0) / (-q1 - s);
+    if (!(t > u)) /* also rejects NaN */
+        return edge;
+    double x = b * (t - u) / t; /* CD of section 4.1 */
+    if (a * cos_c < x && x * cos_c < a)
+        return fmin(ta + t, edge);
+    return edge;
+}
+
+/* The best T(C) that corner `cr` offers from its settled neighbours; +inf if
+ * none. f is the cost F to use; unfolding 0 ignores virtual edges. */
+MFMM_INLINE double mfmm_corner_update(MFMM_GLOBAL const mfmm_corner *cr,
+                                      MFMM_GLOBAL const double *T,
+                                      MFMM_GLOBAL const mfmm_u8 *label,
+                                      double f, int unfolding)
+{
+    mfmm_i32 ia = cr->a, ib = cr->b, iv = cr->virt;
+    int alive_a = (label[ia] & MFMM_STATE_MASK) == MFMM_ALIVE;
+    int alive_b = (label[ib] & MFMM_STATE_MASK) == MFMM_ALIVE;
+    double best = MFMM_INF;
+    if (alive_a) best = fmin(best, T[ia] + cr->len_b * f);
+    if (alive_b) best = fmin(best, T[ib] + cr->len_a * f);
+    if (iv >= 0 && unfolding) {
+        /* section 4.2: the obtuse angle split into two acute virtual
+         * triangles A-C-V and V-C-B */
+        if ((label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE) {
+            double tv = T[iv];
+            best = fmin(best, tv + cr->virt_len * f);
+            if (alive_a)
+                best = fmin(best, mfmm_triangle_update(T[ia], tv, cr->virt_len, cr->len_b,
+                                                       cr->virt_cos_a, f));
+            if (alive_b)
+                best = fmin(best, mfmm_triangle_update(tv, T[ib], cr->len_a, cr->virt_len,
+                                                       cr->virt_cos_b, f));
+        }
+    } else if (alive_a && alive_b && iv != MFMM_VIRT_DEGENERATE) {
+        best = fmin(best, mfmm_triangle_update(T[ia], T[ib], cr->len_a, cr->len_b,
+                                               cr->cos_c, f));
+    }
+    return best;
+}
+
+#endif /* MFMM_LOCAL_UPDATE_H */

@@ -1,0 +1,174 @@
+/*
+ * The heap Fast Marching loop of section 2, over the arrays a mesh
+ * precomputes. Shared by the C core (src/solve.c) and the OpenCL kernel
+ * (kernels/), like local_update.h: one march, one result.
+ *
+ * Workspace per march (all of nv entries): T (double), label (u8), heap keys
+ * (double), heap vertices (i32), heap positions (i32).
+ */
+#ifndef MFMM_MARCH_H
+#define MFMM_MARCH_H
+
+#include "local_update.h"
+
+/* The arrays of a mesh that a march reads. */
+typedef struct mfmm_march_mesh {
+    mfmm_i32 nv;
+    MFMM_GLOBAL const mfmm_i32 *update_offset;   /* (nv+1,) CSR into update_corner */
+    MFMM_GLOBAL const mfmm_i32 *update_corner;   /* corners to recompute when a vertex settles */
+    MFMM_GLOBAL const mfmm_corner *corners;      /* (3 nf,) */
+} mfmm_march_mesh;
+
+/* A march's workspace, and the options it runs with. */
+typedef struct mfmm_march_state {
+    MFMM_GLOBAL double *T;
+    MFMM_GLOBAL mfmm_u8 *label;
+    MFMM_GLOBAL double *heap_key;
+    MFMM_GLOBAL mfmm_i32 *heap_vertex;
+    MFMM_GLOBAL mfmm_i32 *heap_pos; /* position of a Close vertex in the heap */
+    mfmm_i32 heap_size;
+    MFMM_GLOBAL const double *cost; /* NULL: F = 1 */
+    int cost_location;              /* 0 none, 1 per vertex, 2 per face */
+    double max_distance;
+    int unfolding;
+    mfmm_i32 targets_left;          /* early stop when it reaches 0 (if > 0 at start) */
+} mfmm_march_state;
+
+/* ---- indexed binary min-heap with decrease-key ---- */
+
+MFMM_INLINE void mfmm_heap_place(mfmm_march_state *s, mfmm_i32 i, double key, mfmm_i32 v)
+{
+    s->heap_key[i] = key;
+    s->heap_vertex[i] = v;
+    s->heap_pos[v] = i;
+}
+
+MFMM_INLINE void mfmm_heap_sift_up(mfmm_march_state *s, mfmm_i32 i, double key, mfmm_i32 v)
+{
+    while (i > 0) {
+        mfmm_i32 parent = (i - 1) >> 1;
+        double pk = s->heap_key[parent];
+        if (!(key < pk))
+            break;
+        mfmm_heap_place(s, i, pk, s->heap_vertex[parent]);
+        i = parent;
+    }
+    mfmm_heap_place(s, i, key, v);
+}
+
+/* Inserts v with key, or lowers its key if it is already in the heap. */
+MFMM_INLINE void mfmm_heap_push_or_decrease(mfmm_march_state *s, mfmm_i32 v, double key,
+                                            int in_heap)
+{
+    mfmm_i32 i = in_heap ? s->heap_pos[v] : s->heap_size++;
+    mfmm_heap_sift_up(s, i, key, v);
+}
+
+/* Removes the minimum; returns its vertex. heap_size must be > 0. */
+MFMM_INLINE mfmm_i32 mfmm_heap_pop(mfmm_march_state *s)
+{
+    mfmm_i32 top = s->heap_vertex[0];
+    mfmm_i32 n = --s->heap_size;
+    if (n > 0) {
+        double key = s->heap_key[n];
+        mfmm_i32 v = s->heap_vertex[n];
+        mfmm_i32 i = 0;
+        for (;;) {
+            mfmm_i32 child = 2 * i + 1;
+            if (child >= n)
+                break;
+            double ck = s->heap_key[child];
+            if (child + 1 < n && s->heap_key[child + 1] < ck) {
+                child++;
+                ck = s->heap_key[child];
+            }
+            if (!(ck < key))
+                break;
+            mfmm_heap_place(s, i, ck, s->heap_vertex[child]);
+            i = child;
+        }
+        mfmm_heap_place(s, i, key, v);
+    }
+    return top;
+}
+
+/* ---- the march ---- */
+
+/* Resets T to +inf and every label to Far, keeping target flags off. */
+MFMM_INLINE void mfmm_march_reset(mfmm_march_state *s, mfmm_i32 nv)
+{
+    for (mfmm_i32 v = 0; v < nv; v++) {
+        s->T[v] = MFMM_INF;
+        s->label[v] = MFMM_FAR;
+    }
+    s->heap_size = 0;
+    s->targets_left = 0;
+}
+
+/* Offers value to vertex v as an initial condition (a source). Sources start
+ * Close, not Alive, so that several sources with different values settle in
+ * order of T. */
+MFMM_INLINE void mfmm_march_seed(mfmm_march_state *s, mfmm_i32 v, double value)
+{
+    mfmm_u8 st = s->label[v] & MFMM_STATE_MASK;
+    if (value < s->T[v]) {
+        s->T[v] = value;
+        mfmm_heap_push_or_decrease(s, v, value, st == MFMM_CLOSE);
+        s->label[v] = (mfmm_u8)((s->label[v] & MFMM_TARGET) | MFMM_CLOSE);
+    }
+}
+
+/* The cost F at corner id k (vertex c), per the state's cost location. */
+MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, mfmm_i32 k, mfmm_i32 c)
+{
+    if (s->cost_location == 1)
+        return s->cost[c];
+    if (s->cost_location == 2)
+        return s->cost[k / 3];
+    return 1.0;
+}
+
+/* Section 2's loop: settle the Close vertex of least T, recompute its
+ * neighbours from settled values, until the heap is empty, T passes
+ * max_distance, or every target is settled. Vertices not settled are set
+ * to +inf. Returns the number of vertices settled. */
+MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *m)
+{
+    mfmm_i32 settled = 0;
+    int stop_at_targets = s->targets_left > 0;
+    while (s->heap_size > 0) {
+        mfmm_i32 x = s->heap_vertex[0];
+        if (s->T[x] > s->max_distance)
+            break;
+        mfmm_heap_pop(s);
+        mfmm_u8 lx = s->label[x];
+        s->label[x] = (mfmm_u8)((lx & MFMM_TARGET) | MFMM_ALIVE);
+        settled++;
+        if (stop_at_targets && (lx & MFMM_TARGET) && --s->targets_left == 0)
+            break;
+        mfmm_i32 end = m->update_offset[x + 1];
+        for (mfmm_i32 j = m->update_offset[x]; j < end; j++) {
+            mfmm_i32 k = m->update_corner[j];
+            MFMM_GLOBAL const mfmm_corner *cr = m->corners + k;
+            mfmm_i32 c = cr->c;
+            mfmm_u8 st = s->label[c] & MFMM_STATE_MASK;
+            if (st == MFMM_ALIVE)
+                continue;
+            double t = mfmm_corner_update(cr, s->T, s->label, mfmm_march_cost(s, k, c),
+                                          s->unfolding);
+            if (t < s->T[c]) {
+                s->T[c] = t;
+                mfmm_heap_push_or_decrease(s, c, t, st == MFMM_CLOSE);
+                s->label[c] = (mfmm_u8)((s->label[c] & MFMM_TARGET) | MFMM_CLOSE);
+            }
+        }
+    }
+    for (mfmm_i32 v = 0; v < m->nv; v++) {
+        if ((s->label[v] & MFMM_STATE_MASK) != MFMM_ALIVE)
+            s->T[v] = MFMM_INF;
+        s->label[v] &= (mfmm_u8)MFMM_STATE_MASK;
+    }
+    return settled;
+}
+
+#endif /* MFMM_MARCH_H */

@@ -1,0 +1,50 @@
+/* The mesh's internal layout (private to the library). */
+#ifndef MFMM_MESH_H
+#define MFMM_MESH_H
+
+#include "meshfmm.h"
+#include "march.h"
+
+struct mfmm_mesh {
+    int32_t nv, nf;
+    double *xyz;               /* (nv, 3) */
+    int32_t *faces;            /* (nf, 3) */
+    int32_t *face_neighbor;    /* (nf, 3): face across the edge opposite corner k,
+                                  -1 at a boundary or non-manifold edge */
+    int32_t *vertex_face_offset; /* (nv+1,) CSR: corners (3f+k) at each vertex */
+    int32_t *vertex_face_corner;
+    int32_t *component;        /* (nv,) component id, -1 for unreferenced vertices */
+    uint8_t *degenerate;       /* (nf,) 1 for zero-area faces */
+    mfmm_corner *corners;      /* (3 nf,) */
+    int32_t *update_offset;    /* (nv+1,) CSR: corners to recompute when a vertex settles */
+    int32_t *update_corner;
+    mfmm_mesh_info info;
+};
+
+/* The arrays a march reads. */
+static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
+{
+    mfmm_march_mesh m;
+    m.nv = mesh->nv;
+    m.update_offset = mesh->update_offset;
+    m.update_corner = mesh->update_corner;
+    m.corners = mesh->corners;
+    return m;
+}
+
+/* Finds the virtual edge of every obtuse corner by unfolding (section 4.2);
+ * fills corners[].virt, virt_len, virt_cos_a, virt_cos_b and the counts.
+ * Needs faces, xyz, face_neighbor, corners' lengths and cosines. */
+void mfmm_mesh_unfold_obtuse(mfmm_mesh *mesh, int32_t max_steps);
+
+/* Fills err (if any) and returns status. */
+mfmm_status mfmm_fail(mfmm_error *err, mfmm_status status, int64_t index, const char *fmt, ...)
+#ifdef __GNUC__
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
+/* Marks err as success. */
+void mfmm_ok(mfmm_error *err);
+
+#endif /* MFMM_MESH_H */
