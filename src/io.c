@@ -1,0 +1,285 @@
+/* mfmm_load_mesh: reads a whole file and dispatches to the OBJ, OFF or PLY
+ * parser by extension (case-insensitive), sniffing the content otherwise. */
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io.h"
+#include "mesh.h"
+
+void mfmm_io_vec_init(mfmm_io_vec *v, size_t elem)
+{
+    v->data = NULL;
+    v->len = 0;
+    v->cap = 0;
+    v->elem = elem;
+}
+
+int mfmm_io_vec_reserve(mfmm_io_vec *v, size_t extra)
+{
+    if (extra <= v->cap - v->len)
+        return 0;
+    if (extra > SIZE_MAX / v->elem - v->len)
+        return -1;
+    size_t need = v->len + extra;
+    size_t cap = v->cap ? v->cap : 64;
+    while (cap < need)
+        cap = cap > SIZE_MAX / 2 / v->elem ? need : cap * 2;
+    void *p = realloc(v->data, cap * v->elem);
+    if (!p)
+        return -1;
+    v->data = p;
+    v->cap = cap;
+    return 0;
+}
+
+void mfmm_io_vec_free(mfmm_io_vec *v)
+{
+    free(v->data);
+    v->data = NULL;
+    v->len = v->cap = 0;
+}
+
+int mfmm_io_push_tri(mfmm_io_vec *tris, int32_t a, int32_t b, int32_t c)
+{
+    if (mfmm_io_vec_reserve(tris, 3))
+        return -1;
+    int32_t *t = (int32_t *)tris->data + tris->len;
+    t[0] = a;
+    t[1] = b;
+    t[2] = c;
+    tris->len += 3;
+    return 0;
+}
+
+int mfmm_io_scan_int(const char **p, int64_t *value)
+{
+    const char *s = *p;
+    int neg = 0;
+    if (*s == '+' || *s == '-') {
+        neg = *s == '-';
+        s++;
+    }
+    if (*s < '0' || *s > '9')
+        return 0;
+    int64_t v = 0;
+    while (*s >= '0' && *s <= '9') {
+        if (v > (INT64_MAX - 9) / 10)
+            return 0;
+        v = v * 10 + (*s - '0');
+        s++;
+    }
+    *value = neg ? -v : v;
+    *p = s;
+    return 1;
+}
+
+int mfmm_io_scan_double(const char **p, double *value)
+{
+    const char *s = *p;
+    /* strtod skips leading space; a token must start here. */
+    if (!(*s == '+' || *s == '-' || *s == '.' || (*s >= '0' && *s <= '9') || *s == 'i' ||
+          *s == 'I' || *s == 'n' || *s == 'N'))
+        return 0;
+    char *end;
+    double v = strtod(s, &end);
+    if (end == s)
+        return 0;
+    *value = v;
+    *p = end;
+    return 1;
+}
+
+mfmm_status mfmm_io_finish(mfmm_io_vec *verts, mfmm_io_vec *tris, mfmm_io_result *out,
+                           mfmm_error *err)
+{
+    size_t nv = verts->len / 3, nf = tris->len / 3;
+    if (nv == 0) {
+        mfmm_io_vec_free(verts);
+        mfmm_io_vec_free(tris);
+        return mfmm_fail(err, MFMM_ERR_PARSE, -1, "the file has no vertices");
+    }
+    if (nf == 0) {
+        mfmm_io_vec_free(verts);
+        mfmm_io_vec_free(tris);
+        return mfmm_fail(err, MFMM_ERR_PARSE, -1, "the file has no faces");
+    }
+    if (nv > INT32_MAX || nf > INT32_MAX) {
+        mfmm_io_vec_free(verts);
+        mfmm_io_vec_free(tris);
+        return mfmm_fail(err, MFMM_ERR_PARSE, -1, "the file has more than 2^31-1 vertices or faces");
+    }
+    /* Shrink to fit (failure to shrink is harmless). */
+    void *p = realloc(verts->data, nv * 3 * sizeof(double));
+    if (p)
+        verts->data = p;
+    p = realloc(tris->data, nf * 3 * sizeof(int32_t));
+    if (p)
+        tris->data = p;
+    out->V = verts->data;
+    out->nv = (int32_t)nv;
+    out->F = tris->data;
+    out->nf = (int32_t)nf;
+    verts->data = tris->data = NULL;
+    verts->len = verts->cap = tris->len = tris->cap = 0;
+    return MFMM_OK;
+}
+
+/* Reads the whole file into a NUL-terminated buffer. */
+static mfmm_status read_file(const char *path, char **data, size_t *size, mfmm_error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return mfmm_fail(err, MFMM_ERR_IO, -1, "cannot open '%.180s': %.40s", path,
+                         strerror(errno));
+    size_t cap = 0, len = 0;
+    char *buf = NULL;
+    /* Start from the file's size when it is known, then grow if it was wrong. */
+    if (fseek(f, 0, SEEK_END) == 0) {
+        long end = ftell(f);
+        if (end > 0 && (unsigned long)end < SIZE_MAX - 2)
+            cap = (size_t)end + 2; /* room for the NUL and an EOF probe */
+        rewind(f);
+    }
+    if (cap < 4096)
+        cap = 4096;
+    buf = malloc(cap);
+    if (!buf) {
+        fclose(f);
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory reading '%.180s'",
+                         path);
+    }
+    for (;;) {
+        if (len + 1 >= cap) {
+            if (cap > SIZE_MAX / 2) {
+                free(buf);
+                fclose(f);
+                return mfmm_fail(err, MFMM_ERR_IO, -1, "'%.180s' is too large", path);
+            }
+            char *nb = realloc(buf, cap * 2);
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1,
+                                 "out of memory reading '%.180s'", path);
+            }
+            buf = nb;
+            cap *= 2;
+        }
+        size_t got = fread(buf + len, 1, cap - 1 - len, f);
+        len += got;
+        if (got == 0)
+            break;
+    }
+    if (ferror(f)) {
+        int e = errno;
+        free(buf);
+        fclose(f);
+        return mfmm_fail(err, MFMM_ERR_IO, -1, "cannot read '%.180s': %.40s", path,
+                         e ? strerror(e) : "read error");
+    }
+    fclose(f);
+    buf[len] = '\0';
+    *data = buf;
+    *size = len;
+    return MFMM_OK;
+}
+
+static int lower(int c)
+{
+    return c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c;
+}
+
+static int ext_is(const char *ext, const char *want)
+{
+    while (*ext && *want) {
+        if (lower((unsigned char)*ext) != *want)
+            return 0;
+        ext++;
+        want++;
+    }
+    return *ext == '\0' && *want == '\0';
+}
+
+enum { FMT_UNKNOWN, FMT_OBJ, FMT_OFF, FMT_PLY };
+
+static int format_from_path(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    const char *base = slash ? slash + 1 : path;
+    const char *dot = strrchr(base, '.');
+    if (!dot)
+        return FMT_UNKNOWN;
+    if (ext_is(dot + 1, "obj"))
+        return FMT_OBJ;
+    if (ext_is(dot + 1, "off"))
+        return FMT_OFF;
+    if (ext_is(dot + 1, "ply"))
+        return FMT_PLY;
+    return FMT_UNKNOWN;
+}
+
+static int format_from_content(const char *data, size_t size)
+{
+    if (size >= 4 && memcmp(data, "ply", 3) == 0 && (data[3] == '\n' || data[3] == '\r'))
+        return FMT_PLY;
+    /* OFF headers: OFF, COFF, NOFF, CNOFF, STOFF, 4OFF, ... */
+    const char *p = data;
+    size_t i = 0;
+    while (i < size && i < 8 && p[i] != 'O' && ((p[i] >= 'A' && p[i] <= 'Z') || p[i] == '4'))
+        i++;
+    if (i + 3 <= size && memcmp(p + i, "OFF", 3) == 0)
+        return FMT_OFF;
+    return FMT_OBJ;
+}
+
+mfmm_status mfmm_load_mesh(const char *path, double **vertices, int32_t *nv,
+                           int32_t **faces, int32_t *nf, mfmm_error *err)
+{
+    if (!path || !vertices || !nv || !faces || !nf)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "mfmm_load_mesh: a pointer is NULL");
+    *vertices = NULL;
+    *faces = NULL;
+    *nv = 0;
+    *nf = 0;
+    char *data = NULL;
+    size_t size = 0;
+    mfmm_status st = read_file(path, &data, &size, err);
+    if (st != MFMM_OK)
+        return st;
+    int fmt = format_from_path(path);
+    if (fmt == FMT_UNKNOWN)
+        fmt = format_from_content(data, size);
+    mfmm_io_result r = {NULL, 0, NULL, 0};
+    mfmm_error local;
+    mfmm_error *e = err ? err : &local;
+    switch (fmt) {
+    case FMT_PLY:
+        st = mfmm_io_parse_ply(data, size, &r, e);
+        break;
+    case FMT_OFF:
+        st = mfmm_io_parse_off(data, size, &r, e);
+        break;
+    default:
+        st = mfmm_io_parse_obj(data, size, &r, e);
+        break;
+    }
+    free(data);
+    if (st != MFMM_OK) {
+        /* Prefix the file name to the parser's sentence. */
+        char msg[sizeof e->message];
+        snprintf(msg, sizeof msg, "%s", e->message);
+        const char *slash = strrchr(path, '/');
+        mfmm_fail(err, st, e->index, "%.60s: %s", slash ? slash + 1 : path, msg);
+        return st;
+    }
+    *vertices = r.V;
+    *nv = r.nv;
+    *faces = r.F;
+    *nf = r.nf;
+    mfmm_ok(err);
+    return MFMM_OK;
+}
