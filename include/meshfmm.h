@@ -207,25 +207,39 @@ typedef struct mfmm_surface_point {
 typedef struct mfmm_path_options {
     int32_t max_points;   /* most points a path may have; default 100000 */
     /* Sources the distances came from (as given to mfmm_solve): the path ends
-     * exactly at the nearest one. NULL: it ends at the vertex where T stops
-     * decreasing. */
+     * exactly at the one the target's distance came from (a vertex source at
+     * its vertex, a face source at its point once the path enters its face).
+     * NULL: it ends at the vertex where T stops decreasing. */
     const mfmm_source *sources;
     int32_t n_sources;
     const double *cost;               /* the cost the distances were solved with, or NULL */
     mfmm_cost_location cost_location;
+    double *weighted_length;          /* out, may be NULL: the cost-weighted length
+                                         (sum of F times segment length; with no cost,
+                                         the Euclidean length) */
 } mfmm_path_options;
 
+/* Fills `options` with the defaults: 100000 points, no sources, no cost. */
 MFMM_API void mfmm_path_options_init(mfmm_path_options *options);
 
-/* Backtracks from `target` along -grad T to the source (paper section 5,
- * Heun's method).
+/* Backtracks from `target` along -grad T to the source (paper section 5):
+ * Heun's method on T interpolated by a quadratic over each face and its three
+ * neighbours, the face's linear gradient where that fit is ill-posed, and
+ * Euler steps at sonic points.
  *   distances: (nv,) from mfmm_solve.
- *   target:    a vertex (face == -1) or a point in a face.
- *   points:    caller buffer of `capacity` points; receives the polyline from
- *              the target to the source, one point at each edge crossing.
+ *   target:    a vertex (face == -1) or a point in a face (value ignored).
+ *   options:   NULL for defaults.
+ *   points:    caller buffer of `capacity` points (NULL when capacity is 0);
+ *              receives the polyline from the target to the source: the
+ *              target, each edge crossing and vertex passed, and the end.
+ *              points[i].face (i > 0) is the face the segment from point i-1
+ *              ran through; the target's is its own face.
  *   n_points:  receives the count (the status is MFMM_ERR_BAD_COUNT when
  *              capacity is too small, with *n_points the count needed).
- *   length:    receives the polyline's Euclidean length (may be NULL). */
+ *   length:    receives the polyline's Euclidean length (may be NULL).
+ * MFMM_ERR_UNREACHED: T(target) is +inf. MFMM_ERR_PATH_STALLED: T stopped
+ * decreasing before a source (or a local minimum without sources), or the
+ * path needed more than max_points points. */
 MFMM_API mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
                                      const mfmm_source *target,
                                      const mfmm_path_options *options,
