@@ -1,0 +1,58 @@
+# The OpenCL backend (issue 4). Included by the top-level CMakeLists.txt; also
+# run as a script (cmake -P) at build time to embed kernels/fmm_rows.cl with
+# its #include "local_update.h" / "march.h" lines replaced by those files, so
+# the embedded program is self-contained.
+
+if(CMAKE_SCRIPT_MODE_FILE)
+  # -DKERNEL=... -DSRC_DIR=... -DOUT=...
+  file(READ "${SRC_DIR}/local_update.h" lu)
+  file(READ "${SRC_DIR}/march.h" march)
+  file(READ "${KERNEL}" text)
+  string(REPLACE "#include \"local_update.h\"" "${lu}" march "${march}")
+  string(REPLACE "#include \"march.h\"" "${march}" text "${text}")
+  string(REPLACE "#include \"local_update.h\"" "${lu}" text "${text}")
+  if(text MATCHES "#include \"")
+    message(FATAL_ERROR "${KERNEL}: an #include was left unexpanded")
+  endif()
+  file(WRITE "${OUT}.txt" "${text}")
+  file(READ "${OUT}.txt" hex HEX)
+  string(LENGTH "${hex}" nhex)
+  math(EXPR nbytes "${nhex} / 2")
+  string(REGEX REPLACE "([0-9a-f][0-9a-f])" "0x\\1," hex "${hex}")
+  string(REGEX REPLACE "(0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,)" "\\1\n" hex "${hex}")
+  file(WRITE "${OUT}.tmp"
+    "/* Generated from kernels/fmm_rows.cl by cmake/opencl.cmake. Do not edit. */\n"
+    "#include <stddef.h>\n"
+    "const char mfmm_kernel_fmm_rows[] = {\n${hex}0x00};\n"
+    "const size_t mfmm_kernel_fmm_rows_len = ${nbytes};\n")
+  file(RENAME "${OUT}.tmp" "${OUT}")
+  return()
+endif()
+
+if(NOT MESHFMM_WITH_OPENCL)
+  message(STATUS "meshfmm: OpenCL backend disabled (MESHFMM_WITH_OPENCL=OFF)")
+  return()
+endif()
+
+find_package(OpenCL)
+if(NOT OpenCL_FOUND)
+  message(STATUS "meshfmm: OpenCL not found; the opencl backend will report MFMM_ERR_NO_OPENCL")
+  return()
+endif()
+message(STATUS "meshfmm: OpenCL backend on (${OpenCL_LIBRARIES})")
+
+set(MESHFMM_KERNEL_C ${CMAKE_CURRENT_BINARY_DIR}/generated/fmm_rows_cl.c)
+add_custom_command(OUTPUT ${MESHFMM_KERNEL_C}
+  COMMAND ${CMAKE_COMMAND} -DKERNEL=${CMAKE_CURRENT_SOURCE_DIR}/kernels/fmm_rows.cl
+          -DSRC_DIR=${CMAKE_CURRENT_SOURCE_DIR}/src -DOUT=${MESHFMM_KERNEL_C}
+          -P ${CMAKE_CURRENT_SOURCE_DIR}/cmake/opencl.cmake
+  DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/kernels/fmm_rows.cl
+          ${CMAKE_CURRENT_SOURCE_DIR}/src/local_update.h
+          ${CMAKE_CURRENT_SOURCE_DIR}/src/march.h
+          ${CMAKE_CURRENT_SOURCE_DIR}/cmake/opencl.cmake
+  COMMENT "Embedding kernels/fmm_rows.cl"
+  VERBATIM)
+target_sources(meshfmm_objects PRIVATE ${MESHFMM_KERNEL_C})
+target_compile_definitions(meshfmm_objects PRIVATE MESHFMM_HAVE_OPENCL CL_TARGET_OPENCL_VERSION=120)
+target_link_libraries(meshfmm_objects PRIVATE OpenCL::OpenCL)
+list(APPEND MESHFMM_LINK_LIBS OpenCL::OpenCL)

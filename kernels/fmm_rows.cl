@@ -1,0 +1,82 @@
+/*
+ * Many sources at once: one work-item runs one source's full heap march
+ * (src/march.h, the serial core's own code) and writes that source's row.
+ * Per-item workspaces are item-contiguous slices of nv entries.
+ *
+ * Built without -cl-mad-enable / -cl-fast-relaxed-math; local_update.h sets
+ * FP_CONTRACT OFF, so rows equal the C core's bit for bit in float64.
+ * The host embeds this file with the #include lines replaced by the headers.
+ */
+#include "march.h"
+
+/* The march for source sources[first + gid], with T in T_row. */
+inline void mfmm_row_march(int nv, __global const int *update_offset,
+                           __global const int *update_corner,
+                           __global const mfmm_corner *corners, __global const double *cost,
+                           int cost_location, double max_distance, int unfolding,
+                           int source, __global double *T_row, __global uchar *label,
+                           __global double *heap_key, __global int *heap_vertex,
+                           __global int *heap_pos)
+{
+    mfmm_march_mesh m;
+    m.nv = nv;
+    m.update_offset = update_offset;
+    m.update_corner = update_corner;
+    m.corners = corners;
+    mfmm_march_state s;
+    s.T = T_row;
+    s.label = label;
+    s.heap_key = heap_key;
+    s.heap_vertex = heap_vertex;
+    s.heap_pos = heap_pos;
+    s.heap_size = 0;
+    s.cost = cost;
+    s.cost_location = cost_location;
+    s.max_distance = max_distance;
+    s.unfolding = unfolding;
+    s.targets_left = 0;
+    mfmm_march_reset(&s, nv);
+    mfmm_march_seed(&s, source, 0.0);
+    mfmm_march_run(&s, &m);
+}
+
+/* float64 rows: the output row is the march's T. */
+__kernel void fmm_rows_f64(int nv, __global const int *update_offset,
+                           __global const int *update_corner,
+                           __global const mfmm_corner *corners, __global const double *cost,
+                           int cost_location, double max_distance, int unfolding,
+                           __global const int *sources, int first, int count,
+                           __global uchar *label_ws, __global double *key_ws,
+                           __global int *vert_ws, __global int *pos_ws, __global double *out)
+{
+    int i = (int)get_global_id(0);
+    if (i >= count)
+        return;
+    ulong o = (ulong)i * (ulong)nv;
+    mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
+                   max_distance, unfolding, sources[first + i], out + o, label_ws + o,
+                   key_ws + o, vert_ws + o, pos_ws + o);
+}
+
+/* float32 rows: T in a workspace slice, converted (round to nearest). */
+__kernel void fmm_rows_f32(int nv, __global const int *update_offset,
+                           __global const int *update_corner,
+                           __global const mfmm_corner *corners, __global const double *cost,
+                           int cost_location, double max_distance, int unfolding,
+                           __global const int *sources, int first, int count,
+                           __global uchar *label_ws, __global double *key_ws,
+                           __global int *vert_ws, __global int *pos_ws,
+                           __global double *T_ws, __global float *out)
+{
+    int i = (int)get_global_id(0);
+    if (i >= count)
+        return;
+    ulong o = (ulong)i * (ulong)nv;
+    __global double *T = T_ws + o;
+    mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
+                   max_distance, unfolding, sources[first + i], T, label_ws + o,
+                   key_ws + o, vert_ws + o, pos_ws + o);
+    __global float *row = out + o;
+    for (int v = 0; v < nv; v++)
+        row[v] = (float)T[v];
+}

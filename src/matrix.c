@@ -1,0 +1,456 @@
+/* mfmm_distance_matrix: many sources, rows handed out in blocks, on the
+ * serial core (one thread or many) or on OpenCL (src/opencl_host.c). */
+#include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "opencl_host.h"
+
+const char *mfmm_backend_name(mfmm_backend backend)
+{
+    switch (backend) {
+    case MFMM_BACKEND_AUTO: return "auto";
+    case MFMM_BACKEND_SERIAL: return "serial";
+    case MFMM_BACKEND_THREADS: return "threads";
+    case MFMM_BACKEND_OPENCL: return "opencl";
+    }
+    return "unknown";
+}
+
+void mfmm_matrix_options_init(mfmm_matrix_options *options)
+{
+    if (!options)
+        return;
+    memset(options, 0, sizeof *options);
+    options->backend = MFMM_BACKEND_AUTO;
+    options->dtype = MFMM_FLOAT32;
+    options->cost = NULL;
+    options->cost_location = MFMM_COST_NONE;
+    options->max_distance = INFINITY;
+    options->unfolding = 1;
+    options->n_threads = 0;
+    options->memory_limit = 0;
+    options->out = NULL;
+    options->on_rows = NULL;
+    options->user = NULL;
+    options->backend_used = MFMM_BACKEND_AUTO;
+}
+
+int mfmm_rows_deliver(const mfmm_rows_job *job, int32_t first, int32_t n, const void *rows)
+{
+    const mfmm_matrix_options *o = job->opt;
+    size_t row_bytes = (size_t)job->mesh->nv * job->elem_size;
+    if (o->out) {
+        char *dst = (char *)o->out + (size_t)first * row_bytes;
+        if (dst != (const char *)rows)
+            memcpy(dst, rows, (size_t)n * row_bytes);
+        rows = dst;
+    }
+    if (o->on_rows)
+        return o->on_rows(o->user, first, n, rows);
+    return 0;
+}
+
+/* Rows per block for the CPU engines: the budget less the solvers'
+ * workspaces, over `ring` blocks of rows. */
+static int32_t cpu_block_rows(const mfmm_rows_job *job, int n_workers, int ring)
+{
+    size_t nv = (size_t)job->mesh->nv;
+    size_t row_bytes = nv * job->elem_size;
+    size_t work = (size_t)n_workers * nv * 32; /* solver + a float64 row */
+    size_t left = job->budget > work ? job->budget - work : 0;
+    /* ring 0: rows go straight into the caller's buffer */
+    size_t rows = left / ((size_t)(ring > 0 ? ring : 1) * row_bytes);
+    if (rows > 1024)
+        rows = 1024; /* keep callbacks (progress, cancel) frequent */
+    if (rows < (size_t)n_workers)
+        rows = (size_t)n_workers;
+    if (rows > (size_t)job->n_sources)
+        rows = (size_t)job->n_sources;
+    return rows < 1 ? 1 : (int32_t)rows;
+}
+
+static void fill_solve_options(const mfmm_rows_job *job, mfmm_solve_options *so)
+{
+    mfmm_solve_options_init(so);
+    so->cost = job->cost;
+    so->cost_location = (mfmm_cost_location)job->cost_location;
+    so->max_distance = job->opt->max_distance;
+    so->unfolding = job->opt->unfolding != 0;
+}
+
+/* Solves row r into dst (elem_size per entry); tmp is an nv float64 row
+ * for float32 output. */
+static mfmm_status solve_row(const mfmm_rows_job *job, mfmm_solver *solver,
+                             const mfmm_solve_options *so, int32_t r, void *dst, double *tmp,
+                             mfmm_error *err)
+{
+    mfmm_source src;
+    memset(&src, 0, sizeof src);
+    src.vertex = job->sources[r];
+    src.face = -1;
+    src.value = 0.0;
+    int32_t nv = job->mesh->nv;
+    if (job->elem_size == sizeof(double))
+        return mfmm_solve(solver, &src, 1, so, (double *)dst, err);
+    mfmm_status st = mfmm_solve(solver, &src, 1, so, tmp, err);
+    if (st == MFMM_OK) {
+        float *f = (float *)dst;
+        for (int32_t v = 0; v < nv; v++)
+            f[v] = (float)tmp[v];
+    }
+    return st;
+}
+
+/* ---- serial: one solver, this thread ---- */
+
+static mfmm_status run_serial(const mfmm_rows_job *job, int32_t start, mfmm_error *err)
+{
+    int32_t nv = job->mesh->nv;
+    size_t row_bytes = (size_t)nv * job->elem_size;
+    int direct = job->opt->out != NULL;
+    int32_t block = cpu_block_rows(job, 1, direct ? 0 : 1);
+    mfmm_solver *solver = NULL;
+    double *tmp = NULL;
+    char *buf = NULL;
+    mfmm_status st = mfmm_solver_create(job->mesh, &solver);
+    if (st != MFMM_OK)
+        return mfmm_fail(err, st, -1, "could not create a solver");
+    if (job->elem_size != sizeof(double))
+        tmp = malloc((size_t)nv * sizeof *tmp);
+    if (!direct)
+        buf = malloc((size_t)block * row_bytes);
+    if ((job->elem_size != sizeof(double) && !tmp) || (!direct && !buf)) {
+        st = mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for a block of %d rows",
+                       (int)block);
+        goto done;
+    }
+    mfmm_solve_options so;
+    fill_solve_options(job, &so);
+    for (int32_t first = start; first < job->n_sources; first += block) {
+        int32_t n = job->n_sources - first < block ? job->n_sources - first : block;
+        char *base = direct ? (char *)job->opt->out + (size_t)first * row_bytes : buf;
+        for (int32_t i = 0; i < n; i++) {
+            st = solve_row(job, solver, &so, first + i, base + (size_t)i * row_bytes, tmp, err);
+            if (st != MFMM_OK)
+                goto done;
+        }
+        if (mfmm_rows_deliver(job, first, n, base)) {
+            st = mfmm_fail(err, MFMM_ERR_CANCELLED, first, "cancelled by the row callback");
+            goto done;
+        }
+    }
+done:
+    free(buf);
+    free(tmp);
+    mfmm_solver_destroy(solver);
+    return st;
+}
+
+/* ---- threads: one solver per thread; rows handed out one at a time,
+ * blocks delivered in order by the calling thread. At most two blocks are
+ * in flight (a ring of two buffers when there is no caller buffer). ---- */
+
+typedef struct pool {
+    const mfmm_rows_job *job;
+    pthread_mutex_t mu;
+    pthread_cond_t cv_main;   /* a block completed, or a failure */
+    pthread_cond_t cv_worker; /* a block was delivered, or stop */
+    int32_t start, block, next_row, delivered; /* delivered: blocks */
+    int32_t done[2];          /* rows finished in the two blocks in flight */
+    int stop;
+    mfmm_status fail;
+    mfmm_error fail_err;
+    char *ring;               /* 2 blocks, or NULL when writing into out */
+} pool;
+
+static int32_t block_len(const pool *p, int32_t b)
+{
+    int32_t first = p->start + b * p->block;
+    int32_t n = p->job->n_sources - first;
+    return n < p->block ? n : p->block;
+}
+
+static char *row_dest(const pool *p, int32_t r)
+{
+    size_t row_bytes = (size_t)p->job->mesh->nv * p->job->elem_size;
+    if (!p->ring)
+        return (char *)p->job->opt->out + (size_t)r * row_bytes;
+    int32_t b = (r - p->start) / p->block;
+    int32_t i = (r - p->start) % p->block;
+    return p->ring + ((size_t)(b & 1) * (size_t)p->block + (size_t)i) * row_bytes;
+}
+
+static void pool_failed(pool *p, mfmm_status st, const mfmm_error *e)
+{
+    if (p->fail == MFMM_OK) {
+        p->fail = st;
+        if (e)
+            p->fail_err = *e;
+        else
+            mfmm_fail(&p->fail_err, st, -1, "%s", mfmm_status_string(st));
+    }
+    p->stop = 1;
+    pthread_cond_broadcast(&p->cv_main);
+    pthread_cond_broadcast(&p->cv_worker);
+}
+
+static void *pool_worker(void *arg)
+{
+    pool *p = arg;
+    const mfmm_rows_job *job = p->job;
+    mfmm_solver *solver = NULL;
+    double *tmp = NULL;
+    mfmm_error e;
+    mfmm_ok(&e);
+    mfmm_status st = mfmm_solver_create(job->mesh, &solver);
+    if (st == MFMM_OK && job->elem_size != sizeof(double)) {
+        tmp = malloc((size_t)job->mesh->nv * sizeof *tmp);
+        if (!tmp)
+            st = MFMM_ERR_OUT_OF_MEMORY;
+    }
+    mfmm_solve_options so;
+    fill_solve_options(job, &so);
+    pthread_mutex_lock(&p->mu);
+    if (st != MFMM_OK)
+        pool_failed(p, st, NULL);
+    while (!p->stop && p->next_row < job->n_sources) {
+        int32_t r = p->next_row;
+        int32_t b = (r - p->start) / p->block;
+        if (b >= p->delivered + 2) { /* its block's slot is still in use */
+            pthread_cond_wait(&p->cv_worker, &p->mu);
+            continue;
+        }
+        p->next_row++;
+        pthread_mutex_unlock(&p->mu);
+        st = solve_row(job, solver, &so, r, row_dest(p, r), tmp, &e);
+        pthread_mutex_lock(&p->mu);
+        if (st != MFMM_OK) {
+            pool_failed(p, st, &e);
+            break;
+        }
+        if (++p->done[b & 1] == block_len(p, b))
+            pthread_cond_broadcast(&p->cv_main);
+    }
+    pthread_mutex_unlock(&p->mu);
+    free(tmp);
+    mfmm_solver_destroy(solver);
+    return NULL;
+}
+
+static int default_threads(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : (n > 256 ? 256 : (int)n);
+}
+
+static mfmm_status run_threads(const mfmm_rows_job *job, int32_t start, mfmm_error *err)
+{
+    int n_threads = job->opt->n_threads > 0 ? job->opt->n_threads : default_threads();
+    int32_t rows = job->n_sources - start;
+    if (rows <= 0)
+        return MFMM_OK;
+    if (n_threads > rows)
+        n_threads = rows;
+    if (n_threads == 1)
+        return run_serial(job, start, err);
+
+    pool p;
+    memset(&p, 0, sizeof p);
+    p.job = job;
+    p.start = p.next_row = start;
+    p.fail = MFMM_OK;
+    int use_ring = job->opt->out == NULL;
+    p.block = cpu_block_rows(job, n_threads, use_ring ? 2 : 0);
+    if (use_ring) {
+        p.ring = malloc(2 * (size_t)p.block * (size_t)job->mesh->nv * job->elem_size);
+        if (!p.ring)
+            return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1,
+                             "out of memory for two blocks of %d rows", (int)p.block);
+    }
+    pthread_t *tid = malloc((size_t)n_threads * sizeof *tid);
+    if (!tid) {
+        free(p.ring);
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for threads");
+    }
+    if (pthread_mutex_init(&p.mu, NULL) != 0) {
+        free(tid);
+        free(p.ring);
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "could not create a mutex");
+    }
+    if (pthread_cond_init(&p.cv_main, NULL) != 0) {
+        pthread_mutex_destroy(&p.mu);
+        free(tid);
+        free(p.ring);
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "could not create a condition");
+    }
+    if (pthread_cond_init(&p.cv_worker, NULL) != 0) {
+        pthread_cond_destroy(&p.cv_main);
+        pthread_mutex_destroy(&p.mu);
+        free(tid);
+        free(p.ring);
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "could not create a condition");
+    }
+    int started = 0;
+    for (; started < n_threads; started++)
+        if (pthread_create(&tid[started], NULL, pool_worker, &p) != 0)
+            break;
+
+    mfmm_status st = MFMM_OK;
+    pthread_mutex_lock(&p.mu);
+    if (started == 0)
+        pool_failed(&p, MFMM_ERR_OUT_OF_MEMORY, NULL);
+    int32_t n_blocks = (rows + p.block - 1) / p.block;
+    for (int32_t b = 0; b < n_blocks; b++) {
+        int32_t n = block_len(&p, b);
+        while (!p.stop && p.done[b & 1] < n)
+            pthread_cond_wait(&p.cv_main, &p.mu);
+        if (p.stop)
+            break;
+        pthread_mutex_unlock(&p.mu);
+        int32_t first = start + b * p.block;
+        int cancel = mfmm_rows_deliver(job, first, n, row_dest(&p, first));
+        pthread_mutex_lock(&p.mu);
+        if (cancel) {
+            st = mfmm_fail(err, MFMM_ERR_CANCELLED, first, "cancelled by the row callback");
+            p.stop = 1;
+            pthread_cond_broadcast(&p.cv_worker);
+            break;
+        }
+        p.done[b & 1] = 0;
+        p.delivered++;
+        pthread_cond_broadcast(&p.cv_worker);
+    }
+    pthread_mutex_unlock(&p.mu);
+    for (int i = 0; i < started; i++)
+        pthread_join(tid[i], NULL);
+    if (st == MFMM_OK && p.fail != MFMM_OK) {
+        st = p.fail;
+        if (err)
+            *err = p.fail_err;
+    }
+    pthread_cond_destroy(&p.cv_worker);
+    pthread_cond_destroy(&p.cv_main);
+    pthread_mutex_destroy(&p.mu);
+    free(tid);
+    free(p.ring);
+    return st;
+}
+
+/* ---- the entry point ---- */
+
+mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
+                                 int32_t n_sources, mfmm_matrix_options *options,
+                                 mfmm_error *err)
+{
+    mfmm_ok(err);
+    if (!mesh)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "mesh is NULL");
+    if (!options)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "options is NULL");
+    mfmm_matrix_options *o = options;
+    o->backend_used = o->backend;
+    int32_t nv = mesh->nv;
+    if (!o->out && !o->on_rows)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "options give neither an out buffer nor an on_rows callback");
+    if ((int)o->backend < MFMM_BACKEND_AUTO || (int)o->backend > MFMM_BACKEND_OPENCL)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "unknown backend %d", (int)o->backend);
+    if (o->dtype != MFMM_FLOAT32 && o->dtype != MFMM_FLOAT64)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "unknown dtype %d", (int)o->dtype);
+    if (isnan(o->max_distance))
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "max_distance is NaN");
+    if (o->n_threads < 0)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "n_threads is %d, must be >= 0",
+                         (int)o->n_threads);
+    if (sources == NULL && n_sources != nv)
+        return mfmm_fail(err, MFMM_ERR_BAD_COUNT, n_sources,
+                         "sources is NULL (all vertices), so n_sources must be nv = %d, not %d",
+                         (int)nv, (int)n_sources);
+    if (n_sources < 1)
+        return mfmm_fail(err, MFMM_ERR_BAD_COUNT, n_sources,
+                         "n_sources is %d, must be >= 1", (int)n_sources);
+    if (sources) {
+        for (int32_t i = 0; i < n_sources; i++)
+            if (sources[i] < 0 || sources[i] >= nv)
+                return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, i,
+                                 "source %d is vertex %d, outside [0, %d)", (int)i,
+                                 (int)sources[i], (int)nv);
+    }
+    const double *cost = NULL;
+    int cost_location = 0;
+    if (o->cost) {
+        int32_t n_cost;
+        if (o->cost_location == MFMM_COST_PER_VERTEX)
+            n_cost = nv;
+        else if (o->cost_location == MFMM_COST_PER_FACE)
+            n_cost = mesh->nf;
+        else if (o->cost_location == MFMM_COST_NONE)
+            return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                             "a cost array was given without a cost location "
+                             "(per vertex or per face)");
+        else
+            return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "unknown cost location %d",
+                             (int)o->cost_location);
+        for (int32_t i = 0; i < n_cost; i++)
+            if (!(isfinite(o->cost[i]) && o->cost[i] > 0.0))
+                return mfmm_fail(err, MFMM_ERR_BAD_COST, i,
+                                 "cost[%d] = %g; costs must be finite and > 0", (int)i,
+                                 o->cost[i]);
+        cost = o->cost;
+        cost_location = (int)o->cost_location;
+    }
+
+    int32_t *all = NULL;
+    if (!sources) {
+        all = malloc((size_t)nv * sizeof *all);
+        if (!all)
+            return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for %d source ids",
+                             (int)nv);
+        for (int32_t i = 0; i < nv; i++)
+            all[i] = i;
+        sources = all;
+    }
+    mfmm_rows_job job;
+    job.mesh = mesh;
+    job.sources = sources;
+    job.n_sources = n_sources;
+    job.opt = o;
+    job.cost = cost;
+    job.cost_location = cost_location;
+    job.elem_size = o->dtype == MFMM_FLOAT64 ? sizeof(double) : sizeof(float);
+    job.budget = o->memory_limit ? o->memory_limit : MFMM_DEFAULT_BUDGET;
+
+    mfmm_status st;
+    switch (o->backend) {
+    case MFMM_BACKEND_SERIAL:
+        st = run_serial(&job, 0, err);
+        break;
+    case MFMM_BACKEND_THREADS:
+        st = run_threads(&job, 0, err);
+        break;
+    case MFMM_BACKEND_OPENCL: {
+        int32_t done = 0;
+        st = mfmm_opencl_rows(&job, 0, &done, err);
+        break;
+    }
+    default: { /* auto: OpenCL, else threads from the first row not delivered */
+        int32_t done = 0;
+        o->backend_used = MFMM_BACKEND_OPENCL;
+        st = mfmm_opencl_rows(&job, 0, &done, err);
+        if (st == MFMM_ERR_NO_OPENCL || st == MFMM_ERR_OPENCL_BUILD ||
+            st == MFMM_ERR_OPENCL_RUNTIME || st == MFMM_ERR_OUT_OF_MEMORY) {
+            o->backend_used = MFMM_BACKEND_THREADS;
+            mfmm_ok(err);
+            st = run_threads(&job, done, err);
+        }
+        break;
+    }
+    }
+    if (st == MFMM_OK)
+        mfmm_ok(err);
+    free(all);
+    return st;
+}
