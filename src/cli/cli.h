@@ -1,0 +1,78 @@
+/* The meshfmm command line: shared declarations. Each subcommand is a
+ * function `int cmd_NAME(int argc, char **argv)` (argv[0] is the
+ * subcommand's name) returning an exit status, listed in main.c's table. */
+#ifndef MFMM_CLI_H
+#define MFMM_CLI_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+#include "meshfmm.h"
+
+enum { CLI_OK = 0, CLI_FAIL = 1, CLI_USAGE = 2 };
+
+int cmd_info(int argc, char **argv);
+int cmd_distance(int argc, char **argv);
+int cmd_generate(int argc, char **argv);
+
+/* Prints "meshfmm: <message>\n" on stderr. */
+void cli_error(const char *fmt, ...)
+#ifdef __GNUC__
+    __attribute__((format(printf, 1, 2)))
+#endif
+    ;
+
+/* Prints "meshfmm SUB: <message>" and a hint to run --help; returns CLI_USAGE. */
+int cli_usage_error(const char *sub, const char *fmt, ...)
+#ifdef __GNUC__
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+/* Strict number parsing of a whole argument: 1 on success, 0 otherwise. */
+int cli_parse_int32(const char *s, int32_t *out);
+int cli_parse_double(const char *s, double *out);
+
+/* 1 when `path` ends with `.ext` (case-insensitive; ext without the dot). */
+int cli_has_ext(const char *path, const char *ext);
+
+/* Loads a mesh file and builds an mfmm_mesh; prints the error and returns
+ * NULL on failure. */
+mfmm_mesh *cli_load_mesh(const char *path, const mfmm_mesh_options *options);
+
+/* ---- .npy files (format 1.0) ---- */
+
+/* Streaming writer: data goes to "PATH.partial", renamed to PATH by
+ * cli_npy_close; cli_npy_abort removes the temporary file. Errors are
+ * printed (cli_error). */
+typedef struct cli_npy_writer {
+    FILE *f;
+    char *path;      /* final name */
+    char *tmp_path;  /* PATH.partial */
+    int64_t rows;    /* rows promised in the header */
+    int64_t cols;    /* values per row (1 for a 1-D array) */
+    int64_t rows_written;
+    size_t itemsize; /* 4 or 8 */
+} cli_npy_writer;
+
+/* dtype "<f4" or "<f8". cols < 0 writes a 1-D array of `rows` values;
+ * otherwise shape (rows, cols). 0 on success, -1 on error. */
+int cli_npy_open(cli_npy_writer *w, const char *path, const char *dtype, int64_t rows,
+                 int64_t cols);
+/* Appends n_rows rows (n_rows * cols values of the writer's dtype, host
+ * byte order). 0 or -1. */
+int cli_npy_append(cli_npy_writer *w, const void *data, int64_t n_rows);
+/* Checks that all rows were written, closes and renames. 0 or -1; on -1 the
+ * temporary file is removed. */
+int cli_npy_close(cli_npy_writer *w);
+/* Closes and removes the temporary file; safe after a failed open. */
+void cli_npy_abort(cli_npy_writer *w);
+
+/* Reads a 1-D float64 or float32 .npy array (a 2-D one with a dimension of
+ * 1 too) as doubles (malloc'ed). 0 on success, -1 with the error printed. */
+int cli_npy_read_vector(const char *path, double **values, int64_t *n);
+
+/* Reads whitespace-separated numbers from a text file ('#' comments). */
+int cli_txt_read_vector(const char *path, double **values, int64_t *n);
+
+#endif /* MFMM_CLI_H */

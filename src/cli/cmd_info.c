@@ -1,0 +1,111 @@
+/* meshfmm info MESH [--json] [--max-unfold-steps N] */
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+
+static void help(FILE *out)
+{
+    fprintf(out,
+            "usage: meshfmm info MESH [--json] [--max-unfold-steps N]\n\n"
+            "Reads MESH (.obj, .off, .ply) and prints its counts: vertices, faces, edges,\n"
+            "boundary and non-manifold edges, components, unreferenced vertices,\n"
+            "degenerate faces, obtuse corners, virtual edges found by unfolding and\n"
+            "unfolding failures, edge lengths and the bounding-box diagonal.\n\n"
+            "  --json                 one JSON object instead of text\n"
+            "  --max-unfold-steps N   faces one unfolding walk may cross (default 64)\n");
+}
+
+/* Prints a path as a JSON string (escaping quotes, backslashes, controls). */
+static void json_string(const char *s)
+{
+    putchar('"');
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            printf("\\%c", c);
+        else if (c < 0x20)
+            printf("\\u%04x", c);
+        else
+            putchar(c);
+    }
+    putchar('"');
+}
+
+int cmd_info(int argc, char **argv)
+{
+    const char *path = NULL;
+    int json = 0;
+    mfmm_mesh_options opt;
+    mfmm_mesh_options_init(&opt);
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            help(stdout);
+            return CLI_OK;
+        } else if (strcmp(a, "--json") == 0) {
+            json = 1;
+        } else if (strcmp(a, "--max-unfold-steps") == 0) {
+            if (i + 1 >= argc || !cli_parse_int32(argv[i + 1], &opt.max_unfold_steps) ||
+                opt.max_unfold_steps < 1)
+                return cli_usage_error("info", "--max-unfold-steps needs an integer >= 1");
+            i++;
+        } else if (a[0] == '-' && a[1] != '\0') {
+            return cli_usage_error("info", "unknown option '%s'", a);
+        } else if (!path) {
+            path = a;
+        } else {
+            return cli_usage_error("info", "one mesh at a time ('%s' is extra)", a);
+        }
+    }
+    if (!path)
+        return cli_usage_error("info", "no mesh file given");
+
+    mfmm_mesh *mesh = cli_load_mesh(path, &opt);
+    if (!mesh)
+        return CLI_FAIL;
+    mfmm_mesh_info m;
+    mfmm_status st = mfmm_mesh_get_info(mesh, &m);
+    mfmm_mesh_destroy(mesh);
+    if (st != MFMM_OK) {
+        cli_error("%s: %s", path, mfmm_status_string(st));
+        return CLI_FAIL;
+    }
+    if (json) {
+        printf("{\"file\": ");
+        json_string(path);
+        printf(", \"vertices\": %d, \"faces\": %d, \"edges\": %d, \"boundary_edges\": %d, "
+               "\"nonmanifold_edges\": %d, \"components\": %d, \"unreferenced_vertices\": %d, "
+               "\"degenerate_faces\": %d, \"obtuse_corners\": %d, \"virtual_edges\": %d, "
+               "\"unfold_failures\": %d, \"min_edge_length\": %.17g, "
+               "\"max_edge_length\": %.17g, \"mean_edge_length\": %.17g, "
+               "\"bbox_diagonal\": %.17g}\n",
+               (int)m.n_vertices, (int)m.n_faces, (int)m.n_edges, (int)m.n_boundary_edges,
+               (int)m.n_nonmanifold_edges, (int)m.n_components, (int)m.n_unreferenced_vertices,
+               (int)m.n_degenerate_faces, (int)m.n_obtuse_corners, (int)m.n_virtual_edges,
+               (int)m.n_unfold_failures, m.min_edge_length, m.max_edge_length,
+               m.mean_edge_length, m.bbox_diagonal);
+    } else {
+        printf("file:                  %s\n", path);
+        printf("vertices:              %d\n", (int)m.n_vertices);
+        printf("faces:                 %d\n", (int)m.n_faces);
+        printf("edges:                 %d\n", (int)m.n_edges);
+        printf("boundary edges:        %d\n", (int)m.n_boundary_edges);
+        printf("non-manifold edges:    %d\n", (int)m.n_nonmanifold_edges);
+        printf("components:            %d\n", (int)m.n_components);
+        printf("unreferenced vertices: %d\n", (int)m.n_unreferenced_vertices);
+        printf("degenerate faces:      %d\n", (int)m.n_degenerate_faces);
+        printf("obtuse corners:        %d\n", (int)m.n_obtuse_corners);
+        printf("virtual edges:         %d\n", (int)m.n_virtual_edges);
+        printf("unfold failures:       %d\n", (int)m.n_unfold_failures);
+        printf("edge length min:       %.6g\n", m.min_edge_length);
+        printf("edge length max:       %.6g\n", m.max_edge_length);
+        printf("edge length mean:      %.6g\n", m.mean_edge_length);
+        printf("bbox diagonal:         %.6g\n", m.bbox_diagonal);
+    }
+    if (fflush(stdout) != 0) {
+        cli_error("cannot write to standard output");
+        return CLI_FAIL;
+    }
+    return CLI_OK;
+}
