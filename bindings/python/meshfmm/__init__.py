@@ -1,0 +1,35 @@
+"""meshfmm: geodesic distances and shortest paths on triangle meshes by the
+Fast Marching Method of Kimmel & Sethian (PNAS 1998), a ctypes binding of the
+C99 library libmeshfmm.
+
+>>> import meshfmm
+>>> V, F = meshfmm.load_mesh("spot.obj")            # doctest: +SKIP
+>>> mesh = meshfmm.Mesh(V, F)                       # doctest: +SKIP
+>>> d = mesh.distance(0)                            # float64 (nv,)  # doctest: +SKIP
+>>> path = mesh.geodesic_path(d, 1234)              # doctest: +SKIP
+>>> D = mesh.distance_matrix([0, 10, 20])           # float32 (3, nv)  # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+from . import _lib
+from ._lib import MeshError, OpenCLError
+from ._mesh import GeodesicPath, Mesh, MeshInfo, SurfacePoint, load_mesh
+
+#: Version of the loaded libmeshfmm ("MAJOR.MINOR.PATCH").
+__version__: str = _lib.version()
+
+#: Path of the loaded shared library.
+library_path: str = _lib.library_path
+
+__all__ = [
+    "Mesh",
+    "MeshInfo",
+    "SurfacePoint",
+    "GeodesicPath",
+    "MeshError",
+    "OpenCLError",
+    "load_mesh",
+    "library_path",
+    "__version__",
+]

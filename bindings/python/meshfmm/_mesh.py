@@ -1,0 +1,679 @@
+"""Mesh, SurfacePoint, GeodesicPath and load_mesh: the Python face of libmeshfmm.
+
+All foreign calls go through :mod:`meshfmm._lib`.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import dataclasses
+import errno
+import math
+import operator
+import os
+import threading
+from ctypes import byref
+from typing import Any, Callable, List, NamedTuple, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _lib
+from ._lib import MeshError
+
+__all__ = ["Mesh", "MeshInfo", "SurfacePoint", "GeodesicPath", "load_mesh"]
+
+_I32_MIN = -(2**31)
+_I32_MAX = 2**31 - 1
+
+
+class SurfacePoint(NamedTuple):
+    """A point inside a face: ``face`` id and barycentric coordinates ``bary``
+    (three numbers >= 0 summing to 1, weights of the face's corners in the
+    order the face lists them). Usable as a source of :meth:`Mesh.distance`
+    and as a target of :meth:`Mesh.geodesic_path`."""
+
+    face: int
+    bary: Sequence[float]
+
+
+SourceLike = Union[int, SurfacePoint, Sequence[Union[int, SurfacePoint]], np.ndarray]
+
+
+@dataclasses.dataclass(frozen=True)
+class MeshInfo:
+    """Diagnostics of a mesh, computed once when it was created
+    (``mfmm_mesh_info``)."""
+
+    n_vertices: int  #: vertices as given
+    n_faces: int  #: faces as given
+    n_edges: int  #: distinct undirected edges
+    n_boundary_edges: int  #: edges with one face
+    n_nonmanifold_edges: int  #: edges with three or more faces
+    n_components: int  #: edge-connected components of referenced vertices
+    n_unreferenced_vertices: int  #: vertices no face names (always +inf)
+    n_degenerate_faces: int  #: faces of (numerically) zero area
+    n_obtuse_corners: int  #: corners with an angle > 90 degrees
+    n_virtual_edges: int  #: obtuse corners split by a virtual edge (unfolding)
+    n_unfold_failures: int  #: obtuse corners whose unfolding walk failed
+    min_edge_length: float
+    max_edge_length: float
+    mean_edge_length: float
+    bbox_diagonal: float  #: length of the bounding-box diagonal
+
+    def as_dict(self) -> dict:
+        """The fields as a plain dict."""
+        return dataclasses.asdict(self)
+
+
+@dataclasses.dataclass(frozen=True)
+class GeodesicPath:
+    """A polyline on the surface from a target back to its source.
+
+    ``points`` (k,3) positions, ``faces`` (k,) the face each point lies in,
+    ``barycentric`` (k,3) its coordinates in that face, ``length`` the
+    polyline's Euclidean length, ``weighted_length`` its cost-weighted length
+    (sum of F times segment length; equal to ``length`` without a cost).
+    Point 0 is the target, point k-1 the source; ``faces[i]`` (i > 0) is the
+    face the segment from point i-1 runs through.
+    """
+
+    points: np.ndarray
+    faces: np.ndarray
+    barycentric: np.ndarray
+    length: float
+    weighted_length: float
+
+    def __len__(self) -> int:
+        return int(self.faces.shape[0])
+
+
+# ------------------------------------------------------------------ helpers
+def _addr(a: np.ndarray) -> int:
+    """Address of an ndarray's first element."""
+    return a.__array_interface__["data"][0]
+
+
+def _is_int(x: Any) -> bool:
+    return isinstance(x, (int, np.integer)) and not isinstance(x, (bool, np.bool_))
+
+
+def _as_index(x: Any, what: str) -> int:
+    if not _is_int(x):
+        raise TypeError(f"{what} must be an integer, got {type(x).__name__}")
+    i = int(x)
+    if not (_I32_MIN <= i <= _I32_MAX):
+        raise ValueError(f"{what} {i} is out of range (not a 32-bit index)")
+    return i
+
+
+def _bary(b: Any, what: str) -> np.ndarray:
+    try:
+        arr = np.asarray(b, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what}: barycentric coordinates must be 3 numbers, got {b!r}") from None
+    if arr.shape != (3,):
+        raise ValueError(
+            f"{what}: barycentric coordinates must be 3 numbers, got shape {arr.shape}"
+        )
+    return arr
+
+
+def _source_records(sources: Any, what: str = "source") -> np.ndarray:
+    """Any accepted form of sources -> a C-contiguous array of mfmm_source."""
+    if isinstance(sources, SurfacePoint):
+        sources = [sources]
+    elif _is_int(sources):
+        rec = np.zeros(1, dtype=_lib.SOURCE_DTYPE)
+        rec["vertex"] = _as_index(sources, what)
+        rec["face"] = -1
+        return rec
+    if isinstance(sources, np.ndarray):
+        if sources.dtype.kind not in "iu":
+            raise TypeError(f"{what}s as an array must be integer vertex ids, got dtype {sources.dtype}")
+        ids = sources.reshape(-1)
+        if ids.size == 0:
+            raise ValueError(f"at least one {what} is needed")
+        if ids.min() < _I32_MIN or ids.max() > _I32_MAX:
+            bad = ids[(ids < _I32_MIN) | (ids > _I32_MAX)][0]
+            raise ValueError(f"{what} {bad} is out of range (not a 32-bit index)")
+        rec = np.zeros(ids.size, dtype=_lib.SOURCE_DTYPE)
+        rec["vertex"] = ids
+        rec["face"] = -1
+        return rec
+    if isinstance(sources, (str, bytes)) or not hasattr(sources, "__len__"):
+        raise TypeError(
+            f"{what}s must be a vertex id, a SurfacePoint or a sequence of those, "
+            f"got {type(sources).__name__}"
+        )
+    n = len(sources)
+    if n == 0:
+        raise ValueError(f"at least one {what} is needed")
+    rec = np.zeros(n, dtype=_lib.SOURCE_DTYPE)
+    for i, s in enumerate(sources):
+        if isinstance(s, SurfacePoint):
+            rec["face"][i] = _as_index(s.face, f"{what} {i}: face")
+            rec["vertex"][i] = -1
+            rec["bary"][i] = _bary(s.bary, f"{what} {i}")
+        elif _is_int(s):
+            rec["vertex"][i] = _as_index(s, f"{what} {i}: vertex")
+            rec["face"][i] = -1
+        else:
+            raise TypeError(
+                f"{what} {i} must be a vertex id or a SurfacePoint, got {type(s).__name__}"
+            )
+    return rec
+
+
+def _target_record(target: Any) -> _lib.mfmm_source:
+    src = _lib.mfmm_source()
+    if isinstance(target, SurfacePoint):
+        src.vertex = -1
+        src.face = _as_index(target.face, "target face")
+        b = _bary(target.bary, "target")
+        src.bary[0], src.bary[1], src.bary[2] = float(b[0]), float(b[1]), float(b[2])
+    elif _is_int(target):
+        src.vertex = _as_index(target, "target vertex")
+        src.face = -1
+    else:
+        raise TypeError(f"target must be a vertex id or a SurfacePoint, got {type(target).__name__}")
+    return src
+
+
+_COST_LOCATIONS = {"vertex": _lib.MFMM_COST_PER_VERTEX, "face": _lib.MFMM_COST_PER_FACE}
+
+
+def _cost_array(cost: Any, cost_location: Optional[str], nv: int, nf: int) -> Tuple[Optional[np.ndarray], int]:
+    if cost is None:
+        if cost_location is not None and cost_location not in _COST_LOCATIONS:
+            raise ValueError(f"cost_location must be 'vertex' or 'face', got {cost_location!r}")
+        return None, _lib.MFMM_COST_NONE
+    c = np.asarray(cost)
+    if c.dtype.kind not in "iuf":
+        raise ValueError(f"cost must be an array of numbers, got dtype {c.dtype}")
+    c = np.ascontiguousarray(c, dtype=np.float64)
+    if c.ndim != 1:
+        raise ValueError(f"cost must be 1-D, (n_vertices,) or (n_faces,), got shape {c.shape}")
+    if cost_location is None:
+        if c.shape[0] == nv and nv == nf:
+            raise ValueError(
+                f"the mesh has as many vertices as faces ({nv}): say cost_location='vertex' or 'face'"
+            )
+        if c.shape[0] == nv:
+            loc = _lib.MFMM_COST_PER_VERTEX
+        elif c.shape[0] == nf:
+            loc = _lib.MFMM_COST_PER_FACE
+        else:
+            raise ValueError(
+                f"cost has {c.shape[0]} entries; the mesh has {nv} vertices and {nf} faces"
+            )
+    else:
+        if cost_location not in _COST_LOCATIONS:
+            raise ValueError(f"cost_location must be 'vertex' or 'face', got {cost_location!r}")
+        loc = _COST_LOCATIONS[cost_location]
+        want = nv if loc == _lib.MFMM_COST_PER_VERTEX else nf
+        if c.shape[0] != want:
+            raise ValueError(
+                f"cost per {cost_location} must have {want} entries, got {c.shape[0]}"
+            )
+    return c, loc
+
+
+def _max_distance(x: Optional[float]) -> float:
+    if x is None:
+        return math.inf
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        raise TypeError(f"max_distance must be a number, got {type(x).__name__}") from None
+
+
+# --------------------------------------------------------------------- mesh
+class Mesh:
+    """An immutable triangle mesh, validated and preprocessed by the C core.
+
+    ``Mesh(V, F)``: ``V`` anything numpy turns into float64 ``(n, 3)``
+    (lists, float32, Fortran order, strided views), ``F`` anything numpy
+    turns into integer ``(m, 3)`` (0-based vertex ids; int64 accepted when the
+    values fit). Both are copied. ``max_unfold_steps`` bounds the unfolding
+    walk that finds the virtual edge of an obtuse corner (default 64).
+
+    Raises :class:`meshfmm.MeshError` (a ValueError) with the reason for wrong
+    shapes, NaN or infinite coordinates, face indices out of range or a face
+    that repeats a vertex. Boundaries, several components, unreferenced
+    vertices, non-manifold edges and degenerate faces are accepted.
+
+    A Mesh may be used from several threads at once: each concurrent call
+    gets its own solver workspace, and the C calls release the GIL. Free it
+    early with :meth:`close` or a ``with`` block; otherwise it is freed when
+    garbage-collected.
+    """
+
+    def __init__(self, V: Any, F: Any, *, max_unfold_steps: Optional[int] = None) -> None:
+        self._ptr: Optional[int] = None
+        self._lock = threading.Lock()
+        self._active = 0
+        self._solvers: List[int] = []
+        #: Name of the backend that ran the last :meth:`distance_matrix` call
+        #: ("serial", "threads" or "opencl"), None before the first.
+        self.backend_used: Optional[str] = None
+
+        Va = np.asarray(V)
+        if Va.dtype.kind not in "iuf":
+            raise MeshError(f"vertices must be numbers, got dtype {Va.dtype}")
+        if Va.ndim != 2 or Va.shape[1] != 3:
+            raise MeshError(f"vertices must have shape (n, 3), got {Va.shape}")
+        Fa = np.asarray(F)
+        if Fa.size == 0 and Fa.ndim <= 2 and Fa.dtype.kind == "f":
+            Fa = Fa.astype(np.int32)  # an empty list: let the shape check speak
+        if Fa.dtype.kind not in "iu":
+            raise MeshError(f"faces must be integer vertex ids, got dtype {Fa.dtype}")
+        if Fa.ndim != 2 or Fa.shape[1] != 3:
+            raise MeshError(f"faces must have shape (m, 3), got {Fa.shape}")
+        nv, nf = Va.shape[0], Fa.shape[0]
+        if nv > _I32_MAX or nf > _I32_MAX:
+            raise MeshError(f"too many vertices or faces for 32-bit indices ({nv}, {nf})")
+        if nf and Fa.dtype.itemsize >= 4 and Fa.dtype != np.int32:
+            lo, hi = Fa.min(), Fa.max()
+            if lo < _I32_MIN or hi > _I32_MAX:
+                bad = np.argwhere((Fa < _I32_MIN) | (Fa > _I32_MAX))[0]
+                raise MeshError(
+                    f"face {bad[0]} names vertex {Fa[bad[0], bad[1]]}, out of range "
+                    f"(the mesh has {nv} vertices)"
+                )
+        # One private copy each, in the C types; read-only views go out.
+        self._V = np.array(Va, dtype=np.float64, order="C", copy=True)
+        self._F = np.array(Fa, dtype=np.int32, order="C", copy=True)
+        self._V.setflags(write=False)
+        self._F.setflags(write=False)
+
+        opts = _lib.mfmm_mesh_options()
+        _lib.mfmm_mesh_options_init(byref(opts))
+        if max_unfold_steps is not None:
+            opts.max_unfold_steps = _as_index(max_unfold_steps, "max_unfold_steps")
+        err = _lib.mfmm_error()
+        out = ctypes.c_void_p()
+        status = _lib.mfmm_mesh_create(
+            _addr(self._V), nv, _addr(self._F), nf, byref(opts), byref(out), byref(err)
+        )
+        _lib.check(status, err, mesh=True)
+        self._ptr = out.value
+        self._nv = nv
+        self._nf = nf
+        info = _lib.mfmm_mesh_info()
+        _lib.check(_lib.mfmm_mesh_get_info(self._ptr, byref(info)))
+        self._info = MeshInfo(**{name: getattr(info, name) for name, _ in info._fields_})
+        self._opts_template = _lib.mfmm_solve_options()
+        _lib.mfmm_solve_options_init(byref(self._opts_template))
+
+    # ---- lifetime
+    def close(self) -> None:
+        """Frees the C mesh and its solvers now. Idempotent. Raises
+        RuntimeError if another thread is computing on this mesh."""
+        with self._lock:
+            if self._ptr is None:
+                return
+            if self._active:
+                raise RuntimeError("Mesh.close(): another thread is still computing on this mesh")
+            ptr, self._ptr = self._ptr, None
+            solvers, self._solvers = self._solvers, []
+        for s in solvers:
+            _lib.mfmm_solver_destroy(s)
+        _lib.mfmm_mesh_destroy(ptr)
+
+    @property
+    def closed(self) -> bool:
+        """True once :meth:`close` has freed the mesh."""
+        return self._ptr is None
+
+    def __enter__(self) -> "Mesh":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        try:
+            if getattr(self, "_ptr", None) is not None and not self._active:
+                self.close()
+        except Exception:  # interpreter shutdown: the library may be gone
+            pass
+
+    def _enter(self) -> int:
+        with self._lock:
+            if self._ptr is None:
+                raise ValueError("the mesh is closed")
+            self._active += 1
+            return self._ptr
+
+    def _leave(self) -> None:
+        with self._lock:
+            self._active -= 1
+
+    def _take_solver(self, mesh_ptr: int) -> int:
+        try:
+            return self._solvers.pop()  # atomic under the GIL
+        except IndexError:
+            out = ctypes.c_void_p()
+            _lib.check(_lib.mfmm_solver_create(mesh_ptr, byref(out)))
+            return out.value  # type: ignore[return-value]
+
+    # ---- properties
+    @property
+    def n_vertices(self) -> int:
+        """Number of vertices (unreferenced ones included)."""
+        return self._nv
+
+    @property
+    def n_faces(self) -> int:
+        """Number of faces."""
+        return self._nf
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """The vertices, float64 (n_vertices, 3), read-only."""
+        return self._V
+
+    @property
+    def faces(self) -> np.ndarray:
+        """The faces, int32 (n_faces, 3), read-only."""
+        return self._F
+
+    @property
+    def info(self) -> MeshInfo:
+        """Diagnostics: counts of edges, boundary and non-manifold edges,
+        components, unreferenced vertices, degenerate faces, obtuse corners,
+        virtual edges and failed unfoldings; edge lengths; bounding-box
+        diagonal (:class:`MeshInfo`)."""
+        return self._info
+
+    def __repr__(self) -> str:
+        state = "closed" if self._ptr is None else f"{self._nv} vertices, {self._nf} faces"
+        return f"<meshfmm.Mesh {state}>"
+
+    # ---- distances
+    def distance(
+        self,
+        sources: SourceLike,
+        cost: Any = None,
+        max_distance: Optional[float] = None,
+        *,
+        targets: Any = None,
+        unfolding: bool = True,
+        cost_location: Optional[str] = None,
+    ) -> np.ndarray:
+        """Distance from the nearest source to every vertex, float64 (n_vertices,).
+
+        sources: a vertex id, a :class:`SurfacePoint` (a point inside a face),
+            or a sequence mixing those (an integer array is read as vertex ids).
+        cost: the slowness F (``|grad T| = F``), per vertex (n_vertices,) or per
+            face (n_faces,), finite and > 0; None for plain geodesic distance.
+            When the mesh has as many vertices as faces, ``cost_location``
+            ('vertex' or 'face') must say which.
+        max_distance: stop marching past it; vertices beyond are +inf.
+        targets: vertex ids; the march stops once all of them are settled
+            (then only settled vertices are final, the rest may be +inf).
+        unfolding: False uses plain stencils at obtuse corners (for comparison).
+
+        Unreached vertices (other components, beyond max_distance) are +inf.
+        Raises ValueError (bad source, barycentric coordinates, cost, ...).
+        """
+        src = _source_records(sources)
+        opts = _lib.mfmm_solve_options.from_buffer_copy(self._opts_template)
+        c, loc = _cost_array(cost, cost_location, self._nv, self._nf)
+        if c is not None:
+            opts.cost = _addr(c)
+            opts.cost_location = loc
+        if max_distance is not None:
+            opts.max_distance = _max_distance(max_distance)
+        t = None
+        if targets is not None:
+            t = _index_array(targets, "target")
+            opts.targets = _addr(t)
+            opts.n_targets = t.shape[0]
+        if not unfolding:
+            opts.unfolding = 0
+        out = np.empty(self._nv, dtype=np.float64)
+        err = _lib.mfmm_error()
+        solver = None
+        mesh_ptr = self._enter()
+        try:
+            solver = self._take_solver(mesh_ptr)
+            status = _lib.mfmm_solve(
+                solver, _addr(src), src.shape[0], byref(opts), _addr(out), byref(err)
+            )
+        finally:
+            if solver is not None:
+                self._solvers.append(solver)
+            self._leave()
+        if status:
+            raise _lib.make_error(status, err)
+        return out
+
+    # ---- paths
+    def geodesic_path(
+        self,
+        distances: Any,
+        target: Union[int, SurfacePoint],
+        *,
+        sources: Optional[SourceLike] = None,
+        cost: Any = None,
+        cost_location: Optional[str] = None,
+        max_points: Optional[int] = None,
+    ) -> GeodesicPath:
+        """Backtracks from ``target`` along -grad T to the source (paper
+        section 5) and returns a :class:`GeodesicPath`.
+
+        distances: (n_vertices,) from :meth:`distance`.
+        target: a vertex id or a :class:`SurfacePoint`.
+        sources: the sources ``distances`` came from; the path then ends
+            exactly at the nearest one (else where T stops decreasing).
+        cost, cost_location: the cost ``distances`` was solved with.
+        max_points: most points the path may have (default: the library's).
+
+        Raises ValueError for an unreached (+inf) target, RuntimeError when
+        tracing stalls.
+        """
+        d = np.ascontiguousarray(distances, dtype=np.float64)
+        if d.shape != (self._nv,):
+            raise ValueError(f"distances must have shape ({self._nv},), got {d.shape}")
+        tgt = _target_record(target)
+        opts = _lib.mfmm_path_options()
+        _lib.mfmm_path_options_init(byref(opts))
+        if max_points is not None:
+            opts.max_points = _as_index(max_points, "max_points")
+        src = None
+        if sources is not None:
+            src = _source_records(sources)
+            opts.sources = _addr(src)
+            opts.n_sources = src.shape[0]
+        c, loc = _cost_array(cost, cost_location, self._nv, self._nf)
+        if c is not None:
+            opts.cost = _addr(c)
+            opts.cost_location = loc
+        capacity = 1024
+        n = ctypes.c_int32(0)
+        length = ctypes.c_double(0.0)
+        weighted = ctypes.c_double(0.0)
+        opts.weighted_length = ctypes.addressof(weighted)
+        err = _lib.mfmm_error()
+        mesh_ptr = self._enter()
+        try:
+            while True:
+                buf = np.empty(capacity, dtype=_lib.SURFACE_POINT_DTYPE)
+                status = _lib.mfmm_trace_path(
+                    mesh_ptr, _addr(d), byref(tgt), byref(opts), _addr(buf), capacity,
+                    byref(n), byref(length), byref(err),
+                )
+                if status == _lib.MFMM_ERR_BAD_COUNT and n.value > capacity:
+                    capacity = n.value
+                    continue
+                break
+        finally:
+            self._leave()
+        _lib.check(status, err)
+        pts = buf[: n.value]
+        return GeodesicPath(
+            points=np.ascontiguousarray(pts["xyz"]),
+            faces=np.ascontiguousarray(pts["face"]),
+            barycentric=np.ascontiguousarray(pts["bary"]),
+            length=float(length.value),
+            weighted_length=float(weighted.value),
+        )
+
+    # ---- many sources
+    def distance_matrix(
+        self,
+        sources: Any = None,
+        backend: str = "auto",
+        dtype: Any = "float32",
+        out: Optional[np.ndarray] = None,
+        *,
+        max_distance: Optional[float] = None,
+        cost: Any = None,
+        cost_location: Optional[str] = None,
+        unfolding: bool = True,
+        n_threads: int = 0,
+        memory_limit: int = 0,
+        progress: Optional[Callable[[int, int], Any]] = None,
+    ) -> np.ndarray:
+        """Distances from many vertex sources: row i holds the distances from
+        ``sources[i]`` to every vertex (equal to :meth:`distance`'s).
+
+        sources: vertex ids; None for all vertices in order (an N x N matrix).
+        backend: "auto" (OpenCL when a device is usable, else threads),
+            "opencl", "threads" or "serial". The backend that ran is stored in
+            :attr:`backend_used`.
+        dtype: "float32" or "float64" output (arithmetic is always float64).
+        out: a preallocated C-contiguous writable array (a numpy.memmap
+            works) of shape (len(sources) or n_vertices, n_vertices) and the
+            given dtype, written in place and returned; None allocates one.
+        max_distance, cost, cost_location, unfolding: as in :meth:`distance`.
+        n_threads: threads for the threads backend, 0 for all cores.
+        memory_limit: bytes the library may use for blocks in flight (0: default).
+        progress: called as ``progress(rows_done, n_rows)`` as blocks of rows
+            finish; an exception it raises (or Ctrl-C) stops the computation
+            and propagates.
+
+        Raises OpenCLError when backend="opencl" cannot run, ValueError for
+        bad arguments.
+        """
+        if sources is None:
+            src = None
+            n_rows = self._nv
+        else:
+            src = _index_array(sources, "source")
+            n_rows = src.shape[0]
+            if n_rows == 0:
+                raise ValueError("at least one source is needed")
+        dt = np.dtype(dtype)
+        if dt == np.float32:
+            cdt = _lib.MFMM_FLOAT32
+        elif dt == np.float64:
+            cdt = _lib.MFMM_FLOAT64
+        else:
+            raise ValueError(f"dtype must be float32 or float64, got {dt}")
+        if not isinstance(backend, str) or backend.lower() not in _lib.BACKENDS:
+            raise ValueError(f"backend must be one of {sorted(_lib.BACKENDS)}, got {backend!r}")
+        shape = (n_rows, self._nv)
+        if out is None:
+            out = np.empty(shape, dtype=dt)
+        else:
+            if not isinstance(out, np.ndarray):
+                raise TypeError(f"out must be a numpy array or memmap, got {type(out).__name__}")
+            if out.shape != shape:
+                raise ValueError(f"out must have shape {shape}, got {out.shape}")
+            if out.dtype != dt:
+                raise ValueError(f"out must have dtype {dt}, got {out.dtype}")
+            if not out.flags.c_contiguous:
+                raise ValueError("out must be C-contiguous")
+            if not out.flags.writeable:
+                raise ValueError("out must be writable")
+        opts = _lib.mfmm_matrix_options()
+        _lib.mfmm_matrix_options_init(byref(opts))
+        opts.backend = _lib.BACKENDS[backend.lower()]
+        opts.dtype = cdt
+        c, loc = _cost_array(cost, cost_location, self._nv, self._nf)
+        if c is not None:
+            opts.cost = _addr(c)
+            opts.cost_location = loc
+        if max_distance is not None:
+            opts.max_distance = _max_distance(max_distance)
+        opts.unfolding = 1 if unfolding else 0
+        opts.n_threads = _as_index(n_threads, "n_threads")
+        if memory_limit < 0:
+            raise ValueError("memory_limit must be >= 0")
+        opts.memory_limit = int(memory_limit)
+        opts.out = _addr(out) if out.size else None
+
+        caught: List[BaseException] = []
+
+        def on_rows(user: Any, first: int, n: int, rows: Any) -> int:
+            try:
+                if progress is not None:
+                    progress(first + n, n_rows)
+                return 0
+            except BaseException as exc:  # KeyboardInterrupt too: stop the library
+                caught.append(exc)
+                return 1
+
+        callback = _lib.mfmm_rows_callback(on_rows)
+        opts.on_rows = callback
+        err = _lib.mfmm_error()
+        mesh_ptr = self._enter()
+        try:
+            status = _lib.mfmm_distance_matrix(
+                mesh_ptr, None if src is None else _addr(src), n_rows, byref(opts), byref(err)
+            )
+        finally:
+            self._leave()
+        if caught:
+            raise caught[0]
+        _lib.check(status, err)
+        name = _lib.mfmm_backend_name(opts.backend_used)
+        self.backend_used = name.decode("ascii") if name else None
+        return out
+
+
+def _index_array(x: Any, what: str) -> np.ndarray:
+    a = np.asarray(x)
+    if a.ndim == 0:
+        a = a.reshape(1)
+    if a.size and a.dtype.kind not in "iu":
+        raise TypeError(f"{what}s must be integer vertex ids, got dtype {a.dtype}")
+    if a.ndim != 1:
+        raise ValueError(f"{what}s must be 1-D, got shape {a.shape}")
+    if a.size and (a.min() < _I32_MIN or a.max() > _I32_MAX):
+        bad = a[(a < _I32_MIN) | (a > _I32_MAX)][0]
+        raise ValueError(f"{what} {bad} is out of range (not a 32-bit index)")
+    return np.ascontiguousarray(a, dtype=np.int32)
+
+
+def load_mesh(path: Union[str, "os.PathLike[str]"]) -> Tuple[np.ndarray, np.ndarray]:
+    """Reads a triangle mesh file (OBJ, OFF, PLY ascii or binary) with the
+    library's readers and returns ``(V, F)``: float64 (nv, 3) and int32 (nf, 3).
+
+    Raises FileNotFoundError / OSError when the file cannot be read and
+    :class:`meshfmm.MeshError` when it is malformed."""
+    fspath = os.fspath(path)
+    if not os.path.exists(fspath):
+        raise FileNotFoundError(errno.ENOENT, "no such mesh file", fspath)
+    vp = ctypes.c_void_p()
+    fp = ctypes.c_void_p()
+    nv = ctypes.c_int32(0)
+    nf = ctypes.c_int32(0)
+    err = _lib.mfmm_error()
+    status = _lib.mfmm_load_mesh(
+        os.fsencode(fspath), byref(vp), byref(nv), byref(fp), byref(nf), byref(err)
+    )
+    try:
+        _lib.check(status, err, context=str(fspath))
+        V = np.empty((nv.value, 3), dtype=np.float64)
+        F = np.empty((nf.value, 3), dtype=np.int32)
+        if V.size:
+            ctypes.memmove(_addr(V), vp.value, V.nbytes)
+        if F.size:
+            ctypes.memmove(_addr(F), fp.value, F.nbytes)
+    finally:
+        _lib.mfmm_free(vp)
+        _lib.mfmm_free(fp)
+    return V, F

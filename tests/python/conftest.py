@@ -1,0 +1,165 @@
+"""Shared fixtures for the meshfmm Python tests.
+
+The meshes and exact references live in the shared folder beside the
+repository (``../shared``, or ``$MESHFMM_SHARED_DIR``); tests that need them
+skip with a reason when it is absent. For a development build without
+``pip install .``, point ``MESHFMM_LIBRARY`` at a built libmeshfmm and put
+``bindings/python`` on ``PYTHONPATH``.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+SHARED = Path(os.environ.get("MESHFMM_SHARED_DIR", REPO.parent / "shared")).resolve()
+MESHES = SHARED / "meshes"
+REFERENCE = SHARED / "reference"
+
+# Every mesh of ../shared/meshes with its role in the tests.
+MANIFOLD_MESHES = [
+    "hand_lowres.obj",
+    "spot.obj",
+    "wingnut.obj",
+    "fertility_FE_10k.off",
+    "decimated-max.obj",
+    "camelhead.off",
+    "nefertiti-lowres.obj",
+    "stanford-bunny.obj",
+]
+# Obtuse-heavy meshes where unfolding must beat geometry-central clearly.
+OBTUSE_MESHES = ["wingnut.obj", "decimated-max.obj", "camelhead.off"]
+NONMANIFOLD_MESHES = ["beetle.obj"]
+LARGE_MESHES = ["igea.ply"]
+
+
+def need_shared() -> None:
+    if not MESHES.is_dir():
+        pytest.skip(f"shared meshes not found at {MESHES} (set MESHFMM_SHARED_DIR)")
+
+
+@pytest.fixture(scope="session")
+def meshes_dir() -> Path:
+    need_shared()
+    return MESHES
+
+
+@pytest.fixture(scope="session")
+def reference_dir() -> Path:
+    if not REFERENCE.is_dir():
+        pytest.skip(f"shared references not found at {REFERENCE} (set MESHFMM_SHARED_DIR)")
+    return REFERENCE
+
+
+@functools.lru_cache(maxsize=None)
+def load(name: str):
+    """(V, F) of a shared mesh through meshfmm's own readers (cached)."""
+    import meshfmm
+
+    need_shared()
+    V, F = meshfmm.load_mesh(MESHES / name)
+    V.setflags(write=False)
+    F.setflags(write=False)
+    return V, F
+
+
+@functools.lru_cache(maxsize=None)
+def mesh(name: str):
+    """A meshfmm.Mesh of a shared mesh (cached for the session)."""
+    import meshfmm
+
+    V, F = load(name)
+    return meshfmm.Mesh(V, F)
+
+
+def reference(name: str):
+    """(sources, exact distances (3, nv)) stored for a mesh, or skip."""
+    path = REFERENCE / (Path(name).stem + ".npz")
+    if not path.is_file():
+        pytest.skip(f"no stored reference {path}")
+    z = np.load(path)
+    return z["sources"].astype(np.int64), z["distances"]
+
+
+def compact(V: np.ndarray, F: np.ndarray):
+    """Drops unreferenced vertices (libigl and potpourri3d want none).
+    Returns (V2, F2, old_of_new, new_of_old) with new_of_old -1 for dropped."""
+    used = np.zeros(V.shape[0], dtype=bool)
+    used[F.reshape(-1)] = True
+    old_of_new = np.flatnonzero(used)
+    new_of_old = np.full(V.shape[0], -1, dtype=np.int64)
+    new_of_old[old_of_new] = np.arange(old_of_new.size)
+    return V[old_of_new].copy(), new_of_old[F].astype(np.int64), old_of_new, new_of_old
+
+
+def errors(d: np.ndarray, e: np.ndarray, diameter: float):
+    """DESIGN.md metrics: (mean relative error %, max error % of diameter),
+    over vertices with a finite exact distance (> 0 for the relative one)."""
+    finite = np.isfinite(e)
+    pos = finite & (e > 0)
+    mre = 100.0 * np.mean(np.abs(d[pos] - e[pos]) / e[pos])
+    mx = 100.0 * np.max(np.abs(d[finite] - e[finite])) / diameter
+    return float(mre), float(mx)
+
+
+# ------------------------------------------------------- accuracy table
+# Filled by test_accuracy.py; printed and written at the end of the session.
+ACCURACY: dict = {}
+ACCURACY_JSON = REPO / "bench" / "results" / "accuracy_python.json"
+
+
+def _accuracy_table() -> str:
+    head = (
+        f"{'mesh':<22}{'nv':>7} | {'meshfmm MRE%':>12}{'gc-FMM MRE%':>12}{'ratio':>7} | "
+        f"{'meshfmm max%':>12}{'gc-FMM max%':>12}{'ratio':>7} | {'no-unfold MRE%':>14}"
+    )
+    lines = [head, "-" * len(head)]
+    for name, r in ACCURACY.items():
+        lines.append(
+            f"{name:<22}{r['n_vertices']:>7} | {r['meshfmm']['mean_rel_error_pct']:>12.4f}"
+            f"{r['geometry_central_fmm']['mean_rel_error_pct']:>12.4f}"
+            f"{r['mre_ratio_gc_over_meshfmm']:>7.2f} | {r['meshfmm']['max_error_pct_diameter']:>12.4f}"
+            f"{r['geometry_central_fmm']['max_error_pct_diameter']:>12.4f}"
+            f"{r['max_ratio_gc_over_meshfmm']:>7.2f} | "
+            f"{r['meshfmm_no_unfolding']['mean_rel_error_pct']:>14.4f}"
+        )
+    return "\n".join(lines)
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config):
+    if not ACCURACY:
+        return
+    import json
+
+    terminalreporter.write_sep("-", "accuracy against igl.exact_geodesic (3 sources per mesh)")
+    terminalreporter.write_line(_accuracy_table())
+    terminalreporter.write_line(
+        "MRE: mean relative error (%), mean over the sources; max: max error in % of the "
+        "bounding-box diagonal, max over the sources; ratio: geometry-central / meshfmm"
+    )
+    try:
+        ACCURACY_JSON.parent.mkdir(parents=True, exist_ok=True)
+        doc = {
+            "metrics": {
+                "mean_rel_error_pct": "100/N sum |d-e|/e over vertices with e > 0, averaged over sources",
+                "max_error_pct_diameter": "100 max |d-e| / bounding-box diagonal (referenced vertices), max over sources",
+            },
+            "reference": "igl.exact_geodesic (stored in ../shared/reference)",
+            "competitor": "potpourri3d.MeshFastMarchingDistanceSolver (geometry-central FMM)",
+            "meshes": {},
+        }
+        if ACCURACY_JSON.is_file():  # a partial run updates its meshes only
+            try:
+                doc["meshes"] = json.loads(ACCURACY_JSON.read_text()).get("meshes", {})
+            except ValueError:
+                pass
+        doc["meshes"].update(ACCURACY)
+        ACCURACY_JSON.write_text(json.dumps(doc, indent=1) + "\n")
+        terminalreporter.write_line(f"written to {ACCURACY_JSON}")
+    except OSError as exc:  # read-only checkout: the table above is the record
+        terminalreporter.write_line(f"could not write {ACCURACY_JSON}: {exc}")
