@@ -4,9 +4,22 @@
 #define MFMM_TESTUTIL_H
 
 #include <stddef.h>
+#include <math.h>
 #include <stdint.h>
 #include "meshfmm.h"
 #include "generate.h"
+
+#define TM_PI 3.14159265358979323846
+
+/* Fails the test unless |a - b| <= tol (cmocka 1.1 compares only floats).
+ * Include <cmocka.h> first. */
+#define tm_assert_close(a, b, tol)                                                      \
+    do {                                                                                \
+        double tm_a_ = (a), tm_b_ = (b), tm_t_ = (tol);                                 \
+        if (!(fabs(tm_a_ - tm_b_) <= tm_t_))                                            \
+            fail_msg("%s = %.17g, %s = %.17g: differ by %.3g > %.3g", #a, tm_a_, #b, tm_b_, \
+                     fabs(tm_a_ - tm_b_), tm_t_);                                       \
+    } while (0)
 
 /* Builds an mfmm_mesh (default options) from a generated mesh; fails the
  * test (cmocka) on error. */

@@ -1,0 +1,394 @@
+/* Mesh validation and the precomputation every solve reuses: adjacency,
+ * edge lengths, corner angles (section 4.1) and virtual edges (section 4.2,
+ * in unfold.c). */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mesh.h"
+
+void mfmm_mesh_options_init(mfmm_mesh_options *options)
+{
+    if (options)
+        options->max_unfold_steps = 64;
+}
+
+void mfmm_mesh_destroy(mfmm_mesh *mesh)
+{
+    if (!mesh)
+        return;
+    free(mesh->xyz);
+    free(mesh->faces);
+    free(mesh->face_neighbor);
+    free(mesh->vertex_face_offset);
+    free(mesh->vertex_face_corner);
+    free(mesh->component);
+    free(mesh->degenerate);
+    free(mesh->corners);
+    free(mesh->update_offset);
+    free(mesh->update_corner);
+    free(mesh);
+}
+
+/* A half-edge key: the corner opposite the edge (lo, hi). */
+typedef struct half_edge {
+    int32_t lo, hi, corner;
+} half_edge;
+
+static int half_edge_cmp(const void *pa, const void *pb)
+{
+    const half_edge *a = pa, *b = pb;
+    if (a->lo != b->lo)
+        return a->lo < b->lo ? -1 : 1;
+    if (a->hi != b->hi)
+        return a->hi < b->hi ? -1 : 1;
+    return (a->corner > b->corner) - (a->corner < b->corner);
+}
+
+/* Face adjacency across edges, boundary and non-manifold counts, edge-length
+ * statistics. */
+static mfmm_status build_edges(mfmm_mesh *m)
+{
+    size_t nc = (size_t)m->nf * 3;
+    half_edge *he = malloc(nc * sizeof *he);
+    if (!he)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    for (size_t c = 0; c < nc; c++) {
+        size_t f = c / 3, k = c % 3;
+        int32_t u = m->faces[3 * f + (k + 1) % 3], v = m->faces[3 * f + (k + 2) % 3];
+        he[c].lo = u < v ? u : v;
+        he[c].hi = u < v ? v : u;
+        he[c].corner = (int32_t)c;
+    }
+    qsort(he, nc, sizeof *he, half_edge_cmp);
+    double sum = 0.0, lmin = INFINITY, lmax = 0.0;
+    int32_t n_edges = 0, n_boundary = 0, n_nonmanifold = 0;
+    for (size_t i = 0; i < nc;) {
+        size_t j = i + 1;
+        while (j < nc && he[j].lo == he[i].lo && he[j].hi == he[i].hi)
+            j++;
+        n_edges++;
+        const double *p = m->xyz + 3 * (size_t)he[i].lo, *q = m->xyz + 3 * (size_t)he[i].hi;
+        double len = sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                          (p[2] - q[2]) * (p[2] - q[2]));
+        sum += len;
+        lmin = fmin(lmin, len);
+        lmax = fmax(lmax, len);
+        if (j - i == 2) {
+            m->face_neighbor[he[i].corner] = he[i + 1].corner / 3;
+            m->face_neighbor[he[i + 1].corner] = he[i].corner / 3;
+        } else {
+            /* boundary, or non-manifold: the walk of section 4.2 stops here */
+            for (size_t t = i; t < j; t++)
+                m->face_neighbor[he[t].corner] = -1;
+            if (j - i == 1)
+                n_boundary++;
+            else
+                n_nonmanifold++;
+        }
+        i = j;
+    }
+    free(he);
+    m->info.n_edges = n_edges;
+    m->info.n_boundary_edges = n_boundary;
+    m->info.n_nonmanifold_edges = n_nonmanifold;
+    m->info.min_edge_length = lmin;
+    m->info.max_edge_length = lmax;
+    m->info.mean_edge_length = n_edges ? sum / n_edges : 0.0;
+    return MFMM_OK;
+}
+
+/* Vertex -> corner CSR. */
+static mfmm_status build_vertex_faces(mfmm_mesh *m)
+{
+    size_t nc = (size_t)m->nf * 3;
+    int32_t *off = calloc((size_t)m->nv + 1, sizeof *off);
+    int32_t *list = malloc(nc * sizeof *list);
+    if (!off || !list) {
+        free(off);
+        free(list);
+        return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    for (size_t c = 0; c < nc; c++)
+        off[m->faces[c] + 1]++;
+    for (int32_t v = 0; v < m->nv; v++)
+        off[v + 1] += off[v];
+    for (size_t c = 0; c < nc; c++) {
+        int32_t v = m->faces[c];
+        list[off[v]++] = (int32_t)c;
+    }
+    for (int32_t v = m->nv; v > 0; v--)
+        off[v] = off[v - 1];
+    off[0] = 0;
+    m->vertex_face_offset = off;
+    m->vertex_face_corner = list;
+    return MFMM_OK;
+}
+
+static int32_t uf_find(int32_t *parent, int32_t x)
+{
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    return x;
+}
+
+/* Connected components (through faces) of referenced vertices. */
+static mfmm_status build_components(mfmm_mesh *m)
+{
+    int32_t *parent = malloc((size_t)m->nv * sizeof *parent);
+    if (!parent)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    for (int32_t v = 0; v < m->nv; v++)
+        parent[v] = v;
+    for (int32_t f = 0; f < m->nf; f++) {
+        int32_t r0 = uf_find(parent, m->faces[3 * f]);
+        for (int k = 1; k < 3; k++) {
+            int32_t r = uf_find(parent, m->faces[3 * f + k]);
+            if (r != r0)
+                parent[r] = r0;
+        }
+    }
+    int32_t n_comp = 0, n_unref = 0;
+    for (int32_t v = 0; v < m->nv; v++)
+        m->component[v] = -1;
+    for (int32_t v = 0; v < m->nv; v++) {
+        if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1]) {
+            n_unref++;
+            continue;
+        }
+        int32_t r = uf_find(parent, v);
+        if (m->component[r] < 0)
+            m->component[r] = n_comp++;
+        m->component[v] = m->component[r];
+    }
+    free(parent);
+    m->info.n_components = n_comp;
+    m->info.n_unreferenced_vertices = n_unref;
+    return MFMM_OK;
+}
+
+static void sub3(double *o, const double *a, const double *b)
+{
+    o[0] = a[0] - b[0];
+    o[1] = a[1] - b[1];
+    o[2] = a[2] - b[2];
+}
+
+static double dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* Corner lengths and angles; degenerate faces; obtuse corners. */
+static void build_corners(mfmm_mesh *m)
+{
+    int32_t n_degenerate = 0, n_obtuse = 0;
+    for (int32_t f = 0; f < m->nf; f++) {
+        const int32_t *fv = m->faces + 3 * (size_t)f;
+        double e[3][3], len[3]; /* e[k]: edge opposite corner k, from k+1 to k+2 */
+        for (int k = 0; k < 3; k++) {
+            sub3(e[k], m->xyz + 3 * (size_t)fv[(k + 2) % 3], m->xyz + 3 * (size_t)fv[(k + 1) % 3]);
+            len[k] = sqrt(dot3(e[k], e[k]));
+        }
+        double cr[3] = {e[0][1] * e[1][2] - e[0][2] * e[1][1], e[0][2] * e[1][0] - e[0][0] * e[1][2],
+                        e[0][0] * e[1][1] - e[0][1] * e[1][0]};
+        double area2 = sqrt(dot3(cr, cr));
+        double lmax = fmax(len[0], fmax(len[1], len[2]));
+        /* zero area up to rounding: no triangle update there, edges only */
+        int degenerate = !(area2 > 64.0 * DBL_EPSILON * lmax * lmax);
+        m->degenerate[f] = (uint8_t)degenerate;
+        n_degenerate += degenerate;
+        for (int k = 0; k < 3; k++) {
+            mfmm_corner *c = m->corners + 3 * (size_t)f + k;
+            int ka = (k + 1) % 3, kb = (k + 2) % 3;
+            c->c = fv[k];
+            c->a = fv[ka];
+            c->b = fv[kb];
+            c->len_a = len[ka]; /* |BC| is opposite A */
+            c->len_b = len[kb]; /* |AC| is opposite B */
+            c->cos_c = 0.0;
+            c->virt = degenerate ? MFMM_VIRT_DEGENERATE : MFMM_VIRT_NONE;
+            c->virt_len = 0.0;
+            c->virt_cos_a = 0.0;
+            c->virt_cos_b = 0.0;
+            if (degenerate)
+                continue;
+            /* cos at C from the edge vectors C->A = e[kb], C->B = -e[ka] */
+            double cosv = -dot3(e[kb], e[ka]) / (len[kb] * len[ka]);
+            c->cos_c = fmax(-1.0, fmin(1.0, cosv));
+            if (c->cos_c < -1e-9) {
+                c->virt = MFMM_VIRT_FAILED; /* until unfolding finds its virtual edge */
+                n_obtuse++;
+            }
+        }
+    }
+    m->info.n_degenerate_faces = n_degenerate;
+    m->info.n_obtuse_corners = n_obtuse;
+}
+
+/* Corners to recompute when a vertex settles: the other two corners of each
+ * incident face, and each obtuse corner whose virtual edge starts there. */
+static mfmm_status build_update_lists(mfmm_mesh *m)
+{
+    size_t nc = (size_t)m->nf * 3;
+    int32_t *off = calloc((size_t)m->nv + 1, sizeof *off);
+    if (!off)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    size_t total = 0;
+    for (size_t c = 0; c < nc; c++) {
+        const mfmm_corner *cr = m->corners + c;
+        off[cr->a + 1]++;
+        off[cr->b + 1]++;
+        total += 2;
+        if (cr->virt >= 0) {
+            off[cr->virt + 1]++;
+            total++;
+        }
+    }
+    if (total > INT32_MAX) {
+        free(off);
+        return MFMM_ERR_BAD_COUNT;
+    }
+    int32_t *list = malloc(total * sizeof *list);
+    if (!list) {
+        free(off);
+        return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    for (int32_t v = 0; v < m->nv; v++)
+        off[v + 1] += off[v];
+    for (size_t c = 0; c < nc; c++) {
+        const mfmm_corner *cr = m->corners + c;
+        list[off[cr->a]++] = (int32_t)c;
+        list[off[cr->b]++] = (int32_t)c;
+        if (cr->virt >= 0)
+            list[off[cr->virt]++] = (int32_t)c;
+    }
+    for (int32_t v = m->nv; v > 0; v--)
+        off[v] = off[v - 1];
+    off[0] = 0;
+    m->update_offset = off;
+    m->update_corner = list;
+    return MFMM_OK;
+}
+
+static mfmm_status validate(const double *vertices, int32_t nv, const int32_t *faces,
+                            int32_t nf, mfmm_error *err)
+{
+    for (int64_t i = 0; i < (int64_t)nv * 3; i++)
+        if (!isfinite(vertices[i]))
+            return mfmm_fail(err, MFMM_ERR_NONFINITE_VERTEX, i / 3,
+                             "vertex %lld has a coordinate that is NaN or infinite",
+                             (long long)(i / 3));
+    for (int64_t f = 0; f < nf; f++) {
+        const int32_t *t = faces + 3 * f;
+        for (int k = 0; k < 3; k++)
+            if (t[k] < 0 || t[k] >= nv)
+                return mfmm_fail(err, MFMM_ERR_INDEX_OUT_OF_RANGE, f,
+                                 "face %lld names vertex %ld, outside [0, %ld)", (long long)f,
+                                 (long)t[k], (long)nv);
+        if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
+            return mfmm_fail(err, MFMM_ERR_REPEATED_VERTEX, f,
+                             "face %lld names a vertex twice (%ld, %ld, %ld)", (long long)f,
+                             (long)t[0], (long)t[1], (long)t[2]);
+    }
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *faces,
+                             int32_t nf, const mfmm_mesh_options *options, mfmm_mesh **out,
+                             mfmm_error *err)
+{
+    mfmm_ok(err);
+    if (!out)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "out (the mesh pointer) is NULL");
+    *out = NULL;
+    if (!vertices || !faces)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "%s is NULL",
+                         !vertices ? "vertices" : "faces");
+    if (nv < 1 || nf < 1 || nf > INT32_MAX / 3 || nv > INT32_MAX / 3)
+        return mfmm_fail(err, MFMM_ERR_BAD_COUNT, -1,
+                         "a mesh needs 1 to %d vertices and faces (got %ld vertices, %ld faces)",
+                         INT32_MAX / 3, (long)nv, (long)nf);
+    mfmm_mesh_options opt;
+    mfmm_mesh_options_init(&opt);
+    if (options)
+        opt = *options;
+    if (opt.max_unfold_steps < 1)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "max_unfold_steps must be >= 1 (got %ld)",
+                         (long)opt.max_unfold_steps);
+    mfmm_status st = validate(vertices, nv, faces, nf, err);
+    if (st != MFMM_OK)
+        return st;
+
+    mfmm_mesh *m = calloc(1, sizeof *m);
+    if (!m)
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
+    m->nv = nv;
+    m->nf = nf;
+    size_t nc = (size_t)nf * 3;
+    m->xyz = malloc((size_t)nv * 3 * sizeof *m->xyz);
+    m->faces = malloc(nc * sizeof *m->faces);
+    m->face_neighbor = malloc(nc * sizeof *m->face_neighbor);
+    m->component = malloc((size_t)nv * sizeof *m->component);
+    m->degenerate = malloc((size_t)nf * sizeof *m->degenerate);
+    m->corners = malloc(nc * sizeof *m->corners);
+    if (!m->xyz || !m->faces || !m->face_neighbor || !m->component || !m->degenerate ||
+        !m->corners) {
+        mfmm_mesh_destroy(m);
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
+    }
+    memcpy(m->xyz, vertices, (size_t)nv * 3 * sizeof *m->xyz);
+    memcpy(m->faces, faces, nc * sizeof *m->faces);
+    m->info.n_vertices = nv;
+    m->info.n_faces = nf;
+
+    st = build_edges(m);
+    if (st == MFMM_OK)
+        st = build_vertex_faces(m);
+    if (st == MFMM_OK)
+        st = build_components(m);
+    if (st == MFMM_OK) {
+        build_corners(m);
+        mfmm_mesh_unfold_obtuse(m, opt.max_unfold_steps);
+        st = build_update_lists(m);
+    }
+    if (st != MFMM_OK) {
+        mfmm_mesh_destroy(m);
+        return mfmm_fail(err, st, -1, NULL);
+    }
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t v = 0; v < nv; v++) {
+        if (m->component[v] < 0)
+            continue;
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], m->xyz[3 * (size_t)v + k]);
+            hi[k] = fmax(hi[k], m->xyz[3 * (size_t)v + k]);
+        }
+    }
+    m->info.bbox_diagonal = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) +
+                                 (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                 (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    *out = m;
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_mesh_get_info(const mfmm_mesh *mesh, mfmm_mesh_info *info)
+{
+    if (!mesh || !info)
+        return MFMM_ERR_NULL_POINTER;
+    *info = mesh->info;
+    return MFMM_OK;
+}
+
+int32_t mfmm_mesh_vertex_count(const mfmm_mesh *mesh)
+{
+    return mesh ? mesh->nv : 0;
+}
+
+int32_t mfmm_mesh_face_count(const mfmm_mesh *mesh)
+{
+    return mesh ? mesh->nf : 0;
+}
