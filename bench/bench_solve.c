@@ -1,0 +1,123 @@
+/* One serial solve, timed: median of repeats on a built mesh, in vertices per
+ * second (issue 2's figure of merit). Usage:
+ *   bench_solve [--repeats R] [--sources S] MESH...
+ * With no MESH, the larger meshes of ../shared/meshes and generated spheres. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "meshfmm.h"
+#include "generate.h"
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static void bench(const char *name, const double *V, int32_t nv, const int32_t *F, int32_t nf,
+                  int repeats, int n_sources)
+{
+    mfmm_mesh *mesh = NULL;
+    mfmm_error err;
+    double t0 = now();
+    if (mfmm_mesh_create(V, nv, F, nf, NULL, &mesh, &err) != MFMM_OK) {
+        fprintf(stderr, "%s: %s\n", name, err.message);
+        return;
+    }
+    double t_build = now() - t0;
+    mfmm_solver *solver = NULL;
+    double *d = malloc((size_t)nv * sizeof *d);
+    double *times = malloc((size_t)repeats * n_sources * sizeof *times);
+    if (mfmm_solver_create(mesh, &solver) != MFMM_OK || !d || !times) {
+        fprintf(stderr, "out of memory\n");
+        exit(1);
+    }
+    for (int unfolding = 1; unfolding >= 0; unfolding--) {
+        mfmm_solve_options opt;
+        mfmm_solve_options_init(&opt);
+        opt.unfolding = unfolding;
+        int k = 0;
+        int32_t settled = 0;
+        for (int s = 0; s < n_sources; s++) {
+            int32_t v = (int32_t)(((int64_t)nv * (2 * s + 1)) / (2 * n_sources));
+            mfmm_source src = {v, -1, {0, 0, 0}, 0.0};
+            for (int r = 0; r < repeats; r++) {
+                double t1 = now();
+                mfmm_solve(solver, &src, 1, &opt, d, NULL);
+                times[k++] = now() - t1;
+            }
+            settled = 0;
+            for (int32_t i = 0; i < nv; i++)
+                settled += isfinite(d[i]) != 0;
+        }
+        qsort(times, (size_t)k, sizeof *times, cmp_double);
+        double med = times[k / 2];
+        printf("%-22s nv=%7d build=%7.1f ms  unfolding=%d  solve median=%8.3f ms  %6.2f M vertices/s\n",
+               name, nv, 1e3 * t_build, unfolding, 1e3 * med, settled / med / 1e6);
+    }
+    free(d);
+    free(times);
+    mfmm_solver_destroy(solver);
+    mfmm_mesh_destroy(mesh);
+}
+
+int main(int argc, char **argv)
+{
+    int repeats = 5, n_sources = 3, first = 1;
+    while (first < argc && argv[first][0] == '-') {
+        if (!strcmp(argv[first], "--repeats") && first + 1 < argc)
+            repeats = atoi(argv[first + 1]);
+        else if (!strcmp(argv[first], "--sources") && first + 1 < argc)
+            n_sources = atoi(argv[first + 1]);
+        else {
+            fprintf(stderr, "usage: bench_solve [--repeats R] [--sources S] [MESH...]\n");
+            return 2;
+        }
+        first += 2;
+    }
+    if (repeats < 1 || n_sources < 1) {
+        fprintf(stderr, "repeats and sources must be >= 1\n");
+        return 2;
+    }
+    static const char *defaults[] = {"../shared/meshes/camelhead.off",
+                                     "../shared/meshes/nefertiti-lowres.obj",
+                                     "../shared/meshes/stanford-bunny.obj",
+                                     "../shared/meshes/igea.ply"};
+    const char **paths = (const char **)(argv + first);
+    int n_paths = argc - first;
+    if (n_paths == 0) {
+        paths = defaults;
+        n_paths = 4;
+        for (int level = 4; level <= 7; level += 1) {
+            mfmm_gen_mesh g = mfmm_gen_icosphere(level);
+            char name[32];
+            snprintf(name, sizeof name, "icosphere-%d", level);
+            bench(name, g.V, g.nv, g.F, g.nf, repeats, n_sources);
+            mfmm_gen_free(&g);
+        }
+    }
+    for (int i = 0; i < n_paths; i++) {
+        double *V = NULL;
+        int32_t *F = NULL, nv = 0, nf = 0;
+        mfmm_error err;
+        if (mfmm_load_mesh(paths[i], &V, &nv, &F, &nf, &err) != MFMM_OK) {
+            fprintf(stderr, "%s: %s\n", paths[i], err.message);
+            continue;
+        }
+        const char *base = strrchr(paths[i], '/');
+        bench(base ? base + 1 : paths[i], V, nv, F, nf, repeats, n_sources);
+        mfmm_free(V);
+        mfmm_free(F);
+    }
+    return 0;
+}
