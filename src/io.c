@@ -135,24 +135,36 @@ static mfmm_status read_file(const char *path, char **data, size_t *size, mfmm_e
     if (!f)
         return mfmm_fail(err, MFMM_ERR_IO, -1, "cannot open '%.180s': %.40s", path,
                          strerror(errno));
-    size_t cap = 0, len = 0;
-    char *buf = NULL;
-    /* Start from the file's size when it is known, then grow if it was wrong. */
-    if (fseek(f, 0, SEEK_END) == 0) {
-        long end = ftell(f);
-        if (end > 0 && (unsigned long)end < SIZE_MAX - 2)
-            cap = (size_t)end + 2; /* room for the NUL and an EOF probe */
-        rewind(f);
-    }
-    if (cap < 4096)
-        cap = 4096;
-    buf = malloc(cap);
+    /* A first chunk, then the rest sized by the file's length when known
+     * (a directory or an unreadable file fails on the first read). */
+    size_t cap = 1 << 16, len = 0;
+    char *buf = malloc(cap);
     if (!buf) {
         fclose(f);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory reading '%.180s'",
                          path);
     }
-    for (;;) {
+    len = fread(buf, 1, cap - 1, f);
+    if (len == cap - 1 && fseek(f, 0, SEEK_END) == 0) {
+        long end = ftell(f);
+        if (fseek(f, (long)len, SEEK_SET) != 0) {
+            free(buf);
+            fclose(f);
+            return mfmm_fail(err, MFMM_ERR_IO, -1, "cannot read '%.180s'", path);
+        }
+        if (end > 0 && (unsigned long)end > len && (unsigned long)end < SIZE_MAX - 2) {
+            char *nb = realloc(buf, (size_t)end + 2); /* room for the NUL and an EOF probe */
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1,
+                                 "out of memory reading '%.180s'", path);
+            }
+            buf = nb;
+            cap = (size_t)end + 2;
+        }
+    }
+    while (!ferror(f)) {
         if (len + 1 >= cap) {
             if (cap > SIZE_MAX / 2) {
                 free(buf);
