@@ -1,0 +1,88 @@
+"""Python and the command line `meshfmm distance` agree to the last bit.
+
+The CLI is found through $MESHFMM_CLI, else the newest build*/meshfmm of the
+repository, else `meshfmm` on PATH; the test skips when there is none. The CLI
+and the Python package's library must be built from the same tree.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import meshfmm
+from conftest import REPO, load, mesh, need_shared
+
+
+def find_cli():
+    env = os.environ.get("MESHFMM_CLI")
+    if env:
+        return env if os.access(env, os.X_OK) else None
+    builds = [p for p in REPO.glob("build*/meshfmm") if p.is_file() and os.access(p, os.X_OK)]
+    if builds:
+        return str(max(builds, key=lambda p: p.stat().st_mtime))
+    return shutil.which("meshfmm")
+
+
+@pytest.fixture(scope="module")
+def cli():
+    path = find_cli()
+    if path is None:
+        pytest.skip("no meshfmm command line found (set MESHFMM_CLI or build with CMake)")
+    return path
+
+
+def run(cli, *args):
+    proc = subprocess.run([cli, *map(str, args)], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, f"{cli} {' '.join(map(str, args))}: {proc.stderr}"
+    return proc
+
+
+CASES = [
+    ("hand_lowres.obj", ["--source", 21], {"sources": 21}),
+    ("wingnut.obj", ["--source", 80, "--source", 2593], {"sources": [80, 2593]}),
+    ("camelhead.off", ["--source", 300, "--no-unfolding"], {"sources": 300, "unfolding": False}),
+    ("spot.obj", ["--source", 77, "--max-distance", 0.5], {"sources": 77, "max_distance": 0.5}),
+    ("spot.obj", ["--face-source", 100, 0.2, 0.3, 0.5],
+     {"sources": meshfmm.SurfacePoint(100, (0.2, 0.3, 0.5))}),
+    ("beetle.obj", ["--source", 3], {"sources": 3}),
+]
+
+
+@pytest.mark.parametrize("name,args,kwargs", CASES, ids=[f"{c[0]}{c[1]}" for c in CASES])
+def test_distance_bitwise_equal(cli, tmp_path, name, args, kwargs):
+    need_shared()
+    from conftest import MESHES
+
+    out = tmp_path / "d.npy"
+    run(cli, "distance", MESHES / name, *args, "-o", out)
+    c = np.load(out)
+    p = mesh(name).distance(kwargs.pop("sources"), **kwargs)
+    assert c.dtype == np.float64 and c.shape == p.shape
+    assert c.tobytes() == p.tobytes(), f"max |diff| {np.nanmax(np.abs(c - p))}"
+
+
+def test_cost_and_txt_bitwise_equal(cli, tmp_path):
+    need_shared()
+    from conftest import MESHES
+
+    name = "fertility_FE_10k.off"
+    V, F = load(name)
+    rng = np.random.default_rng(11)
+    cost = rng.uniform(0.5, 3.0, F.shape[0])
+    np.save(tmp_path / "cost.npy", cost)
+    run(cli, "distance", MESHES / name, "--source", 893, "--cost", tmp_path / "cost.npy",
+        "--cost-per-face", "-o", tmp_path / "d.txt")
+    c = np.loadtxt(tmp_path / "d.txt", dtype=np.float64)
+    p = mesh(name).distance(893, cost=cost)
+    assert c.tobytes() == p.tobytes()
+    vcost = rng.uniform(0.5, 3.0, V.shape[0])
+    np.save(tmp_path / "vcost.npy", vcost)
+    run(cli, "distance", MESHES / name, "--source", 131, "--cost", tmp_path / "vcost.npy",
+        "-o", tmp_path / "v.npy")
+    assert np.load(tmp_path / "v.npy").tobytes() == mesh(name).distance(131, cost=vcost).tobytes()
