@@ -14,6 +14,7 @@ enum { CLI_OK = 0, CLI_FAIL = 1, CLI_USAGE = 2 };
 int cmd_info(int argc, char **argv);
 int cmd_distance(int argc, char **argv);
 int cmd_generate(int argc, char **argv);
+int cmd_allpairs(int argc, char **argv);
 
 /* Prints "meshfmm: <message>\n" on stderr. */
 void cli_error(const char *fmt, ...)

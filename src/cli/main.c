@@ -20,6 +20,7 @@ static const cli_command commands[] = {
     {"info", cmd_info, "print a mesh's counts, boundary, components and defects"},
     {"distance", cmd_distance, "geodesic distances from sources to every vertex"},
     {"generate", cmd_generate, "write a generated mesh (sine, sphere, torus, grid, lattice)"},
+    {"allpairs", cmd_allpairs, "the distance matrix of many sources, streamed into a .npy file"},
 };
 
 static void print_usage(FILE *out)
