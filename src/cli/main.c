@@ -36,6 +36,7 @@ static void print_usage(FILE *out)
 int main(int argc, char **argv)
 {
     if (argc < 2) {
+        cli_error("no command given");
         print_usage(stderr);
         return CLI_USAGE;
     }
