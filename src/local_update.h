@@ -34,13 +34,14 @@ typedef uint8_t mfmm_u8;
 #define MFMM_VIRT_FAILED (-2)     /* obtuse, walk failed: plain stencil */
 #define MFMM_VIRT_DEGENERATE (-3) /* zero-area face: edge updates only */
 
-/* One corner C of a face, with what its update needs: the face's other
+/* One corner C of a face, with what its update needs: the face, its other
  * vertices A and B (a = |BC|, b = |AC|, angle theta at C) and, for an
  * obtuse corner, the virtual vertex V of the unfolded patch, with |CV| and the
  * cosines of the two angles the virtual edge splits theta into (A-C-V and
- * V-C-B). 64 bytes, the same layout in C and OpenCL C. */
+ * V-C-B). C itself is known from where the corner is stored (corners are
+ * grouped by vertex). 64 bytes, the same layout in C and OpenCL C. */
 typedef struct mfmm_corner {
-    mfmm_i32 c, a, b, virt;
+    mfmm_i32 face, a, b, virt;
     double len_a;      /* |BC| */
     double len_b;      /* |AC| */
     double cos_c;      /* cos theta at C */
@@ -55,6 +56,12 @@ typedef struct mfmm_corner {
 #define MFMM_ALIVE 2
 #define MFMM_STATE_MASK 3
 #define MFMM_TARGET 4
+
+/* min without libm's NaN rules (no NaN reaches here), so it inlines */
+MFMM_INLINE double mfmm_min(double x, double y)
+{
+    return x < y ? x : y;
+}
 
 /* T(C) from triangle ABC with T(A) = ta, T(B) = tb both known; a = |BC|,
  * b = |AC|, cos_c = cos theta at C; f = cost F.
@@ -72,7 +79,7 @@ MFMM_INLINE double mfmm_triangle_update(double ta, double tb, double a, double b
         double s = ta; ta = tb; tb = s;
         s = a; a = b; b = s;
     }
-    double edge = fmin(ta + b * f, tb + a * f);
+    double edge = mfmm_min(ta + b * f, tb + a * f);
     double u = tb - ta;
     double sin2 = (1.0 - cos_c) * (1.0 + cos_c);
     /* Eq. 4: q2 t^2 + q1 t + q0 = 0, q2 = c^2 = a^2 + b^2 - 2ab cos theta */
@@ -90,7 +97,7 @@ MFMM_INLINE double mfmm_triangle_update(double ta, double tb, double a, double b
         return edge;
     double x = b * (t - u) / t; /* CD of section 4.1 */
     if (a * cos_c < x && x * cos_c < a)
-        return fmin(ta + t, edge);
+        return mfmm_min(ta + t, edge);
     return edge;
 }
 
@@ -105,23 +112,23 @@ MFMM_INLINE double mfmm_corner_update(MFMM_GLOBAL const mfmm_corner *cr,
     int alive_a = (label[ia] & MFMM_STATE_MASK) == MFMM_ALIVE;
     int alive_b = (label[ib] & MFMM_STATE_MASK) == MFMM_ALIVE;
     double best = MFMM_INF;
-    if (alive_a) best = fmin(best, T[ia] + cr->len_b * f);
-    if (alive_b) best = fmin(best, T[ib] + cr->len_a * f);
+    if (alive_a) best = mfmm_min(best, T[ia] + cr->len_b * f);
+    if (alive_b) best = mfmm_min(best, T[ib] + cr->len_a * f);
     if (iv >= 0 && unfolding) {
         /* section 4.2: the obtuse angle split into two acute virtual
          * triangles A-C-V and V-C-B */
         if ((label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE) {
             double tv = T[iv];
-            best = fmin(best, tv + cr->virt_len * f);
+            best = mfmm_min(best, tv + cr->virt_len * f);
             if (alive_a)
-                best = fmin(best, mfmm_triangle_update(T[ia], tv, cr->virt_len, cr->len_b,
+                best = mfmm_min(best, mfmm_triangle_update(T[ia], tv, cr->virt_len, cr->len_b,
                                                        cr->virt_cos_a, f));
             if (alive_b)
-                best = fmin(best, mfmm_triangle_update(tv, T[ib], cr->len_a, cr->virt_len,
+                best = mfmm_min(best, mfmm_triangle_update(tv, T[ib], cr->len_a, cr->virt_len,
                                                        cr->virt_cos_b, f));
         }
     } else if (alive_a && alive_b && iv != MFMM_VIRT_DEGENERATE) {
-        best = fmin(best, mfmm_triangle_update(T[ia], T[ib], cr->len_a, cr->len_b,
+        best = mfmm_min(best, mfmm_triangle_update(T[ia], T[ib], cr->len_a, cr->len_b,
                                                cr->cos_c, f));
     }
     return best;

@@ -14,9 +14,12 @@
 /* The arrays of a mesh that a march reads. */
 typedef struct mfmm_march_mesh {
     mfmm_i32 nv;
-    MFMM_GLOBAL const mfmm_i32 *update_offset;   /* (nv+1,) CSR into update_corner */
-    MFMM_GLOBAL const mfmm_i32 *update_corner;   /* corners to recompute when a vertex settles */
-    MFMM_GLOBAL const mfmm_corner *corners;      /* (3 nf,) */
+    MFMM_GLOBAL const mfmm_i32 *update_offset; /* (nv+1,) CSR into update_corner pairs */
+    /* when a vertex settles: pairs (corner index, its vertex C) to recompute,
+     * 2 * update_offset[nv] entries; C is here so that settled neighbours are
+     * skipped without touching their corner records */
+    MFMM_GLOBAL const mfmm_i32 *update_corner;
+    MFMM_GLOBAL const mfmm_corner *corners; /* (3 nf,) grouped by vertex C */
 } mfmm_march_mesh;
 
 /* A march's workspace, and the options it runs with. */
@@ -118,13 +121,14 @@ MFMM_INLINE void mfmm_march_seed(mfmm_march_state *s, mfmm_i32 v, double value)
     }
 }
 
-/* The cost F at corner id k (vertex c), per the state's cost location. */
-MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, mfmm_i32 k, mfmm_i32 c)
+/* The cost F for updating vertex c through corner cr. */
+MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, MFMM_GLOBAL const mfmm_corner *cr,
+                                   mfmm_i32 c)
 {
     if (s->cost_location == 1)
         return s->cost[c];
     if (s->cost_location == 2)
-        return s->cost[k / 3];
+        return s->cost[cr->face];
     return 1.0;
 }
 
@@ -148,13 +152,12 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
             break;
         mfmm_i32 end = m->update_offset[x + 1];
         for (mfmm_i32 j = m->update_offset[x]; j < end; j++) {
-            mfmm_i32 k = m->update_corner[j];
-            MFMM_GLOBAL const mfmm_corner *cr = m->corners + k;
-            mfmm_i32 c = cr->c;
+            mfmm_i32 c = m->update_corner[2 * j + 1];
             mfmm_u8 st = s->label[c] & MFMM_STATE_MASK;
             if (st == MFMM_ALIVE)
                 continue;
-            double t = mfmm_corner_update(cr, s->T, s->label, mfmm_march_cost(s, k, c),
+            MFMM_GLOBAL const mfmm_corner *cr = m->corners + m->update_corner[2 * j];
+            double t = mfmm_corner_update(cr, s->T, s->label, mfmm_march_cost(s, cr, c),
                                           s->unfolding);
             if (t < s->T[c]) {
                 s->T[c] = t;

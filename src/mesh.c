@@ -204,7 +204,7 @@ static void build_corners(mfmm_mesh *m)
         for (int k = 0; k < 3; k++) {
             mfmm_corner *c = m->corners + 3 * (size_t)f + k;
             int ka = (k + 1) % 3, kb = (k + 2) % 3;
-            c->c = fv[k];
+            c->face = f;
             c->a = fv[ka];
             c->b = fv[kb];
             c->len_a = len[ka]; /* |BC| is opposite A */
@@ -229,17 +229,28 @@ static void build_corners(mfmm_mesh *m)
     m->info.n_obtuse_corners = n_obtuse;
 }
 
-/* Corners to recompute when a vertex settles: the other two corners of each
- * incident face, and each obtuse corner whose virtual edge starts there. */
+/* Puts the corner records in vertex order (the vertex -> corner CSR), so
+ * that the corners of one vertex share cache lines, and builds the update
+ * lists: when a vertex settles, the pairs (corner, its vertex C) to recompute
+ * are the other two corners of each incident face, and each obtuse corner
+ * whose virtual edge starts there. */
 static mfmm_status build_update_lists(mfmm_mesh *m)
 {
     size_t nc = (size_t)m->nf * 3;
     int32_t *off = calloc((size_t)m->nv + 1, sizeof *off);
-    if (!off)
+    mfmm_corner *grouped = malloc(nc * sizeof *grouped);
+    if (!off || !grouped) {
+        free(off);
+        free(grouped);
         return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    for (size_t j = 0; j < nc; j++)
+        grouped[j] = m->corners[m->vertex_face_corner[j]];
+    free(m->corners);
+    m->corners = grouped;
     size_t total = 0;
-    for (size_t c = 0; c < nc; c++) {
-        const mfmm_corner *cr = m->corners + c;
+    for (size_t j = 0; j < nc; j++) {
+        const mfmm_corner *cr = m->corners + j;
         off[cr->a + 1]++;
         off[cr->b + 1]++;
         total += 2;
@@ -248,23 +259,27 @@ static mfmm_status build_update_lists(mfmm_mesh *m)
             total++;
         }
     }
-    if (total > INT32_MAX) {
+    if (total > INT32_MAX / 2) {
         free(off);
         return MFMM_ERR_BAD_COUNT;
     }
-    int32_t *list = malloc(total * sizeof *list);
+    int32_t *list = malloc(2 * total * sizeof *list);
     if (!list) {
         free(off);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
     for (int32_t v = 0; v < m->nv; v++)
         off[v + 1] += off[v];
-    for (size_t c = 0; c < nc; c++) {
-        const mfmm_corner *cr = m->corners + c;
-        list[off[cr->a]++] = (int32_t)c;
-        list[off[cr->b]++] = (int32_t)c;
-        if (cr->virt >= 0)
-            list[off[cr->virt]++] = (int32_t)c;
+    for (int32_t c = 0; c < m->nv; c++) {
+        for (int32_t j = m->vertex_face_offset[c]; j < m->vertex_face_offset[c + 1]; j++) {
+            const mfmm_corner *cr = m->corners + j;
+            int32_t to[3] = {cr->a, cr->b, cr->virt};
+            for (int t = 0; t < (cr->virt >= 0 ? 3 : 2); t++) {
+                int32_t e = off[to[t]]++;
+                list[2 * e] = j;
+                list[2 * e + 1] = c;
+            }
+        }
     }
     for (int32_t v = m->nv; v > 0; v--)
         off[v] = off[v - 1];

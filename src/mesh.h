@@ -15,9 +15,10 @@ struct mfmm_mesh {
     int32_t *vertex_face_corner;
     int32_t *component;        /* (nv,) component id, -1 for unreferenced vertices */
     uint8_t *degenerate;       /* (nf,) 1 for zero-area faces */
-    mfmm_corner *corners;      /* (3 nf,) */
+    mfmm_corner *corners;      /* (3 nf,) in vertex_face_corner order: corners[j] is
+                                  corner vertex_face_corner[j] (grouped by vertex) */
     int32_t *update_offset;    /* (nv+1,) CSR: corners to recompute when a vertex settles */
-    int32_t *update_corner;
+    int32_t *update_corner;    /* pairs (index into corners, its vertex C) */
     mfmm_mesh_info info;
 };
 
@@ -34,7 +35,8 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
 
 /* Finds the virtual edge of every obtuse corner by unfolding (section 4.2);
  * fills corners[].virt, virt_len, virt_cos_a, virt_cos_b and the counts.
- * Needs faces, xyz, face_neighbor, corners' lengths and cosines. */
+ * Needs faces, xyz, face_neighbor, corners' lengths and cosines, with the
+ * corners still in face order (corner 3f+k), as mesh creation has them then. */
 void mfmm_mesh_unfold_obtuse(mfmm_mesh *mesh, int32_t max_steps);
 
 /* Fills err (if any) and returns status. */

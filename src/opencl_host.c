@@ -494,7 +494,7 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
 
     /* the mesh, read-only, used in place where the driver allows */
     cl_mem_flags ro = CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR;
-    size_t n_upd = (size_t)mesh->update_offset[mesh->nv];
+    size_t n_upd = 2 * (size_t)mesh->update_offset[mesh->nv]; /* (corner, vertex) pairs */
     mem[MB_OFFSET] = clCreateBuffer(cl.context, ro, (nv + 1) * sizeof(int32_t),
                                     mesh->update_offset, &e);
     if (e == CL_SUCCESS)

@@ -68,7 +68,7 @@ static int unfold_corner(mfmm_mesh *m, int32_t corner, int32_t max_steps)
             return 0;
         int kq = 3 - k1 - k2;
         int32_t q = m->faces[3 * (size_t)g + kq];
-        if (q == cr->c || q == cr->a || q == cr->b)
+        if (q == m->faces[corner] || q == cr->a || q == cr->b)
             return 0;
         const double *xq = m->xyz + 3 * (size_t)q;
         vec2 pq = unfold_point(p1, p2, dist3(m->xyz + 3 * (size_t)e1, xq),
