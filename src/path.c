@@ -1,0 +1,971 @@
+/*
+ * Minimal geodesic paths (Kimmel & Sethian 1998, section 5): backtrack from a
+ * target along dX/ds = -grad T with Heun's second-order method, switching to
+ * a first-order (Euler) step at sonic points. Inside a face, T is the
+ * quadratic fitted to the face's three vertices and the far vertices of its
+ * three neighbours, unfolded into the face's plane (six values, six
+ * coefficients); where that fit is ill-posed the face's linear gradient is
+ * used. The path moves face to face through edges and vertices and records a
+ * surface point at each crossing; between two points it is straight (a
+ * geodesic inside a flat face is).
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mesh.h"
+
+#define SNAP_BARY 1e-9      /* a crossing this close to a corner is at the vertex */
+#define ON_EDGE 1e-12       /* barycentric coordinate treated as 0 (on the edge) */
+#define OUTWARD_COS 1e-9    /* a direction leaves through an edge it lies on */
+#define SONIC_COS 0.70710678118654752 /* predictor and corrector 45 degrees apart: sonic */
+#define STALL_STEPS 64      /* steps without T decreasing before giving up */
+#define PIVOT_RATIO 1e-7    /* 6x6 fit refused below this pivot ratio */
+
+typedef struct src_key {
+    int32_t key; /* vertex id (vertex sources) or face id (face sources) */
+    int32_t idx; /* index into options->sources */
+} src_key;
+
+/* One face unfolded into its plane, with its interpolants of T. */
+typedef struct frame {
+    int32_t f;
+    int32_t v[3];
+    int degenerate;
+    double e1[3], e2[3];  /* in-plane axes; corner 0 at the origin */
+    double P[3][2];       /* corners in the plane */
+    double gb[3][2];      /* gradients of the barycentric coordinates */
+    double T[3];
+    int lin_ok;           /* all three corners finite */
+    double glin[2];       /* linear gradient */
+    int quad_ok;          /* quadratic fit usable */
+    double c[6];          /* T = c0 + c1 x + c2 y + c3 x^2 + c4 xy + c5 y^2, normalized coords */
+    double ox, oy, scale; /* normalization: (p - o) / scale */
+    double max_edge;
+    double F;             /* face cost (per face), or mean of corner costs */
+} frame;
+
+typedef struct tracer {
+    const mfmm_mesh *m;
+    const double *T;
+    const mfmm_source *src;
+    int32_t n_src;
+    const double *cost;
+    mfmm_cost_location cost_loc;
+    src_key *vkeys, *fkeys;
+    int32_t n_vkeys, n_fkeys;
+    mfmm_surface_point *pts;
+    int32_t cap, n, max_points;
+    double len, wlen;
+    double last_xyz[3], last_F;
+    mfmm_error *err;
+    mfmm_status st;
+} tracer;
+
+static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static double dist3(const double *a, const double *b)
+{
+    double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+    return sqrt(dot3(d, d));
+}
+
+/* Reads T[v], refusing NaN. */
+static int read_T(tracer *t, int32_t v, double *out)
+{
+    double x = t->T[v];
+    if (isnan(x)) {
+        t->st = mfmm_fail(t->err, MFMM_ERR_BAD_ARGUMENT, v, "distances[%d] is NaN", (int)v);
+        return 0;
+    }
+    *out = x;
+    return 1;
+}
+
+/* Reads the cost of a vertex or face, refusing values not finite or <= 0. */
+static int read_cost(tracer *t, int32_t i, double *out)
+{
+    double c = t->cost[i];
+    if (!(isfinite(c) && c > 0.0)) {
+        t->st = mfmm_fail(t->err, MFMM_ERR_BAD_COST, i, "cost[%d] = %g is not finite and > 0",
+                          (int)i, c);
+        return 0;
+    }
+    *out = c;
+    return 1;
+}
+
+/* F at barycentric b of face f (1 without cost). */
+static int cost_at(tracer *t, int32_t f, const double b[3], double *out)
+{
+    if (!t->cost) {
+        *out = 1.0;
+        return 1;
+    }
+    if (t->cost_loc == MFMM_COST_PER_FACE)
+        return read_cost(t, f, out);
+    double s = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double c;
+        if (!read_cost(t, t->m->faces[3 * f + k], &c))
+            return 0;
+        s += b[k] * c;
+    }
+    *out = s;
+    return 1;
+}
+
+/* Gaussian elimination with partial pivoting; 0 when ill-conditioned. */
+static int solve6(double A[6][6], double r[6], double x[6])
+{
+    double pmax = 0.0, pmin = INFINITY;
+    for (int col = 0; col < 6; col++) {
+        int piv = col;
+        for (int i = col + 1; i < 6; i++)
+            if (fabs(A[i][col]) > fabs(A[piv][col]))
+                piv = i;
+        if (piv != col) {
+            for (int j = 0; j < 6; j++) {
+                double s = A[col][j]; A[col][j] = A[piv][j]; A[piv][j] = s;
+            }
+            double s = r[col]; r[col] = r[piv]; r[piv] = s;
+        }
+        double p = fabs(A[col][col]);
+        if (!(p > 0.0))
+            return 0;
+        if (p > pmax) pmax = p;
+        if (p < pmin) pmin = p;
+        for (int i = col + 1; i < 6; i++) {
+            double q = A[i][col] / A[col][col];
+            for (int j = col; j < 6; j++)
+                A[i][j] -= q * A[col][j];
+            r[i] -= q * r[col];
+        }
+    }
+    if (pmin < PIVOT_RATIO * pmax)
+        return 0;
+    for (int i = 5; i >= 0; i--) {
+        double s = r[i];
+        for (int j = i + 1; j < 6; j++)
+            s -= A[i][j] * x[j];
+        x[i] = s / A[i][i];
+        if (!isfinite(x[i]))
+            return 0;
+    }
+    return 1;
+}
+
+/* Unfolds the far vertex w of the neighbour across the edge opposite corner k
+ * into the face's plane: the point at its 3D distances from the edge's ends,
+ * on the other side of the edge from corner k. */
+static void unfold_far(const mfmm_mesh *m, const frame *fr, int k, int32_t w, double out[2])
+{
+    int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+    const double *X1 = m->xyz + 3 * (size_t)fr->v[k1], *X2 = m->xyz + 3 * (size_t)fr->v[k2];
+    const double *W = m->xyz + 3 * (size_t)w;
+    double d1 = dist3(W, X1), d2 = dist3(W, X2);
+    double ex = fr->P[k2][0] - fr->P[k1][0], ey = fr->P[k2][1] - fr->P[k1][1];
+    double L = sqrt(ex * ex + ey * ey);
+    ex /= L;
+    ey /= L;
+    double a = (d1 * d1 - d2 * d2 + L * L) / (2.0 * L);
+    double h2 = d1 * d1 - a * a;
+    double h = h2 > 0.0 ? sqrt(h2) : 0.0;
+    double nx = -ey, ny = ex; /* normal to the edge, pointed away from corner k */
+    if ((fr->P[k][0] - fr->P[k1][0]) * nx + (fr->P[k][1] - fr->P[k1][1]) * ny > 0.0) {
+        nx = -nx;
+        ny = -ny;
+    }
+    out[0] = fr->P[k1][0] + a * ex + h * nx;
+    out[1] = fr->P[k1][1] + a * ey + h * ny;
+}
+
+/* Builds face f's frame and interpolants. 0 on a bad input value. */
+static int frame_build(tracer *t, int32_t f, frame *fr)
+{
+    const mfmm_mesh *m = t->m;
+    memset(fr, 0, sizeof *fr);
+    fr->f = f;
+    for (int k = 0; k < 3; k++) {
+        fr->v[k] = m->faces[3 * f + k];
+        if (!read_T(t, fr->v[k], &fr->T[k]))
+            return 0;
+    }
+    double b1[3] = {1.0 / 3, 1.0 / 3, 1.0 / 3};
+    if (!cost_at(t, f, b1, &fr->F))
+        return 0;
+    const double *A = m->xyz + 3 * (size_t)fr->v[0], *B = m->xyz + 3 * (size_t)fr->v[1],
+                 *C = m->xyz + 3 * (size_t)fr->v[2];
+    double u[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]};
+    double w[3] = {C[0] - A[0], C[1] - A[1], C[2] - A[2]};
+    double L = sqrt(dot3(u, u));
+    fr->max_edge = fmax(L, fmax(sqrt(dot3(w, w)), dist3(B, C)));
+    double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    double n2 = sqrt(dot3(n, n));
+    if (m->degenerate[f] || !(L > 0.0) || !(n2 > 1e-14 * fr->max_edge * fr->max_edge)) {
+        fr->degenerate = 1;
+        return 1;
+    }
+    for (int i = 0; i < 3; i++) {
+        fr->e1[i] = u[i] / L;
+        n[i] /= n2;
+    }
+    fr->e2[0] = n[1] * fr->e1[2] - n[2] * fr->e1[1];
+    fr->e2[1] = n[2] * fr->e1[0] - n[0] * fr->e1[2];
+    fr->e2[2] = n[0] * fr->e1[1] - n[1] * fr->e1[0];
+    fr->P[1][0] = L;
+    fr->P[2][0] = dot3(w, fr->e1);
+    fr->P[2][1] = dot3(w, fr->e2);
+    double twoA = fr->P[1][0] * fr->P[2][1] - fr->P[1][1] * fr->P[2][0];
+    for (int k = 0; k < 3; k++) {
+        const double *p1 = fr->P[(k + 1) % 3], *p2 = fr->P[(k + 2) % 3];
+        fr->gb[k][0] = (p1[1] - p2[1]) / twoA;
+        fr->gb[k][1] = (p2[0] - p1[0]) / twoA;
+    }
+    fr->lin_ok = isfinite(fr->T[0]) && isfinite(fr->T[1]) && isfinite(fr->T[2]);
+    if (!fr->lin_ok)
+        return 1;
+    for (int d = 0; d < 2; d++)
+        fr->glin[d] = fr->T[0] * fr->gb[0][d] + fr->T[1] * fr->gb[1][d] + fr->T[2] * fr->gb[2][d];
+
+    /* Section 5: the second-order fit over the face and its three neighbours. */
+    double pts[6][2], vals[6];
+    for (int k = 0; k < 3; k++) {
+        pts[k][0] = fr->P[k][0];
+        pts[k][1] = fr->P[k][1];
+        vals[k] = fr->T[k];
+    }
+    double Fmin = fr->F, Fmax = fr->F;
+    for (int k = 0; k < 3; k++) {
+        int32_t g = m->face_neighbor[3 * f + k];
+        if (g < 0 || m->degenerate[g])
+            return 1; /* boundary or degenerate neighbour: linear */
+        int32_t a1 = fr->v[(k + 1) % 3], a2 = fr->v[(k + 2) % 3], far = -1;
+        for (int j = 0; j < 3; j++) {
+            int32_t x = m->faces[3 * g + j];
+            if (x != a1 && x != a2)
+                far = x;
+        }
+        if (far < 0 || far == fr->v[k])
+            return 1;
+        if (!read_T(t, far, &vals[3 + k]))
+            return 0;
+        if (!isfinite(vals[3 + k]))
+            return 1;
+        unfold_far(m, fr, k, far, pts[3 + k]);
+        if (t->cost) {
+            double Fg;
+            if (t->cost_loc == MFMM_COST_PER_FACE) {
+                if (!read_cost(t, g, &Fg))
+                    return 0;
+            } else if (!read_cost(t, far, &Fg)) {
+                return 0;
+            }
+            Fmin = fmin(Fmin, Fg);
+            Fmax = fmax(Fmax, Fg);
+        }
+    }
+    /* T has a kink where the cost jumps (refraction): no smooth fit there. */
+    if (t->cost && (t->cost_loc == MFMM_COST_PER_FACE ? Fmax != Fmin : Fmax > 1.1 * Fmin))
+        return 1;
+    fr->ox = (fr->P[0][0] + fr->P[1][0] + fr->P[2][0]) / 3.0;
+    fr->oy = (fr->P[0][1] + fr->P[1][1] + fr->P[2][1]) / 3.0;
+    fr->scale = fr->max_edge;
+    double M[6][6], r[6];
+    for (int i = 0; i < 6; i++) {
+        double x = (pts[i][0] - fr->ox) / fr->scale, y = (pts[i][1] - fr->oy) / fr->scale;
+        M[i][0] = 1.0;
+        M[i][1] = x;
+        M[i][2] = y;
+        M[i][3] = x * x;
+        M[i][4] = x * y;
+        M[i][5] = y * y;
+        r[i] = vals[i] - fr->T[0];
+    }
+    fr->quad_ok = solve6(M, r, fr->c);
+    return 1;
+}
+
+/* grad T at plane point p: the quadratic where usable and descending like
+ * the linear gradient, else the linear one. 0 when there is none. */
+static int field_grad(const frame *fr, const double p[2], double g[2])
+{
+    if (!fr->lin_ok) {
+        /* a corner is unreached: head for the lowest finite corner */
+        int best = -1;
+        for (int k = 0; k < 3; k++)
+            if (isfinite(fr->T[k]) && (best < 0 || fr->T[k] < fr->T[best]))
+                best = k;
+        if (best < 0)
+            return 0;
+        g[0] = p[0] - fr->P[best][0];
+        g[1] = p[1] - fr->P[best][1];
+        return g[0] != 0.0 || g[1] != 0.0;
+    }
+    g[0] = fr->glin[0];
+    g[1] = fr->glin[1];
+    if (fr->quad_ok) {
+        double x = (p[0] - fr->ox) / fr->scale, y = (p[1] - fr->oy) / fr->scale;
+        double qx = (fr->c[1] + 2.0 * fr->c[3] * x + fr->c[4] * y) / fr->scale;
+        double qy = (fr->c[2] + fr->c[4] * x + 2.0 * fr->c[5] * y) / fr->scale;
+        if (qx * g[0] + qy * g[1] > 0.0) {
+            g[0] = qx;
+            g[1] = qy;
+        }
+    }
+    return isfinite(g[0]) && isfinite(g[1]) && (g[0] != 0.0 || g[1] != 0.0);
+}
+
+static void bary_to_plane(const frame *fr, const double b[3], double p[2])
+{
+    p[0] = b[0] * fr->P[0][0] + b[1] * fr->P[1][0] + b[2] * fr->P[2][0];
+    p[1] = b[0] * fr->P[0][1] + b[1] * fr->P[1][1] + b[2] * fr->P[2][1];
+}
+
+static double frame_T(const frame *fr, const double b[3])
+{
+    double s = 0.0;
+    for (int k = 0; k < 3; k++)
+        if (b[k] > 0.0)
+            s += b[k] * fr->T[k];
+    return s;
+}
+
+static void bary_to_xyz(const mfmm_mesh *m, int32_t f, const double b[3], double x[3])
+{
+    for (int i = 0; i < 3; i++)
+        x[i] = 0.0;
+    for (int k = 0; k < 3; k++) {
+        const double *X = m->xyz + 3 * (size_t)m->faces[3 * f + k];
+        for (int i = 0; i < 3; i++)
+            x[i] += b[k] * X[i];
+    }
+}
+
+/* Appends a point; the segment to it ran through face f. */
+static int emit(tracer *t, int32_t f, const double b[3])
+{
+    double x[3], F;
+    bary_to_xyz(t->m, f, b, x);
+    if (!cost_at(t, f, b, &F))
+        return 0;
+    if (t->n > 0) {
+        double d = dist3(x, t->last_xyz);
+        t->len += d;
+        t->wlen += d * (t->cost && t->cost_loc == MFMM_COST_PER_VERTEX ? 0.5 * (F + t->last_F) : F);
+    }
+    if (t->n >= t->max_points) {
+        t->st = mfmm_fail(t->err, MFMM_ERR_PATH_STALLED, t->n,
+                          "the path needs more than max_points = %d points", (int)t->max_points);
+        return 0;
+    }
+    if (t->n < t->cap) {
+        mfmm_surface_point *p = &t->pts[t->n];
+        p->face = f;
+        for (int i = 0; i < 3; i++) {
+            p->bary[i] = b[i];
+            p->xyz[i] = x[i];
+        }
+    }
+    t->n++;
+    memcpy(t->last_xyz, x, sizeof x);
+    t->last_F = F;
+    return 1;
+}
+
+static int cmp_key(const void *a, const void *b)
+{
+    const src_key *x = a, *y = b;
+    if (x->key != y->key)
+        return x->key < y->key ? -1 : 1;
+    return x->idx < y->idx ? -1 : x->idx > y->idx;
+}
+
+static int32_t lower_bound(const src_key *k, int32_t n, int32_t key)
+{
+    int32_t lo = 0, hi = n;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (k[mid].key < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* The best source reachable straight inside face f from the point at b: the
+ * one with the least value + F |x - source| that agrees with T(x) within half
+ * a face (the distance came from it). Returns the source index or -1. */
+static int32_t face_source(tracer *t, const frame *fr, const double b[3], double Tx,
+                           double sb[3])
+{
+    const mfmm_mesh *m = t->m;
+    double x[3];
+    bary_to_xyz(m, fr->f, b, x);
+    double best = INFINITY;
+    int32_t bi = -1;
+    for (int k = 0; k < 4; k++) {
+        const src_key *keys = k < 3 ? t->vkeys : t->fkeys;
+        int32_t nk = k < 3 ? t->n_vkeys : t->n_fkeys;
+        int32_t key = k < 3 ? fr->v[k] : fr->f;
+        for (int32_t i = lower_bound(keys, nk, key); i < nk && keys[i].key == key; i++) {
+            const mfmm_source *s = &t->src[keys[i].idx];
+            double xs[3], bs[3] = {0.0, 0.0, 0.0};
+            if (k < 3)
+                bs[k] = 1.0;
+            else
+                memcpy(bs, s->bary, sizeof bs);
+            bary_to_xyz(m, fr->f, bs, xs);
+            double c = s->value + fr->F * dist3(x, xs);
+            if (c < best) {
+                best = c;
+                bi = keys[i].idx;
+                memcpy(sb, bs, sizeof bs);
+            }
+        }
+    }
+    if (bi >= 0 && !(best <= Tx + 0.5 * fr->F * fr->max_edge))
+        bi = -1;
+    return bi;
+}
+
+/* 1 when no edge neighbour of v has a smaller T. */
+static int local_min(const tracer *t, int32_t v)
+{
+    const mfmm_mesh *m = t->m;
+    double Tv = t->T[v];
+    for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
+        int32_t c = m->vertex_face_corner[i], f = c / 3, k = c % 3;
+        if (t->T[m->faces[3 * f + (k + 1) % 3]] < Tv || t->T[m->faces[3 * f + (k + 2) % 3]] < Tv)
+            return 0;
+    }
+    return 1;
+}
+
+/* Ends the path inside face f from the point at b when f holds the end: a
+ * source the distance came from, or (without sources) a local-minimum
+ * corner. 1: ended; 0: go on; -1: error. */
+static int try_finish(tracer *t, const frame *fr, const double b[3], double Tx)
+{
+    double eb[3] = {0.0, 0.0, 0.0};
+    if (t->n_src > 0) {
+        if (face_source(t, fr, b, Tx, eb) < 0)
+            return 0;
+    } else {
+        int best = -1;
+        for (int k = 0; k < 3; k++)
+            if (fr->T[k] <= Tx && local_min(t, fr->v[k]) && (best < 0 || fr->T[k] < fr->T[best]))
+                best = k;
+        if (best < 0)
+            return 0;
+        eb[best] = 1.0;
+    }
+    if (eb[0] == b[0] && eb[1] == b[1] && eb[2] == b[2])
+        return 1; /* already there */
+    return emit(t, fr->f, eb) ? 1 : -1;
+}
+
+/* Where a ray from b along plane direction d leaves face fr: the largest
+ * step t <= hmax inside, and the edge (opposite corner) it leaves through or
+ * -1. t = 0 when it leaves at once through an edge b lies on. */
+static double ray_exit(const frame *fr, const double b[3], const double d[2], double hmax,
+                       int *edge)
+{
+    double t = hmax;
+    *edge = -1;
+    for (int k = 0; k < 3; k++) {
+        double rate = fr->gb[k][0] * d[0] + fr->gb[k][1] * d[1];
+        if (!(rate < 0.0))
+            continue;
+        if (b[k] <= ON_EDGE) {
+            double gn = sqrt(fr->gb[k][0] * fr->gb[k][0] + fr->gb[k][1] * fr->gb[k][1]);
+            if (rate < -OUTWARD_COS * gn) {
+                *edge = k;
+                return 0.0;
+            }
+            continue; /* moving along the edge */
+        }
+        double tk = b[k] / -rate;
+        if (tk <= t) {
+            t = tk;
+            *edge = k;
+        }
+    }
+    return t;
+}
+
+static void advance(const frame *fr, double b[3], const double d[2], double s, int edge)
+{
+    double sum = 0.0;
+    for (int k = 0; k < 3; k++) {
+        b[k] += s * (fr->gb[k][0] * d[0] + fr->gb[k][1] * d[1]);
+        if (b[k] < ON_EDGE || k == edge)
+            b[k] = 0.0;
+        sum += b[k];
+    }
+    for (int k = 0; k < 3; k++)
+        b[k] /= sum;
+}
+
+/* Face g's barycentric coordinates of a point on its edge shared with f. */
+static void map_bary(const mfmm_mesh *m, const frame *fr, const double b[3], int32_t g, double bg[3])
+{
+    for (int j = 0; j < 3; j++) {
+        bg[j] = 0.0;
+        int32_t x = m->faces[3 * g + j];
+        for (int k = 0; k < 3; k++)
+            if (fr->v[k] == x)
+                bg[j] = b[k];
+    }
+}
+
+typedef struct pos {
+    int32_t f;      /* current face */
+    double b[3];    /* barycentric in f */
+    int32_t vertex; /* >= 0: the point is this vertex */
+    int32_t from;   /* face just crossed from at this position, or -1 */
+} pos;
+
+static void set_vertex(pos *p, const mfmm_mesh *m, int32_t f, int32_t v)
+{
+    p->f = f;
+    p->vertex = v;
+    p->from = -1;
+    for (int k = 0; k < 3; k++)
+        p->b[k] = m->faces[3 * f + k] == v ? 1.0 : 0.0;
+}
+
+/* At vertex v: steepest descent among the incident faces (a face whose
+ * -grad T at v points into its corner) and edges. 1: moved on (p updated,
+ * possibly to another vertex); 0: no descent; -1: error. */
+static int leave_vertex(tracer *t, pos *p, frame *fr, double *d_out)
+{
+    const mfmm_mesh *m = t->m;
+    int32_t v = p->vertex;
+    double Tv = t->T[v], best = 0.0;
+    int kind = 0; /* 1 face, 2 edge */
+    int32_t bf = -1, bw = -1;
+    double bd[2] = {0.0, 0.0};
+    for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
+        int32_t c = m->vertex_face_corner[i], f = c / 3, k = c % 3;
+        frame cf;
+        if (!frame_build(t, f, &cf))
+            return -1;
+        for (int j = 1; j <= 2; j++) {
+            int32_t w = cf.v[(k + j) % 3];
+            double Tw = cf.T[(k + j) % 3];
+            double L = dist3(m->xyz + 3 * (size_t)v, m->xyz + 3 * (size_t)w);
+            if (kind != 1 && isfinite(Tw) && L > 0.0 && (Tv - Tw) / L > best * (1.0 + 1e-9)) {
+                best = (Tv - Tw) / L;
+                kind = 2;
+                bf = f;
+                bw = w;
+            }
+        }
+        if (cf.degenerate)
+            continue;
+        double g[2];
+        if (!field_grad(&cf, cf.P[k], g))
+            continue;
+        double gn = sqrt(g[0] * g[0] + g[1] * g[1]);
+        double d[2] = {-g[0] / gn, -g[1] / gn};
+        /* d = alpha (P1 - Pk) + beta (P2 - Pk) with alpha, beta >= 0: into the corner */
+        const double *P0 = cf.P[k], *P1 = cf.P[(k + 1) % 3], *P2 = cf.P[(k + 2) % 3];
+        double ax = P1[0] - P0[0], ay = P1[1] - P0[1], cx = P2[0] - P0[0], cy = P2[1] - P0[1];
+        double det = ax * cy - ay * cx;
+        double alpha = (d[0] * cy - d[1] * cx) / det, beta = (ax * d[1] - ay * d[0]) / det;
+        double la = sqrt(ax * ax + ay * ay), lc = sqrt(cx * cx + cy * cy);
+        if (alpha * la >= -1e-12 && beta * lc >= -1e-12 && (kind != 1 || gn > best)) {
+            best = gn;
+            kind = 1;
+            bf = f;
+            bd[0] = d[0];
+            bd[1] = d[1];
+        }
+    }
+    if (kind == 0)
+        return 0;
+    if (kind == 2) {
+        pos q;
+        set_vertex(&q, m, bf, bw);
+        if (!emit(t, bf, q.b))
+            return -1;
+        *p = q;
+        return 1;
+    }
+    set_vertex(p, m, bf, v);
+    p->vertex = -1;
+    if (!frame_build(t, bf, fr))
+        return -1;
+    d_out[0] = bd[0];
+    d_out[1] = bd[1];
+    return 1;
+}
+
+/* Moves along the edge opposite corner k of the current face (a boundary, or
+ * a valley both faces descend into) in the direction of d's tangential
+ * part, at most hmax. Returns 1, or 0 when d is across the edge (no way on). */
+static int slide(tracer *t, pos *p, const frame *fr, int k, const double d[2], double hmax)
+{
+    int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+    double ex = fr->P[k2][0] - fr->P[k1][0], ey = fr->P[k2][1] - fr->P[k1][1];
+    double L = sqrt(ex * ex + ey * ey);
+    double s = (d[0] * ex + d[1] * ey) / L;
+    int toward;
+    if (fabs(s) > 1e-6)
+        toward = s > 0.0 ? k2 : k1;
+    else if (fr->T[k1] != fr->T[k2])
+        toward = fr->T[k1] < fr->T[k2] ? k1 : k2;
+    else
+        return 0;
+    int other = toward == k1 ? k2 : k1;
+    double left = p->b[other] * L; /* distance to the corner `toward` */
+    if (left <= hmax) {
+        int32_t v = fr->v[toward];
+        set_vertex(p, t->m, fr->f, v);
+        return emit(t, fr->f, p->b) ? 1 : -1;
+    }
+    double q = hmax / L;
+    p->b[other] -= q;
+    p->b[toward] += q;
+    p->b[k] = 0.0;
+    p->from = -1;
+    return 1;
+}
+
+static int validate_point(const mfmm_mesh *m, const mfmm_source *s, const char *what, int64_t idx,
+                          mfmm_error *err)
+{
+    if (s->face == -1) {
+        if (s->vertex < 0 || s->vertex >= m->nv)
+            return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, idx, "%s vertex %d is out of range [0, %d)",
+                             what, (int)s->vertex, (int)m->nv);
+        return MFMM_OK;
+    }
+    if (s->face < 0 || s->face >= m->nf)
+        return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, idx, "%s face %d is out of range [0, %d)", what,
+                         (int)s->face, (int)m->nf);
+    double sum = 0.0;
+    for (int k = 0; k < 3; k++) {
+        if (!isfinite(s->bary[k]) || s->bary[k] < 0.0)
+            return mfmm_fail(err, MFMM_ERR_BAD_BARYCENTRIC, idx,
+                             "%s barycentric coordinate %d = %g is not finite and >= 0", what, k,
+                             s->bary[k]);
+        sum += s->bary[k];
+    }
+    if (fabs(sum - 1.0) > 1e-9)
+        return mfmm_fail(err, MFMM_ERR_BAD_BARYCENTRIC, idx,
+                         "%s barycentric coordinates sum to %.17g, not 1", what, sum);
+    return MFMM_OK;
+}
+
+void mfmm_path_options_init(mfmm_path_options *options)
+{
+    if (!options)
+        return;
+    memset(options, 0, sizeof *options);
+    options->max_points = 100000;
+    options->cost_location = MFMM_COST_NONE;
+}
+
+static mfmm_status trace(tracer *t, const mfmm_source *target);
+
+mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
+                            const mfmm_source *target, const mfmm_path_options *options,
+                            mfmm_surface_point *points, int32_t capacity, int32_t *n_points,
+                            double *length, mfmm_error *err)
+{
+    mfmm_path_options defaults;
+    mfmm_path_options_init(&defaults);
+    const mfmm_path_options *o = options ? options : &defaults;
+    if (n_points)
+        *n_points = 0;
+    if (length)
+        *length = 0.0;
+    if (!mesh)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "mesh is NULL");
+    if (!distances)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "distances is NULL");
+    if (!target)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "target is NULL");
+    if (!n_points)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "n_points is NULL");
+    if (capacity < 0)
+        return mfmm_fail(err, MFMM_ERR_BAD_COUNT, capacity, "capacity %d is negative",
+                         (int)capacity);
+    if (capacity > 0 && !points)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "points is NULL with capacity %d",
+                         (int)capacity);
+    if (o->max_points < 1)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, o->max_points,
+                         "max_points %d is not >= 1", (int)o->max_points);
+    if (o->n_sources < 0 || (o->n_sources > 0 && !o->sources))
+        return mfmm_fail(err, o->n_sources < 0 ? MFMM_ERR_BAD_COUNT : MFMM_ERR_NULL_POINTER,
+                         o->n_sources, "n_sources is %d with sources %s", (int)o->n_sources,
+                         o->sources ? "given" : "NULL");
+    if (o->cost && o->cost_location != MFMM_COST_PER_VERTEX &&
+        o->cost_location != MFMM_COST_PER_FACE)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, (int64_t)o->cost_location,
+                         "cost_location %d is not per vertex or per face", (int)o->cost_location);
+    mfmm_status st = validate_point(mesh, target, "target", -1, err);
+    if (st != MFMM_OK)
+        return st;
+    for (int32_t i = 0; i < o->n_sources; i++) {
+        if ((st = validate_point(mesh, &o->sources[i], "source", i, err)) != MFMM_OK)
+            return st;
+        if (!isfinite(o->sources[i].value))
+            return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, i, "source %d has value %g", (int)i,
+                             o->sources[i].value);
+    }
+
+    tracer t;
+    memset(&t, 0, sizeof t);
+    t.m = mesh;
+    t.T = distances;
+    t.src = o->sources;
+    t.n_src = o->n_sources;
+    t.cost = o->cost;
+    t.cost_loc = o->cost ? o->cost_location : MFMM_COST_NONE;
+    t.pts = points;
+    t.cap = capacity;
+    t.max_points = o->max_points;
+    t.err = err;
+    t.st = MFMM_OK;
+    /* The only scratch: the sources sorted by vertex and by face. */
+    if (t.n_src > 0) {
+        t.vkeys = malloc(sizeof(src_key) * (size_t)t.n_src);
+        t.fkeys = malloc(sizeof(src_key) * (size_t)t.n_src);
+        if (!t.vkeys || !t.fkeys) {
+            free(t.vkeys);
+            free(t.fkeys);
+            return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "no memory for %d sources",
+                             (int)t.n_src);
+        }
+        for (int32_t i = 0; i < t.n_src; i++) {
+            const mfmm_source *s = &t.src[i];
+            if (s->face == -1)
+                t.vkeys[t.n_vkeys++] = (src_key){s->vertex, i};
+            else
+                t.fkeys[t.n_fkeys++] = (src_key){s->face, i};
+        }
+        qsort(t.vkeys, (size_t)t.n_vkeys, sizeof(src_key), cmp_key);
+        qsort(t.fkeys, (size_t)t.n_fkeys, sizeof(src_key), cmp_key);
+    }
+    st = trace(&t, target);
+    free(t.vkeys);
+    free(t.fkeys);
+    *n_points = t.n;
+    if (length)
+        *length = t.len;
+    if (o->weighted_length)
+        *o->weighted_length = t.wlen;
+    if (st == MFMM_OK && t.n > t.cap)
+        st = mfmm_fail(err, MFMM_ERR_BAD_COUNT, t.n, "the path has %d points, capacity is %d",
+                       (int)t.n, (int)t.cap);
+    if (st == MFMM_OK)
+        mfmm_ok(err);
+    return st;
+}
+
+static mfmm_status trace(tracer *t, const mfmm_source *target)
+{
+    const mfmm_mesh *m = t->m;
+    pos p;
+    frame fr;
+    int have_frame = 0;
+    double T0;
+    if (target->face == -1) {
+        int32_t v = target->vertex;
+        if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1])
+            return mfmm_fail(t->err, MFMM_ERR_UNREACHED, v, "target vertex %d is in no face",
+                             (int)v);
+        if (!read_T(t, v, &T0))
+            return t->st;
+        set_vertex(&p, m, m->vertex_face_corner[m->vertex_face_offset[v]] / 3, v);
+    } else {
+        p.f = target->face;
+        p.vertex = -1;
+        p.from = -1;
+        memcpy(p.b, target->bary, sizeof p.b);
+        if (!frame_build(t, p.f, &fr))
+            return t->st;
+        have_frame = 1;
+        T0 = frame_T(&fr, p.b);
+        if (!fr.lin_ok)
+            for (int k = 0; k < 3; k++)
+                if (p.b[k] > 0.0 && !isfinite(fr.T[k]))
+                    T0 = INFINITY;
+    }
+    if (!(T0 < INFINITY))
+        return mfmm_fail(t->err, MFMM_ERR_UNREACHED, target->face == -1 ? target->vertex : target->face,
+                         "the target's distance is infinite (not reached)");
+    if (!emit(t, p.f, p.b))
+        return t->st;
+
+    double best = T0;
+    int64_t stall = 0, steps = 0, max_steps = 16 * (int64_t)t->max_points + 64;
+    for (;;) {
+        if (++steps > max_steps || stall > STALL_STEPS)
+            return mfmm_fail(t->err, MFMM_ERR_PATH_STALLED, t->n,
+                             "T stopped decreasing at %.17g after %d points", best, (int)t->n);
+        double Tcur, d[2] = {0.0, 0.0};
+        int have_dir = 0;
+        if (p.vertex >= 0) {
+            int32_t v = p.vertex;
+            Tcur = t->T[v];
+            /* the end may lie in any face around the vertex */
+            for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
+                int32_t f = m->vertex_face_corner[i] / 3;
+                frame cf;
+                if (!frame_build(t, f, &cf))
+                    return t->st;
+                double b[3];
+                for (int k = 0; k < 3; k++)
+                    b[k] = cf.v[k] == v ? 1.0 : 0.0;
+                int r = try_finish(t, &cf, b, Tcur);
+                if (r < 0)
+                    return t->st;
+                if (r > 0)
+                    return MFMM_OK;
+            }
+            int r = leave_vertex(t, &p, &fr, d);
+            if (r < 0)
+                return t->st;
+            if (r == 0)
+                return mfmm_fail(t->err, MFMM_ERR_PATH_STALLED, v,
+                                 "T has a local minimum %.17g at vertex %d, not at a source",
+                                 Tcur, (int)v);
+            if (p.vertex >= 0) { /* went down an edge to another vertex */
+                have_frame = 0;
+                if (t->T[p.vertex] < best) {
+                    best = t->T[p.vertex];
+                    stall = 0;
+                } else {
+                    stall++;
+                }
+                continue;
+            }
+            have_frame = 1;
+            have_dir = 1;
+        } else if (!have_frame || fr.f != p.f) {
+            if (!frame_build(t, p.f, &fr))
+                return t->st;
+            have_frame = 1;
+        }
+        Tcur = frame_T(&fr, p.b);
+        if (!have_dir) {
+            int r = try_finish(t, &fr, p.b, Tcur);
+            if (r < 0)
+                return t->st;
+            if (r > 0)
+                return MFMM_OK;
+        }
+        if (fr.degenerate || !fr.lin_ok) {
+            /* no plane or an unreached corner: go straight to the lowest corner */
+            int lo = -1;
+            for (int k = 0; k < 3; k++)
+                if (isfinite(fr.T[k]) && (lo < 0 || fr.T[k] < fr.T[lo]))
+                    lo = k;
+            if (lo < 0)
+                return mfmm_fail(t->err, MFMM_ERR_PATH_STALLED, p.f,
+                                 "face %d has no reached corner", (int)p.f);
+            set_vertex(&p, m, fr.f, fr.v[lo]);
+            if (!emit(t, fr.f, p.b))
+                return t->st;
+            if (fr.T[lo] < best) {
+                best = fr.T[lo];
+                stall = 0;
+            } else {
+                stall++;
+            }
+            continue;
+        }
+
+        /* Heun's step (section 5), at most a third of the face's longest edge. */
+        double h = fr.max_edge / 3.0, x0[2];
+        bary_to_plane(&fr, p.b, x0);
+        if (!have_dir) {
+            double g[2];
+            if (!field_grad(&fr, x0, g))
+                return mfmm_fail(t->err, MFMM_ERR_PATH_STALLED, p.f,
+                                 "grad T vanishes in face %d", (int)p.f);
+            double gn = sqrt(g[0] * g[0] + g[1] * g[1]);
+            d[0] = -g[0] / gn;
+            d[1] = -g[1] / gn;
+        }
+        int edge;
+        double s1 = ray_exit(&fr, p.b, d, h, &edge);
+        if (s1 > 0.0) {
+            double x1[2] = {x0[0] + s1 * d[0], x0[1] + s1 * d[1]}, g2[2];
+            if (field_grad(&fr, x1, g2)) {
+                double gn = sqrt(g2[0] * g2[0] + g2[1] * g2[1]);
+                double d2[2] = {-g2[0] / gn, -g2[1] / gn};
+                /* a sonic point (gradient jump): keep the first-order step */
+                if (d[0] * d2[0] + d[1] * d2[1] >= SONIC_COS) {
+                    double a[2] = {d[0] + d2[0], d[1] + d2[1]};
+                    double an = sqrt(a[0] * a[0] + a[1] * a[1]);
+                    a[0] /= an;
+                    a[1] /= an;
+                    int e2;
+                    double s2 = ray_exit(&fr, p.b, a, h, &e2);
+                    if (s2 > 0.0) {
+                        d[0] = a[0];
+                        d[1] = a[1];
+                        s1 = s2;
+                        edge = e2;
+                    }
+                }
+            }
+            advance(&fr, p.b, d, s1, edge);
+            p.from = -1;
+        }
+        Tcur = frame_T(&fr, p.b);
+        if (Tcur < best - 1e-14 * (1.0 + fabs(best))) {
+            best = Tcur;
+            stall = 0;
+        } else {
+            stall++;
+        }
+        if (edge < 0)
+            continue;
+
+        /* on the edge opposite corner `edge`: at a vertex, across, or along it */
+        int corner = -1;
+        for (int k = 0; k < 3; k++)
+            if (k != edge && p.b[k] <= SNAP_BARY)
+                corner = 3 - k - edge;
+        if (corner >= 0) {
+            set_vertex(&p, m, fr.f, fr.v[corner]);
+            if (!emit(t, fr.f, p.b))
+                return t->st;
+            continue;
+        }
+        int32_t g = m->face_neighbor[3 * fr.f + edge];
+        if (g >= 0 && g != p.from) {
+            if (s1 > 0.0 && !emit(t, fr.f, p.b))
+                return t->st;
+            double bg[3];
+            map_bary(m, &fr, p.b, g, bg);
+            p.from = fr.f;
+            p.f = g;
+            memcpy(p.b, bg, sizeof bg);
+            continue;
+        }
+        /* a boundary, or a valley: both faces descend into this edge */
+        if (s1 > 0.0)
+            continue; /* came to a boundary edge: decide from there */
+        int r = slide(t, &p, &fr, edge, d, h);
+        if (r < 0)
+            return t->st;
+        if (r == 0)
+            return mfmm_fail(t->err, MFMM_ERR_PATH_STALLED, p.f,
+                             "the path runs into an edge of face %d and stops", (int)p.f);
+        if (p.vertex < 0) {
+            double Tn = frame_T(&fr, p.b);
+            if (Tn < best) {
+                best = Tn;
+                stall = 0;
+            }
+        }
+    }
+}
