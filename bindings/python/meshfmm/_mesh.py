@@ -89,8 +89,13 @@ class GeodesicPath:
 
 # ------------------------------------------------------------------ helpers
 def _addr(a: np.ndarray) -> int:
-    """Address of an ndarray's first element."""
-    return a.__array_interface__["data"][0]
+    """Address of an ndarray's first element. (ctypes.c_char.from_buffer is
+    several times faster than ndarray.ctypes.data, but needs a writable,
+    non-empty buffer.)"""
+    try:
+        return ctypes.addressof(ctypes.c_char.from_buffer(a))
+    except (TypeError, ValueError):
+        return a.__array_interface__["data"][0]
 
 
 def _is_int(x: Any) -> bool:
@@ -148,6 +153,15 @@ def _source_records(sources: Any, what: str = "source") -> np.ndarray:
     n = len(sources)
     if n == 0:
         raise ValueError(f"at least one {what} is needed")
+    if all(_is_int(s) for s in sources):  # vertex ids only: filled at once
+        ids = [int(s) for s in sources]
+        for i, v in enumerate(ids):
+            if not (_I32_MIN <= v <= _I32_MAX):
+                raise ValueError(f"{what} {i}: vertex {v} is out of range (not a 32-bit index)")
+        rec = np.zeros(n, dtype=_lib.SOURCE_DTYPE)
+        rec["vertex"] = ids
+        rec["face"] = -1
+        return rec
     rec = np.zeros(n, dtype=_lib.SOURCE_DTYPE)
     for i, s in enumerate(sources):
         if isinstance(s, SurfacePoint):
@@ -417,30 +431,36 @@ class Mesh:
         Unreached vertices (other components, beyond max_distance) are +inf.
         Raises ValueError (bad source, barycentric coordinates, cost, ...).
         """
-        src = _source_records(sources)
-        opts = _lib.mfmm_solve_options.from_buffer_copy(self._opts_template)
-        c, loc = _cost_array(cost, cost_location, self._nv, self._nf)
-        if c is not None:
-            opts.cost = _addr(c)
-            opts.cost_location = loc
-        if max_distance is not None:
-            opts.max_distance = _max_distance(max_distance)
-        t = None
-        if targets is not None:
-            t = _index_array(targets, "target")
-            opts.targets = _addr(t)
-            opts.n_targets = t.shape[0]
-        if not unfolding:
-            opts.unfolding = 0
+        if _is_int(sources):  # the common case, kept cheap (see bench_python.py)
+            one = _lib.mfmm_source(_as_index(sources, "source"), -1)
+            src_addr, n_src = ctypes.addressof(one), 1
+        else:
+            src = _source_records(sources)
+            src_addr, n_src = _addr(src), src.shape[0]
+        opts = None
+        if (cost is not None or max_distance is not None or targets is not None
+                or not unfolding or cost_location is not None):
+            opts = _lib.mfmm_solve_options.from_buffer_copy(self._opts_template)
+            c, loc = _cost_array(cost, cost_location, self._nv, self._nf)
+            if c is not None:
+                opts.cost = _addr(c)
+                opts.cost_location = loc
+            if max_distance is not None:
+                opts.max_distance = _max_distance(max_distance)
+            if targets is not None:
+                t = _index_array(targets, "target")
+                opts.targets = _addr(t)
+                opts.n_targets = t.shape[0]
+            if not unfolding:
+                opts.unfolding = 0
+            opts = byref(opts)
         out = np.empty(self._nv, dtype=np.float64)
         err = _lib.mfmm_error()
         solver = None
         mesh_ptr = self._enter()
         try:
             solver = self._take_solver(mesh_ptr)
-            status = _lib.mfmm_solve(
-                solver, _addr(src), src.shape[0], byref(opts), _addr(out), byref(err)
-            )
+            status = _lib.mfmm_solve(solver, src_addr, n_src, opts, _addr(out), byref(err))
         finally:
             if solver is not None:
                 self._solvers.append(solver)
