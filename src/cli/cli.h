@@ -15,6 +15,7 @@ int cmd_info(int argc, char **argv);
 int cmd_distance(int argc, char **argv);
 int cmd_generate(int argc, char **argv);
 int cmd_allpairs(int argc, char **argv);
+int cmd_path(int argc, char **argv);
 
 /* Prints "meshfmm: <message>\n" on stderr. */
 void cli_error(const char *fmt, ...)

@@ -21,6 +21,7 @@ static const cli_command commands[] = {
     {"distance", cmd_distance, "geodesic distances from sources to every vertex"},
     {"generate", cmd_generate, "write a generated mesh (sine, sphere, torus, grid, lattice)"},
     {"allpairs", cmd_allpairs, "the distance matrix of many sources, streamed into a .npy file"},
+    {"path", cmd_path, "the minimal geodesic from a target to the sources (.csv or .obj)"},
 };
 
 static void print_usage(FILE *out)
