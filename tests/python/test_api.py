@@ -383,3 +383,72 @@ def test_distance_matrix_smoke(tmp_path):
 
     with pytest.raises(KeyError, match="stop here"):
         m.distance_matrix([0, 1, 2], backend="serial", progress=stop)
+
+
+def test_opencl_errors_map_to_openclerror(tmp_path):
+    """Without an OpenCL platform (no ICD vendors), backend='opencl' raises
+    meshfmm.OpenCLError with the library's message and 'auto' falls back."""
+    code = textwrap.dedent(
+        """
+        import numpy as np, meshfmm, sys
+        sys.path.insert(0, %r)
+        from test_api import grid
+        m = meshfmm.Mesh(*grid(4))
+        try:
+            m.distance_matrix([0, 1], backend="opencl")
+            print("no exception")
+        except NotImplementedError:
+            print("skip")
+            raise SystemExit
+        except meshfmm.OpenCLError as exc:
+            assert isinstance(exc, RuntimeError) and str(exc), exc
+            print("OpenCLError", exc)
+        D = m.distance_matrix([0, 1], backend="auto", dtype="float64")
+        assert m.backend_used in ("threads", "serial"), m.backend_used
+        assert (D[1] == m.distance(1)).all()
+        print("fallback", m.backend_used)
+        """
+    ) % str(Path(__file__).parent)
+    env = dict(os.environ, OCL_ICD_VENDORS=str(tmp_path), OPENCL_VENDOR_PATH=str(tmp_path))
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=env, timeout=120)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    if proc.stdout.strip() == "skip":
+        pytest.skip("no mfmm_distance_matrix in this library build")
+    lines = proc.stdout.strip().splitlines()
+    assert lines[0].startswith("OpenCLError"), proc.stdout
+    assert lines[-1].startswith("fallback"), proc.stdout
+
+
+def test_ctrl_c_stops_distance_matrix():
+    """SIGINT during distance_matrix stops the library at the next block and
+    raises KeyboardInterrupt; the interpreter and the mesh stay usable."""
+    code = textwrap.dedent(
+        """
+        import os, signal, threading, time, numpy as np, meshfmm, sys
+        sys.path.insert(0, %r)
+        from test_api import grid
+        m = meshfmm.Mesh(*grid(60))
+        calls = []
+        def progress(done, n):
+            calls.append(done)
+            if len(calls) == 1:
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(0.05)
+        try:
+            m.distance_matrix(backend="serial", memory_limit=1 << 20, progress=progress)
+            print("finished", len(calls))
+        except KeyboardInterrupt:
+            print("interrupted", len(calls))
+        assert (m.distance(3) >= 0).all()
+        """
+    ) % str(Path(__file__).parent)
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    out = proc.stdout.strip()
+    if "NotImplementedError" in proc.stderr:
+        pytest.skip("no mfmm_distance_matrix in this library build")
+    assert out.startswith("interrupted"), out
+    done = int(out.split()[1])
+    assert done < 10, f"{done} blocks ran after Ctrl-C"
