@@ -452,3 +452,12 @@ def test_ctrl_c_stops_distance_matrix():
     assert out.startswith("interrupted"), out
     done = int(out.split()[1])
     assert done < 10, f"{done} blocks ran after Ctrl-C"
+
+
+def test_max_unfold_steps_reaches_the_core(meshes_dir):
+    V, F = load("wingnut.obj")
+    default = meshfmm.Mesh(V, F).info
+    short = meshfmm.Mesh(V, F, max_unfold_steps=1).info
+    assert default.n_obtuse_corners == short.n_obtuse_corners > 0
+    assert default.n_virtual_edges + default.n_unfold_failures == default.n_obtuse_corners
+    assert short.n_unfold_failures > default.n_unfold_failures
