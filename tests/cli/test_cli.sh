@@ -5,6 +5,7 @@
 set -u
 BIN=${1:?usage: test_cli.sh MESHFMM SHARED_DIR}
 SHARED=${2:?usage: test_cli.sh MESHFMM SHARED_DIR}
+[ -x "$BIN" ] || { echo "FAIL: no executable $BIN"; exit 1; }
 T=$(mktemp -d "${TMPDIR:-/tmp}/mfmm_cli.XXXXXX") || exit 1
 trap 'rm -rf "$T"' EXIT INT TERM
 FAILS=0
