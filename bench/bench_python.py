@@ -11,7 +11,7 @@ solve timed in C (a small C program compiled against the same libmeshfmm, or a
 bare ctypes loop on mfmm_solve without a compiler).
 
 Writes bench/results/python_speed.json. Not a test: timings on a shared
-machine are noisy; the medians of interleaved repeats are reported.
+machine are noisy; the medians over rounds of per-method blocks are reported.
 
     python bench/bench_python.py [--meshes a.obj b.off ...] [--sources 20] [--large]
 """
@@ -84,10 +84,15 @@ def bench_mesh(name, n_sources, repeats):
     rng = np.random.default_rng(1)
     sources = rng.choice(old_of_new, size=min(n_sources, old_of_new.size), replace=False)
     ours, gcf, gch = [], [], []
-    for _ in range(repeats):  # interleaved, so that machine load hits all alike
+    # Rounds of blocks (all sources with one method, then the next): machine
+    # load hits all three alike, and each runs with its own data in cache, as
+    # a user's loop over sources would.
+    for _ in range(repeats):
         for s in sources:
             ours.append(timed(mesh.distance, int(s))[0])
+        for s in sources:
             gcf.append(timed(fmm.compute_distance, [[(int(new_of_old[s]), [])]])[0])
+        for s in sources:
             gch.append(timed(heat.compute_distance, int(new_of_old[s]))[0])
     row = {
         "n_vertices": int(V.shape[0]),
@@ -260,7 +265,7 @@ def main():
         "machine": {"platform": platform.platform(), "processor": platform.processor(),
                     "cpus": os.cpu_count(), "python": platform.python_version()},
         "meshfmm_version": meshfmm.__version__,
-        "timing": "median seconds per source over interleaved repeats; heat after its precompute",
+        "timing": "median seconds per source over rounds of per-method blocks; heat after its precompute",
         "meshes": rows,
         "call_overhead": ov,
     }
