@@ -29,6 +29,15 @@ static double now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
+static double cpu_seconds(void)
+{
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) != 0)
+        return 0.0;
+    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+           (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+}
+
 static int drop_rows(void *user, int32_t first, int32_t n, const void *rows)
 {
     (void)first;
@@ -42,6 +51,7 @@ typedef struct result {
     double seconds;
     int64_t rows;
     long maxrss_kb; /* the child's own peak */
+    double cpu;     /* CPU seconds (user + system) of the timed call */
 } result;
 
 static size_t memory_limit; /* --memory MB; 0: the library's default */
@@ -49,7 +59,7 @@ static size_t memory_limit; /* --memory MB; 0: the library's default */
 static void run_child(const char *path, mfmm_backend backend, int threads, int32_t n_rows,
                       int fd)
 {
-    result r = {1, 0.0, 0, 0};
+    result r = {1, 0.0, 0, 0, 0.0};
     double *V = NULL;
     int32_t *F = NULL, nv = 0, nf = 0;
     mfmm_error err;
@@ -81,9 +91,10 @@ static void run_child(const char *path, mfmm_backend backend, int threads, int32
         mfmm_distance_matrix(mesh, src, 2, &o, &err);
         o.user = &r.rows;
     }
-    double t0 = now();
+    double c0 = cpu_seconds(), t0 = now();
     mfmm_status st = mfmm_distance_matrix(mesh, src, n_rows, &o, &err);
     r.seconds = now() - t0;
+    r.cpu = cpu_seconds() - c0;
     if (st != MFMM_OK)
         fprintf(stderr, "%s %s: %s\n", path, mfmm_backend_name(backend), err.message);
     r.status = st;
@@ -157,11 +168,12 @@ static void bench_mesh(const char *path, int32_t n_rows, int full)
         double rate = entries / r.seconds;
         if (k == 0)
             serial_rate = rate;
-        printf("  %-18s %6lld rows %8.2f s  %10.3g entries/s  x%.2f serial  full matrix %s%.1f s"
-               "  peak RSS %.1f MiB\n",
+        printf("  %-18s %6lld rows %7.2f s %9.3g entries/s  x%.2f serial  full %s%.1f s  "
+               "%9.3g entries/cpu-s  peak RSS %.1f MiB\n",
                runs[k].name, (long long)r.rows, r.seconds, rate,
                serial_rate > 0 ? rate / serial_rate : 0.0, r.rows < nv ? "~" : "",
-               (double)nv * nv / rate, (double)rss / 1024.0);
+               (double)nv * nv / rate, r.cpu > 0 ? entries / r.cpu : 0.0,
+               (double)rss / 1024.0);
     }
 }
 

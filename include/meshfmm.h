@@ -292,8 +292,14 @@ MFMM_API void mfmm_matrix_options_init(mfmm_matrix_options *options);
  * every vertex (equal to mfmm_solve's). sources NULL: all vertices, in order
  * (n_sources must then be nv). Rows go to options->out, to options->on_rows,
  * or both; the library holds only the blocks in flight, never n_sources x nv.
- * With backend AUTO, an OpenCL failure falls back to threads;
- * options->backend_used tells which ran. */
+ * With backend AUTO, an OpenCL failure falls back to threads (from the first
+ * row not yet delivered); options->backend_used tells which ran.
+ * OpenCL: the device is $MESHFMM_OPENCL_DEVICE (an index over all platforms'
+ * devices, or a substring of a device name), default the first CPU device;
+ * the program binary is cached in $MESHFMM_CACHE_DIR, else
+ * $XDG_CACHE_HOME/meshfmm, else ~/.cache/meshfmm (best effort). Float64
+ * rows equal mfmm_solve's bit for bit (OpenCL: built without contraction or
+ * relaxed math; tested on PoCL). */
 MFMM_API mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
                                           int32_t n_sources, mfmm_matrix_options *options,
                                           mfmm_error *err);

@@ -283,7 +283,9 @@ static void cache_store(const char *dir, const char *path, uint64_t key, const u
 {
     char tmp[1200];
     make_dirs(dir);
-    if (snprintf(tmp, sizeof tmp, "%s.%ld.tmp", path, (long)getpid()) >= (int)sizeof tmp)
+    /* pid and a stack address: unique among processes and concurrent calls */
+    if (snprintf(tmp, sizeof tmp, "%s.%ld.%p.tmp", path, (long)getpid(), (void *)tmp) >=
+        (int)sizeof tmp)
         return;
     FILE *f = fopen(tmp, "wb");
     if (!f)
