@@ -78,6 +78,7 @@ static int check_opencl(const mfmm_mesh *mesh, const int32_t *src, int32_t n, co
         o.cost = so->cost;
         o.cost_location = so->cost_location;
         o.max_distance = so->max_distance;
+        o.unfolding = so->unfolding;
     }
     mfmm_error err;
     mfmm_status st = mfmm_distance_matrix(mesh, src, n, &o, &err);
@@ -150,6 +151,23 @@ static void test_generated_meshes(void **state)
             assert_int_equal(count_files(cache_dir), 1);
         check_opencl(mesh, src, n, ref, MFMM_FLOAT32, 1, (size_t)nv * 60 * 3, NULL);
         free(ref);
+        /* per-vertex cost, and plain stencils (no unfolding) */
+        double *vcost = malloc((size_t)nv * sizeof *vcost);
+        assert_non_null(vcost);
+        for (int32_t v = 0; v < nv; v++)
+            vcost[v] = 0.5 + 0.1 * (double)(v % 13);
+        mfmm_solve_options so[2];
+        mfmm_solve_options_init(&so[0]);
+        mfmm_solve_options_init(&so[1]);
+        so[0].cost = vcost;
+        so[0].cost_location = MFMM_COST_PER_VERTEX;
+        so[1].unfolding = 0;
+        for (int k = 0; k < 2; k++) {
+            ref = reference_rows(mesh, src, n, &so[k]);
+            assert_true(check_opencl(mesh, src, n, ref, MFMM_FLOAT64, 0, 0, &so[k]));
+            free(ref);
+        }
+        free(vcost);
         free(src);
         mfmm_mesh_destroy(mesh);
         mfmm_gen_free(&g[m]);
