@@ -151,6 +151,11 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
         if (stop_at_targets && (lx & MFMM_TARGET) && --s->targets_left == 0)
             break;
         mfmm_i32 end = m->update_offset[x + 1];
+#ifndef __OPENCL_VERSION__
+        /* the march waits on these records (cache misses): ask for all first */
+        for (mfmm_i32 j = m->update_offset[x]; j < end; j++)
+            __builtin_prefetch(m->corners + m->update_corner[2 * j]);
+#endif
         for (mfmm_i32 j = m->update_offset[x]; j < end; j++) {
             mfmm_i32 c = m->update_corner[2 * j + 1];
             mfmm_u8 st = s->label[c] & MFMM_STATE_MASK;

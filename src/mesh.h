@@ -15,8 +15,8 @@ struct mfmm_mesh {
     int32_t *vertex_face_corner;
     int32_t *component;        /* (nv,) component id, -1 for unreferenced vertices */
     uint8_t *degenerate;       /* (nf,) 1 for zero-area faces */
-    mfmm_corner *corners;      /* (3 nf,) in vertex_face_corner order: corners[j] is
-                                  corner vertex_face_corner[j] (grouped by vertex) */
+    mfmm_corner *corners;      /* (3 nf,) records for the march, grouped by vertex,
+                                  groups in breadth-first order (see mesh.c) */
     int32_t *update_offset;    /* (nv+1,) CSR: corners to recompute when a vertex settles */
     int32_t *update_corner;    /* pairs (index into corners, its vertex C) */
     mfmm_mesh_info info;
