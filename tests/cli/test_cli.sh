@@ -136,6 +136,21 @@ fi
 awk '{ print 2 }' "$T/v.txt" >"$T/cost.txt"
 expect 0 "distance with --cost" "$BIN" distance "$T/g.obj" --source "$C" --cost "$T/cost.txt" -o "$T/d2.txt" &&
     axis_check "$T/d2.txt" 2 "cost 2 along the axes"
+# The same cost as .npy, float64 and float32 (header padded to 64 bytes).
+# npy_twos DESCR BYTES_OF_2.0 FILE: NV values of 2.0.
+npy_twos() {
+    dict="{'descr': '$1', 'fortran_order': False, 'shape': ($NV,), }"
+    { printf '\223NUMPY\001\000\166\000'; printf "%-117s\n" "$dict"
+      i=0; while [ $i -lt "$NV" ]; do printf "$2"; i=$((i + 1)); done; } >"$3"
+}
+npy_twos '<f8' '\0\0\0\0\0\0\0\100' "$T/cost8.npy"
+npy_twos '<f4' '\0\0\0\100' "$T/cost4.npy"
+for c in cost8 cost4; do
+    expect 0 "distance with --cost $c.npy" "$BIN" distance "$T/g.obj" --source "$C" --cost "$T/$c.npy" -o "$T/d_$c.txt" &&
+        axis_check "$T/d_$c.txt" 2 "$c.npy cost 2 along the axes"
+done
+head -c 100 "$T/cost8.npy" >"$T/cut.npy"
+expect 1 "truncated cost .npy" "$BIN" distance "$T/g.obj" --source "$C" --cost "$T/cut.npy" -o "$T/x.txt"
 # Per-face cost: nf values.
 awk 'NR <= 2 * '"$N"' * '"$N"' { print 2 }' "$T/v.txt" "$T/v.txt" >"$T/fcost.txt"
 expect 0 "distance with --cost-per-face" "$BIN" distance "$T/g.obj" --source "$C" --cost "$T/fcost.txt" --cost-per-face -o "$T/d3.txt" &&
