@@ -18,7 +18,7 @@ typedef struct mfmm_rows_job {
 } mfmm_rows_job;
 
 /* Default budget when memory_limit is 0. */
-#define MFMM_DEFAULT_BUDGET ((size_t)32 << 20)
+#define MFMM_DEFAULT_BUDGET ((size_t)16 << 20)
 
 /* Hands rows [first, first + n) to the caller: copies them into opt->out
  * (unless rows already point there) and calls opt->on_rows. Returns non-zero
