@@ -33,8 +33,16 @@ extern const char mfmm_kernel_fmm_rows[];
 extern const size_t mfmm_kernel_fmm_rows_len;
 
 /* Program build options: no -cl-mad-enable, no -cl-fast-relaxed-math (the
- * kernel's FP_CONTRACT OFF keeps a*b+c unfused, like -ffp-contract=off). */
-static const char build_options[] = "-cl-std=CL1.2";
+ * kernel's FP_CONTRACT OFF keeps a*b+c unfused, like -ffp-contract=off).
+ * Tunables of march.h get the C side's values, so both march alike. */
+#define MFMM_STR2(x) #x
+#define MFMM_STR(x) MFMM_STR2(x)
+#ifdef MFMM_HEAP_ARITY
+#define MFMM_CL_ARITY " -DMFMM_HEAP_ARITY=" MFMM_STR(MFMM_HEAP_ARITY)
+#else
+#define MFMM_CL_ARITY ""
+#endif
+static const char build_options[] = "-cl-std=CL1.2" MFMM_CL_ARITY;
 
 static const char *cl_error_name(cl_int e)
 {
