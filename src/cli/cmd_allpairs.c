@@ -388,7 +388,8 @@ int cmd_allpairs(int argc, char **argv)
         cli_npy_abort(&s.w);
         goto restore;
     }
-    progress(&s, 1);
+    if (s.tty)
+        progress(&s, 1); /* completes the \r line; the summary says the rest */
     if (cli_npy_close(&s.w))
         goto restore;
     fprintf(stderr, "meshfmm allpairs: %lld x %d %s matrix, backend %s, %.2f s, wrote %s\n",
