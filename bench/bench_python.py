@@ -196,7 +196,10 @@ def bench_overhead(n=31, reps=4000):
         with tempfile.TemporaryDirectory() as tmp:
             src = Path(tmp) / "overhead.c"
             src.write_text(C_PROGRAM)
-            libdir = str(Path(meshfmm.library_path).parent)
+            # the package holds libmeshfmm.so alone; the link records its soname
+            for name in ("libmeshfmm.so.0", "libmeshfmm.so"):
+                (Path(tmp) / name).symlink_to(meshfmm.library_path)
+            libdir = tmp
             exe = Path(tmp) / "overhead"
             subprocess.run([cc, "-O2", "-std=c99", "-I", str(REPO / "include"), str(src),
                             meshfmm.library_path, "-o", str(exe), f"-Wl,-rpath,{libdir}"],
