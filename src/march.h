@@ -159,18 +159,16 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
         if (stop_at_targets && (lx & MFMM_TARGET) && --s->targets_left == 0)
             break;
         mfmm_i32 end = m->update_offset[x + 1];
-#ifndef __OPENCL_VERSION__
         /* The march waits on corner records (cache misses). Ask for this
          * vertex's, and for those of the likely next one, the new heap top,
          * one iteration ahead. */
         for (mfmm_i32 j = m->update_offset[x]; j < end; j++)
-            __builtin_prefetch(m->corners + m->update_corner[2 * j]);
+            MFMM_PREFETCH(m->corners + m->update_corner[2 * j]);
         if (s->heap_size > 0) {
             mfmm_i32 y = s->heap_vertex[0];
             for (mfmm_i32 j = m->update_offset[y]; j < m->update_offset[y + 1]; j++)
-                __builtin_prefetch(m->corners + m->update_corner[2 * j]);
+                MFMM_PREFETCH(m->corners + m->update_corner[2 * j]);
         }
-#endif
         for (mfmm_i32 j = m->update_offset[x]; j < end; j++) {
             mfmm_i32 c = m->update_corner[2 * j + 1];
             mfmm_u8 st = s->label[c] & MFMM_STATE_MASK;
@@ -180,11 +178,9 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
             double t = mfmm_corner_update(cr, s->T, s->label, mfmm_march_cost(s, cr, c),
                                           s->unfolding);
             if (t < s->T[c]) {
-#ifndef __OPENCL_VERSION__
                 /* c joins the front: its own update list is read when it settles */
                 if (st == MFMM_FAR)
-                    __builtin_prefetch(m->update_corner + 2 * m->update_offset[c]);
-#endif
+                    MFMM_PREFETCH(m->update_corner + 2 * m->update_offset[c]);
                 s->T[c] = t;
                 mfmm_heap_push_or_decrease(s, c, t, st == MFMM_CLOSE);
                 s->label[c] = (mfmm_u8)((s->label[c] & MFMM_TARGET) | MFMM_CLOSE);
