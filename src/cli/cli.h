@@ -42,6 +42,15 @@ int cli_has_ext(const char *path, const char *ext);
  * NULL on failure. */
 mfmm_mesh *cli_load_mesh(const char *path, const mfmm_mesh_options *options);
 
+/* Text output written as "PATH.partial" and renamed to PATH once complete,
+ * so a failed write leaves nothing under PATH. cli_partial_open returns the
+ * stream and the temporary name (*tmp, malloc'ed), or NULL with the error
+ * printed. cli_partial_close flushes, closes and renames (`bad`: a write
+ * already failed), removes the temporary file on failure and frees tmp;
+ * 0 or -1 (printed). */
+FILE *cli_partial_open(const char *path, char **tmp);
+int cli_partial_close(FILE *f, char *tmp, const char *path, int bad);
+
 /* ---- .npy files (format 1.0) ---- */
 
 /* Streaming writer: data goes to "PATH.partial", renamed to PATH by

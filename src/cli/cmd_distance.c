@@ -1,5 +1,4 @@
 /* meshfmm distance MESH --source I [...] -o OUT (.npy or .txt) */
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,20 +26,10 @@ static void help(FILE *out)
 
 static int write_txt(const char *path, const double *d, int32_t n)
 {
-    size_t len = strlen(path);
-    char *tmp = malloc(len + 9);
-    if (!tmp) {
-        cli_error("out of memory");
+    char *tmp;
+    FILE *f = cli_partial_open(path, &tmp);
+    if (!f)
         return -1;
-    }
-    memcpy(tmp, path, len);
-    memcpy(tmp + len, ".partial", 9);
-    FILE *f = fopen(tmp, "w");
-    if (!f) {
-        cli_error("cannot create '%s': %s", tmp, strerror(errno));
-        free(tmp);
-        return -1;
-    }
     int bad = 0;
     for (int32_t i = 0; i < n && !bad; i++) {
         if (isinf(d[i]))
@@ -48,16 +37,7 @@ static int write_txt(const char *path, const double *d, int32_t n)
         else
             bad = fprintf(f, "%.17g\n", d[i]) < 0;
     }
-    bad |= fflush(f) != 0 || ferror(f);
-    bad |= fclose(f) != 0;
-    if (bad || rename(tmp, path) != 0) {
-        cli_error("cannot write '%s': %s", path, strerror(errno));
-        remove(tmp);
-        free(tmp);
-        return -1;
-    }
-    free(tmp);
-    return 0;
+    return cli_partial_close(f, tmp, path, bad);
 }
 
 int cmd_distance(int argc, char **argv)

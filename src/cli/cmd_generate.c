@@ -1,5 +1,4 @@
 /* meshfmm generate sine|sphere|torus|grid|lattice N -o OUT.obj */
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,20 +23,10 @@ static void help(FILE *out)
 
 static int write_obj(const char *path, const mfmm_gen_mesh *m, const char *comment)
 {
-    size_t len = strlen(path);
-    char *tmp = malloc(len + 9);
-    if (!tmp) {
-        cli_error("out of memory");
+    char *tmp;
+    FILE *f = cli_partial_open(path, &tmp);
+    if (!f)
         return -1;
-    }
-    memcpy(tmp, path, len);
-    memcpy(tmp + len, ".partial", 9);
-    FILE *f = fopen(tmp, "w");
-    if (!f) {
-        cli_error("cannot create '%s': %s", tmp, strerror(errno));
-        free(tmp);
-        return -1;
-    }
     int bad = fprintf(f, "# %s\n", comment) < 0;
     for (int32_t i = 0; i < m->nv && !bad; i++)
         bad = fprintf(f, "v %.17g %.17g %.17g\n", m->V[3 * i], m->V[3 * i + 1],
@@ -45,16 +34,7 @@ static int write_obj(const char *path, const mfmm_gen_mesh *m, const char *comme
     for (int32_t i = 0; i < m->nf && !bad; i++)
         bad = fprintf(f, "f %ld %ld %ld\n", (long)m->F[3 * i] + 1, (long)m->F[3 * i + 1] + 1,
                       (long)m->F[3 * i + 2] + 1) < 0;
-    bad |= fflush(f) != 0 || ferror(f);
-    bad |= fclose(f) != 0;
-    if (bad || rename(tmp, path) != 0) {
-        cli_error("cannot write '%s': %s", path, strerror(errno));
-        remove(tmp);
-        free(tmp);
-        return -1;
-    }
-    free(tmp);
-    return 0;
+    return cli_partial_close(f, tmp, path, bad);
 }
 
 int cmd_generate(int argc, char **argv)

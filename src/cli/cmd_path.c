@@ -1,6 +1,5 @@
 /* meshfmm path MESH --source I [...] --target J -o OUT (.csv or .obj):
  * the minimal geodesic from a target back to the sources (paper section 5). */
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -30,20 +29,10 @@ static void help(FILE *out)
 
 static int write_path(const char *path, const mfmm_surface_point *p, int32_t n, int obj)
 {
-    size_t len = strlen(path);
-    char *tmp = malloc(len + 9);
-    if (!tmp) {
-        cli_error("out of memory");
+    char *tmp;
+    FILE *f = cli_partial_open(path, &tmp);
+    if (!f)
         return -1;
-    }
-    memcpy(tmp, path, len);
-    memcpy(tmp + len, ".partial", 9);
-    FILE *f = fopen(tmp, "w");
-    if (!f) {
-        cli_error("cannot create '%s': %s", tmp, strerror(errno));
-        free(tmp);
-        return -1;
-    }
     int bad = 0;
     if (obj) {
         bad = fprintf(f, "# meshfmm path: %d points, target first\n", (int)n) < 0;
@@ -62,16 +51,7 @@ static int write_path(const char *path, const mfmm_surface_point *p, int32_t n, 
                           p[i].bary[0], p[i].bary[1], p[i].bary[2], p[i].xyz[0], p[i].xyz[1],
                           p[i].xyz[2]) < 0;
     }
-    bad |= fflush(f) != 0 || ferror(f);
-    bad |= fclose(f) != 0;
-    if (bad || rename(tmp, path) != 0) {
-        cli_error("cannot write '%s': %s", path, strerror(errno));
-        remove(tmp);
-        free(tmp);
-        return -1;
-    }
-    free(tmp);
-    return 0;
+    return cli_partial_close(f, tmp, path, bad);
 }
 
 static int parse_face_point(int argc, char **argv, int i, mfmm_source *s)

@@ -121,6 +121,39 @@ int cli_has_ext(const char *path, const char *ext)
     return 1;
 }
 
+FILE *cli_partial_open(const char *path, char **tmp)
+{
+    size_t len = strlen(path);
+    *tmp = malloc(len + 9);
+    if (!*tmp) {
+        cli_error("out of memory");
+        return NULL;
+    }
+    memcpy(*tmp, path, len);
+    memcpy(*tmp + len, ".partial", 9);
+    FILE *f = fopen(*tmp, "w");
+    if (!f) {
+        cli_error("cannot create '%s': %s", *tmp, strerror(errno));
+        free(*tmp);
+        *tmp = NULL;
+    }
+    return f;
+}
+
+int cli_partial_close(FILE *f, char *tmp, const char *path, int bad)
+{
+    bad |= fflush(f) != 0 || ferror(f);
+    bad |= fclose(f) != 0;
+    if (bad || rename(tmp, path) != 0) {
+        cli_error("cannot write '%s': %s", path, strerror(errno));
+        remove(tmp);
+        free(tmp);
+        return -1;
+    }
+    free(tmp);
+    return 0;
+}
+
 mfmm_mesh *cli_load_mesh(const char *path, const mfmm_mesh_options *options)
 {
     double *V = NULL;
