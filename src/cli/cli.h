@@ -42,6 +42,52 @@ int cli_has_ext(const char *path, const char *ext);
  * NULL on failure. */
 mfmm_mesh *cli_load_mesh(const char *path, const mfmm_mesh_options *options);
 
+/* ---- options shared by distance and path (options.c) ---- */
+
+/* One point argument at argv[i] (the option itself): --source-like "I" or
+ * --face-source-like "F W0 W1 W2". 1 with *s filled, 0 when malformed. */
+int cli_parse_vertex_point(int argc, char **argv, int i, mfmm_source *s);
+int cli_parse_face_point(int argc, char **argv, int i, mfmm_source *s);
+
+/* The positional mesh, --source I, --face-source F W0 W1 W2, --cost FILE,
+ * --cost-per-face and -o/--output OUT; `sub` names the subcommand in
+ * messages. */
+typedef struct cli_sources_and_cost {
+    const char *sub;
+    const char *mesh_path;
+    const char *out_path;
+    const char *cost_path;
+    int cost_per_face;
+    mfmm_source *src; /* room for one source per argument */
+    int32_t n_src;
+    double *cost;     /* loaded by cli_sources_and_cost_load */
+} cli_sources_and_cost;
+
+/* 0, or -1 with "out of memory" printed. argc: the subcommand's. */
+int cli_sources_and_cost_init(cli_sources_and_cost *o, const char *sub, int argc);
+void cli_sources_and_cost_free(cli_sources_and_cost *o);
+/* Takes argv[*i] (a shared option, with its values, or the mesh) and
+ * advances *i past its values; anything else starting with '-' is an unknown
+ * option. CLI_OK, or CLI_USAGE with the usage error printed. */
+int cli_sources_and_cost_arg(cli_sources_and_cost *o, int argc, char **argv, int *i);
+/* After the argument loop: a mesh and at least one source. CLI_OK or
+ * CLI_USAGE (printed). */
+int cli_sources_and_cost_check_inputs(const cli_sources_and_cost *o);
+/* An output ending in .ext0 or .ext1 (*which: 0 or 1) and no --cost-per-face
+ * without --cost. CLI_OK or CLI_USAGE (printed). */
+int cli_sources_and_cost_check_output(const cli_sources_and_cost *o, const char *ext0,
+                                      const char *ext1, int *which);
+/* Loads --cost FILE (if given) into o->cost, checks its length against the
+ * mesh and sets opt->cost and opt->cost_location. hint_per_face: suggest
+ * --cost-per-face when a per-vertex cost has one value per face. 0, or -1
+ * with the error printed. */
+int cli_sources_and_cost_load(cli_sources_and_cost *o, const mfmm_mesh *mesh,
+                              int hint_per_face, mfmm_solve_options *opt);
+/* Distances from o's sources to every vertex (malloc'ed), or NULL with the
+ * error printed. */
+double *cli_solve_distances(const mfmm_mesh *mesh, const cli_sources_and_cost *o,
+                            const mfmm_solve_options *opt);
+
 /* Text output written as "PATH.partial" and renamed to PATH once complete,
  * so a failed write leaves nothing under PATH. cli_partial_open returns the
  * stream and the temporary name (*tmp, malloc'ed), or NULL with the error

@@ -42,47 +42,20 @@ static int write_txt(const char *path, const double *d, int32_t n)
 
 int cmd_distance(int argc, char **argv)
 {
-    const char *path = NULL, *out_path = NULL, *cost_path = NULL;
-    int cost_per_face = 0, rc = CLI_FAIL;
+    int rc = CLI_FAIL;
     mfmm_solve_options opt;
     mfmm_solve_options_init(&opt);
-    mfmm_source *src = malloc((size_t)argc * sizeof *src); /* at most one per argument */
-    int32_t n_src = 0;
-    double *cost = NULL, *dist = NULL;
+    cli_sources_and_cost o;
+    double *dist = NULL;
     mfmm_mesh *mesh = NULL;
-    mfmm_solver *solver = NULL;
-    if (!src) {
-        cli_error("out of memory");
+    if (cli_sources_and_cost_init(&o, "distance", argc))
         return CLI_FAIL;
-    }
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             help(stdout);
             rc = CLI_OK;
             goto done;
-        } else if (strcmp(a, "--source") == 0) {
-            int32_t v;
-            if (i + 1 >= argc || !cli_parse_int32(argv[i + 1], &v)) {
-                rc = cli_usage_error("distance", "--source needs a vertex id");
-                goto done;
-            }
-            mfmm_source s = {v, -1, {0, 0, 0}, 0.0};
-            src[n_src++] = s;
-            i++;
-        } else if (strcmp(a, "--face-source") == 0) {
-            int32_t fid;
-            double w[3];
-            if (i + 4 >= argc || !cli_parse_int32(argv[i + 1], &fid) ||
-                !cli_parse_double(argv[i + 2], &w[0]) || !cli_parse_double(argv[i + 3], &w[1]) ||
-                !cli_parse_double(argv[i + 4], &w[2])) {
-                rc = cli_usage_error("distance",
-                                     "--face-source needs a face id and three barycentric weights");
-                goto done;
-            }
-            mfmm_source s = {-1, fid, {w[0], w[1], w[2]}, 0.0};
-            src[n_src++] = s;
-            i += 4;
         } else if (strcmp(a, "--max-distance") == 0) {
             if (i + 1 >= argc || !cli_parse_double(argv[i + 1], &opt.max_distance) ||
                 !(opt.max_distance >= 0)) {
@@ -92,91 +65,26 @@ int cmd_distance(int argc, char **argv)
             i++;
         } else if (strcmp(a, "--no-unfolding") == 0) {
             opt.unfolding = 0;
-        } else if (strcmp(a, "--cost") == 0) {
-            if (i + 1 >= argc) {
-                rc = cli_usage_error("distance", "--cost needs a file");
-                goto done;
-            }
-            cost_path = argv[++i];
-        } else if (strcmp(a, "--cost-per-face") == 0) {
-            cost_per_face = 1;
-        } else if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
-            if (i + 1 >= argc) {
-                rc = cli_usage_error("distance", "-o needs a file name");
-                goto done;
-            }
-            out_path = argv[++i];
-        } else if (a[0] == '-' && a[1] != '\0') {
-            rc = cli_usage_error("distance", "unknown option '%s'", a);
-            goto done;
-        } else if (!path) {
-            path = a;
-        } else {
-            rc = cli_usage_error("distance", "one mesh at a time ('%s' is extra)", a);
+        } else if ((rc = cli_sources_and_cost_arg(&o, argc, argv, &i)) != CLI_OK) {
             goto done;
         }
     }
-    if (!path) {
-        rc = cli_usage_error("distance", "no mesh file given");
+    int is_txt;
+    if ((rc = cli_sources_and_cost_check_inputs(&o)) != CLI_OK ||
+        (rc = cli_sources_and_cost_check_output(&o, "npy", "txt", &is_txt)) != CLI_OK)
         goto done;
-    }
-    if (n_src == 0) {
-        rc = cli_usage_error("distance", "no source given (--source or --face-source)");
-        goto done;
-    }
-    if (!out_path) {
-        rc = cli_usage_error("distance", "no output given (-o OUT.npy or OUT.txt)");
-        goto done;
-    }
-    int npy = cli_has_ext(out_path, "npy");
-    if (!npy && !cli_has_ext(out_path, "txt")) {
-        rc = cli_usage_error("distance", "the output must end in .npy or .txt");
-        goto done;
-    }
-    if (cost_per_face && !cost_path) {
-        rc = cli_usage_error("distance", "--cost-per-face needs --cost");
-        goto done;
-    }
+    rc = CLI_FAIL;
 
-    mesh = cli_load_mesh(path, NULL);
-    if (!mesh)
+    mesh = cli_load_mesh(o.mesh_path, NULL);
+    if (!mesh || cli_sources_and_cost_load(&o, mesh, 1, &opt))
         goto done;
-    int32_t nv = mfmm_mesh_vertex_count(mesh), nf = mfmm_mesh_face_count(mesh);
-    if (cost_path) {
-        int64_t nc;
-        int r = cli_has_ext(cost_path, "npy") ? cli_npy_read_vector(cost_path, &cost, &nc)
-                                              : cli_txt_read_vector(cost_path, &cost, &nc);
-        if (r)
-            goto done;
-        int64_t want = cost_per_face ? nf : nv;
-        if (nc != want) {
-            cli_error("%s: %lld cost values, the mesh has %lld %s%s", cost_path, (long long)nc,
-                      (long long)want, cost_per_face ? "faces" : "vertices",
-                      !cost_per_face && nc == nf ? " (use --cost-per-face for face costs)" : "");
-            goto done;
-        }
-        opt.cost = cost;
-        opt.cost_location = cost_per_face ? MFMM_COST_PER_FACE : MFMM_COST_PER_VERTEX;
-    }
-    dist = malloc((size_t)nv * sizeof *dist);
-    if (!dist) {
-        cli_error("out of memory");
+    int32_t nv = mfmm_mesh_vertex_count(mesh);
+    dist = cli_solve_distances(mesh, &o, &opt);
+    if (!dist)
         goto done;
-    }
-    mfmm_status st = mfmm_solver_create(mesh, &solver);
-    if (st != MFMM_OK) {
-        cli_error("%s", mfmm_status_string(st));
-        goto done;
-    }
-    mfmm_error err;
-    st = mfmm_solve(solver, src, n_src, &opt, dist, &err);
-    if (st != MFMM_OK) {
-        cli_error("%s", err.message);
-        goto done;
-    }
-    if (npy) {
+    if (!is_txt) {
         cli_npy_writer w;
-        if (cli_npy_open(&w, out_path, "<f8", nv, -1))
+        if (cli_npy_open(&w, o.out_path, "<f8", nv, -1))
             goto done;
         if (cli_npy_append(&w, dist, nv)) {
             cli_npy_abort(&w);
@@ -184,15 +92,13 @@ int cmd_distance(int argc, char **argv)
         }
         if (cli_npy_close(&w))
             goto done;
-    } else if (write_txt(out_path, dist, nv)) {
+    } else if (write_txt(o.out_path, dist, nv)) {
         goto done;
     }
     rc = CLI_OK;
 done:
-    mfmm_solver_destroy(solver);
     mfmm_mesh_destroy(mesh);
     free(dist);
-    free(cost);
-    free(src);
+    cli_sources_and_cost_free(&o);
     return rc;
 }

@@ -1,0 +1,159 @@
+/* Options shared by `distance` and `path`: the mesh, the sources, the cost
+ * file and the output; their checks and the cost loader. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+int cli_parse_vertex_point(int argc, char **argv, int i, mfmm_source *s)
+{
+    int32_t v;
+    if (i + 1 >= argc || !cli_parse_int32(argv[i + 1], &v))
+        return 0;
+    mfmm_source x = {v, -1, {0, 0, 0}, 0.0};
+    *s = x;
+    return 1;
+}
+
+int cli_parse_face_point(int argc, char **argv, int i, mfmm_source *s)
+{
+    int32_t fid;
+    double w[3];
+    if (i + 4 >= argc || !cli_parse_int32(argv[i + 1], &fid) ||
+        !cli_parse_double(argv[i + 2], &w[0]) || !cli_parse_double(argv[i + 3], &w[1]) ||
+        !cli_parse_double(argv[i + 4], &w[2]))
+        return 0;
+    mfmm_source x = {-1, fid, {w[0], w[1], w[2]}, 0.0};
+    *s = x;
+    return 1;
+}
+
+int cli_sources_and_cost_init(cli_sources_and_cost *o, const char *sub, int argc)
+{
+    memset(o, 0, sizeof *o);
+    o->sub = sub;
+    o->src = malloc((size_t)argc * sizeof *o->src); /* at most one per argument */
+    if (!o->src) {
+        cli_error("out of memory");
+        return -1;
+    }
+    return 0;
+}
+
+void cli_sources_and_cost_free(cli_sources_and_cost *o)
+{
+    free(o->src);
+    free(o->cost);
+    o->src = NULL;
+    o->cost = NULL;
+}
+
+int cli_sources_and_cost_arg(cli_sources_and_cost *o, int argc, char **argv, int *i)
+{
+    const char *a = argv[*i];
+    if (strcmp(a, "--source") == 0) {
+        if (!cli_parse_vertex_point(argc, argv, *i, &o->src[o->n_src]))
+            return cli_usage_error(o->sub, "%s needs a vertex id", a);
+        o->n_src++;
+        *i += 1;
+    } else if (strcmp(a, "--face-source") == 0) {
+        if (!cli_parse_face_point(argc, argv, *i, &o->src[o->n_src]))
+            return cli_usage_error(o->sub, "%s needs a face id and three barycentric weights", a);
+        o->n_src++;
+        *i += 4;
+    } else if (strcmp(a, "--cost") == 0) {
+        if (*i + 1 >= argc)
+            return cli_usage_error(o->sub, "--cost needs a file");
+        o->cost_path = argv[++*i];
+    } else if (strcmp(a, "--cost-per-face") == 0) {
+        o->cost_per_face = 1;
+    } else if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
+        if (*i + 1 >= argc)
+            return cli_usage_error(o->sub, "-o needs a file name");
+        o->out_path = argv[++*i];
+    } else if (a[0] == '-' && a[1] != '\0') {
+        return cli_usage_error(o->sub, "unknown option '%s'", a);
+    } else if (!o->mesh_path) {
+        o->mesh_path = a;
+    } else {
+        return cli_usage_error(o->sub, "one mesh at a time ('%s' is extra)", a);
+    }
+    return CLI_OK;
+}
+
+int cli_sources_and_cost_check_inputs(const cli_sources_and_cost *o)
+{
+    if (!o->mesh_path)
+        return cli_usage_error(o->sub, "no mesh file given");
+    if (o->n_src == 0)
+        return cli_usage_error(o->sub, "no source given (--source or --face-source)");
+    return CLI_OK;
+}
+
+int cli_sources_and_cost_check_output(const cli_sources_and_cost *o, const char *ext0,
+                                      const char *ext1, int *which)
+{
+    if (!o->out_path)
+        return cli_usage_error(o->sub, "no output given (-o OUT.%s or OUT.%s)", ext0, ext1);
+    if (cli_has_ext(o->out_path, ext0))
+        *which = 0;
+    else if (cli_has_ext(o->out_path, ext1))
+        *which = 1;
+    else
+        return cli_usage_error(o->sub, "the output must end in .%s or .%s", ext0, ext1);
+    if (o->cost_per_face && !o->cost_path)
+        return cli_usage_error(o->sub, "--cost-per-face needs --cost");
+    return CLI_OK;
+}
+
+int cli_sources_and_cost_load(cli_sources_and_cost *o, const mfmm_mesh *mesh,
+                              int hint_per_face, mfmm_solve_options *opt)
+{
+    if (!o->cost_path)
+        return 0;
+    int32_t nv = mfmm_mesh_vertex_count(mesh), nf = mfmm_mesh_face_count(mesh);
+    int64_t nc;
+    int r = cli_has_ext(o->cost_path, "npy") ? cli_npy_read_vector(o->cost_path, &o->cost, &nc)
+                                             : cli_txt_read_vector(o->cost_path, &o->cost, &nc);
+    if (r)
+        return -1;
+    int64_t want = o->cost_per_face ? nf : nv;
+    if (nc != want) {
+        cli_error("%s: %lld cost values, the mesh has %lld %s%s", o->cost_path, (long long)nc,
+                  (long long)want, o->cost_per_face ? "faces" : "vertices",
+                  hint_per_face && !o->cost_per_face && nc == nf
+                      ? " (use --cost-per-face for face costs)"
+                      : "");
+        return -1;
+    }
+    opt->cost = o->cost;
+    opt->cost_location = o->cost_per_face ? MFMM_COST_PER_FACE : MFMM_COST_PER_VERTEX;
+    return 0;
+}
+
+double *cli_solve_distances(const mfmm_mesh *mesh, const cli_sources_and_cost *o,
+                            const mfmm_solve_options *opt)
+{
+    int32_t nv = mfmm_mesh_vertex_count(mesh);
+    double *dist = malloc((size_t)nv * sizeof *dist);
+    if (!dist) {
+        cli_error("out of memory");
+        return NULL;
+    }
+    mfmm_solver *solver = NULL;
+    mfmm_status st = mfmm_solver_create(mesh, &solver);
+    if (st != MFMM_OK) {
+        cli_error("%s", mfmm_status_string(st));
+        free(dist);
+        return NULL;
+    }
+    mfmm_error err;
+    st = mfmm_solve(solver, o->src, o->n_src, opt, dist, &err);
+    mfmm_solver_destroy(solver);
+    if (st != MFMM_OK) {
+        cli_error("%s", err.message);
+        free(dist);
+        return NULL;
+    }
+    return dist;
+}
