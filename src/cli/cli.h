@@ -129,6 +129,13 @@ void cli_npy_abort(cli_npy_writer *w);
  * 1 too) as doubles (malloc'ed). 0 on success, -1 with the error printed. */
 int cli_npy_read_vector(const char *path, double **values, int64_t *n);
 
+/* Reads a 1-D integer .npy array (i1..i8, u1..u8, either byte order; a 2-D
+ * one with a dimension of 1 too) as int32 ids (malloc'ed). 0 on success, 1
+ * when the file holds another dtype (nothing printed: the caller may try
+ * cli_npy_read_vector), -1 with the error printed (a value outside int32:
+ * "source I is out of range"). */
+int cli_npy_read_ints(const char *path, int32_t **ids, int64_t *n);
+
 /* Reads whitespace-separated numbers from a text file ('#' comments). */
 int cli_txt_read_vector(const char *path, double **values, int64_t *n);
 

@@ -1,6 +1,5 @@
 /* meshfmm allpairs MESH -o OUT.npy: the distance matrix, streamed in blocks
  * of rows into a .npy file (OUT.npy.partial, renamed when complete). */
-#include <errno.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -54,108 +53,6 @@ static double now(void)
 
 /* ---- --sources FILE ---- */
 
-/* A 1-D integer .npy array (i1..i8, u1..u8, either byte order). 1 when the
- * file holds another dtype (the caller then tries float), 0 on success, -1
- * on error (printed). */
-static int read_npy_ints(const char *path, int32_t **ids, int64_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        cli_error("cannot open '%s': %s", path, strerror(errno));
-        return -1;
-    }
-    unsigned char pre[12];
-    char *dict = NULL;
-    unsigned char *raw = NULL;
-    int rc = -1;
-    size_t hlen = 0;
-    if (fread(pre, 1, 10, f) != 10 || memcmp(pre, "\x93NUMPY", 6) != 0)
-        goto bad;
-    if (pre[6] == 1) {
-        hlen = (size_t)pre[8] | (size_t)pre[9] << 8;
-    } else {
-        if (fread(pre + 10, 1, 2, f) != 2)
-            goto bad;
-        hlen = (size_t)pre[8] | (size_t)pre[9] << 8 | (size_t)pre[10] << 16 |
-               (size_t)pre[11] << 24;
-        if (hlen > 1 << 20)
-            goto bad;
-    }
-    dict = malloc(hlen + 1);
-    if (!dict || fread(dict, 1, hlen, f) != hlen)
-        goto bad;
-    dict[hlen] = '\0';
-    const char *d = strstr(dict, "'descr':");
-    const char *sh = strstr(dict, "'shape':");
-    if (!d || !sh)
-        goto bad;
-    d += 8;
-    while (*d == ' ')
-        d++;
-    /* e.g. '<i4', '|u1' */
-    if (d[0] != '\'' || !strchr("<>|=", d[1]) || (d[2] != 'i' && d[2] != 'u') ||
-        !strchr("1248", d[3]) || d[4] != '\'') {
-        rc = 1;
-        goto out;
-    }
-    int big = d[1] == '>', is_signed = d[2] == 'i';
-    size_t size = (size_t)(d[3] - '0');
-    sh += 8;
-    while (*sh == ' ')
-        sh++;
-    long long count = -1, other = 1;
-    if (sscanf(sh, "(%lld,)", &count) != 1 && sscanf(sh, "(%lld, %lld)", &count, &other) != 2)
-        goto bad;
-    if (count < 0 || other < 0 || (other != 1 && count != 1))
-        goto bad;
-    count *= other;
-    if (count > INT32_MAX) {
-        cli_error("%s: too many sources", path);
-        goto out;
-    }
-    raw = malloc(count ? (size_t)count * size : 1);
-    *ids = malloc(count ? (size_t)count * sizeof **ids : 1);
-    if (!raw || !*ids) {
-        cli_error("out of memory reading '%s'", path);
-        goto out;
-    }
-    if (fread(raw, size, (size_t)count, f) != (size_t)count)
-        goto bad;
-    for (long long i = 0; i < count; i++) {
-        const unsigned char *p = raw + (size_t)i * size;
-        unsigned long long u = 0;
-        for (size_t k = 0; k < size; k++) {
-            size_t byte = big ? k : size - 1 - k;
-            u = (u << 8) | p[byte];
-        }
-        long long v;
-        if (is_signed && size < 8 && (u >> (8 * size - 1)) & 1)
-            v = (long long)(u | (~0ull << (8 * size)));
-        else
-            v = (long long)u;
-        if ((!is_signed && size == 8 && u > (unsigned long long)INT32_MAX) || v < INT32_MIN ||
-            v > INT32_MAX) {
-            cli_error("%s: source %lld is out of range", path, i);
-            goto out;
-        }
-        (*ids)[i] = (int32_t)v;
-    }
-    *n = count;
-    rc = 0;
-    goto out;
-bad:
-    cli_error("%s: not a readable .npy file", path);
-out:
-    if (rc != 0) {
-        free(*ids);
-        *ids = NULL;
-    }
-    free(raw);
-    free(dict);
-    fclose(f);
-    return rc;
-}
-
 static int read_sources(const char *path, int32_t **ids, int64_t *n)
 {
     *ids = NULL;
@@ -163,7 +60,7 @@ static int read_sources(const char *path, int32_t **ids, int64_t *n)
     double *v = NULL;
     int64_t count = 0;
     if (cli_has_ext(path, "npy")) {
-        int r = read_npy_ints(path, ids, n);
+        int r = cli_npy_read_ints(path, ids, n);
         if (r <= 0)
             return r;
         if (cli_npy_read_vector(path, &v, &count))

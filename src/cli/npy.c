@@ -1,5 +1,5 @@
-/* .npy (format 1.0) streaming writer and a small reader of 1-D float
- * vectors; plain text vectors. */
+/* .npy (format 1.0) streaming writer and small readers of 1-D float and
+ * integer vectors; plain text vectors. */
 #include <errno.h>
 #include <inttypes.h>
 #include <stdio.h>
@@ -190,6 +190,38 @@ static const char *dict_value(const char *dict, const char *key)
     return p;
 }
 
+/* Reads the magic string, version and header dict (format 1.0 to 3.0) of
+ * a .npy file; *dict is malloc'ed and NUL-terminated, and f is left at the
+ * data. 0, -1 when it is not a readable .npy file, -2 when out of memory
+ * (nothing printed). */
+static int read_header(FILE *f, char **dict)
+{
+    unsigned char pre[12];
+    *dict = NULL;
+    if (fread(pre, 1, 10, f) != 10 || memcmp(pre, "\x93NUMPY", 6) != 0)
+        return -1;
+    size_t hlen;
+    if (pre[6] == 1) {
+        hlen = (size_t)pre[8] | (size_t)pre[9] << 8;
+    } else if (pre[6] == 2 || pre[6] == 3) {
+        if (fread(pre + 10, 1, 2, f) != 2)
+            return -1;
+        hlen = (size_t)pre[8] | (size_t)pre[9] << 8 | (size_t)pre[10] << 16 |
+               (size_t)pre[11] << 24;
+        if (hlen > 1 << 20)
+            return -1;
+    } else {
+        return -1;
+    }
+    *dict = malloc(hlen + 1);
+    if (!*dict)
+        return -2;
+    if (fread(*dict, 1, hlen, f) != hlen)
+        return -1;
+    (*dict)[hlen] = '\0';
+    return 0;
+}
+
 int cli_npy_read_vector(const char *path, double **values, int64_t *n)
 {
     *values = NULL;
@@ -199,31 +231,14 @@ int cli_npy_read_vector(const char *path, double **values, int64_t *n)
         cli_error("cannot open '%s': %s", path, strerror(errno));
         return -1;
     }
-    unsigned char pre[12];
     char *dict = NULL;
     void *raw = NULL;
     double *out = NULL;
-    if (fread(pre, 1, 10, f) != 10 || memcmp(pre, "\x93NUMPY", 6) != 0)
-        goto bad;
-    size_t hlen;
-    if (pre[6] == 1) {
-        hlen = (size_t)pre[8] | (size_t)pre[9] << 8;
-    } else if (pre[6] == 2 || pre[6] == 3) {
-        if (fread(pre + 10, 1, 2, f) != 2)
-            goto bad;
-        hlen = (size_t)pre[8] | (size_t)pre[9] << 8 | (size_t)pre[10] << 16 |
-               (size_t)pre[11] << 24;
-        if (hlen > 1 << 20)
-            goto bad;
-    } else {
-        goto bad;
-    }
-    dict = malloc(hlen + 1);
-    if (!dict)
+    int hr = read_header(f, &dict);
+    if (hr == -2)
         goto oom;
-    if (fread(dict, 1, hlen, f) != hlen)
+    if (hr)
         goto bad;
-    dict[hlen] = '\0';
     const char *d = dict_value(dict, "descr");
     const char *fo = dict_value(dict, "fortran_order");
     const char *sh = dict_value(dict, "shape");
@@ -316,6 +331,84 @@ fail:
     free(dict);
     fclose(f);
     return -1;
+}
+
+int cli_npy_read_ints(const char *path, int32_t **ids, int64_t *n)
+{
+    *ids = NULL;
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        cli_error("cannot open '%s': %s", path, strerror(errno));
+        return -1;
+    }
+    char *dict = NULL;
+    unsigned char *raw = NULL;
+    int rc = -1;
+    if (read_header(f, &dict))
+        goto bad;
+    const char *d = dict_value(dict, "descr");
+    const char *sh = dict_value(dict, "shape");
+    if (!d || !sh)
+        goto bad;
+    /* e.g. '<i4', '|u1' */
+    if (d[0] != '\'' || !strchr("<>|=", d[1]) || (d[2] != 'i' && d[2] != 'u') ||
+        !strchr("1248", d[3]) || d[4] != '\'') {
+        rc = 1;
+        goto out;
+    }
+    int big = d[1] == '>', is_signed = d[2] == 'i';
+    size_t size = (size_t)(d[3] - '0');
+    long long count = -1, other = 1;
+    if (sscanf(sh, "(%lld,)", &count) != 1 && sscanf(sh, "(%lld, %lld)", &count, &other) != 2)
+        goto bad;
+    if (count < 0 || other < 0 || (other != 1 && count != 1))
+        goto bad;
+    count *= other;
+    if (count > INT32_MAX) {
+        cli_error("%s: too many sources", path);
+        goto out;
+    }
+    raw = malloc(count ? (size_t)count * size : 1);
+    *ids = malloc(count ? (size_t)count * sizeof **ids : 1);
+    if (!raw || !*ids) {
+        cli_error("out of memory reading '%s'", path);
+        goto out;
+    }
+    if (fread(raw, size, (size_t)count, f) != (size_t)count)
+        goto bad;
+    for (long long i = 0; i < count; i++) {
+        const unsigned char *p = raw + (size_t)i * size;
+        unsigned long long u = 0;
+        for (size_t k = 0; k < size; k++) {
+            size_t byte = big ? k : size - 1 - k;
+            u = (u << 8) | p[byte];
+        }
+        long long v;
+        if (is_signed && size < 8 && (u >> (8 * size - 1)) & 1)
+            v = (long long)(u | (~0ull << (8 * size)));
+        else
+            v = (long long)u;
+        if ((!is_signed && size == 8 && u > (unsigned long long)INT32_MAX) || v < INT32_MIN ||
+            v > INT32_MAX) {
+            cli_error("%s: source %lld is out of range", path, i);
+            goto out;
+        }
+        (*ids)[i] = (int32_t)v;
+    }
+    *n = count;
+    rc = 0;
+    goto out;
+bad:
+    cli_error("%s: not a readable .npy file", path);
+out:
+    if (rc != 0) {
+        free(*ids);
+        *ids = NULL;
+    }
+    free(raw);
+    free(dict);
+    fclose(f);
+    return rc;
 }
 
 int cli_txt_read_vector(const char *path, double **values, int64_t *n)
