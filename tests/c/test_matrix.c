@@ -15,41 +15,11 @@
 
 #include "testutil.h"
 
-/* rows from mfmm_solve, float64 */
-static double *reference_rows(const mfmm_mesh *mesh, const int32_t *src, int32_t n,
-                              const mfmm_solve_options *so)
-{
-    int32_t nv = mfmm_mesh_vertex_count(mesh);
-    double *ref = malloc((size_t)n * (size_t)nv * sizeof *ref);
-    assert_non_null(ref);
-    mfmm_solver *solver = NULL;
-    assert_int_equal(mfmm_solver_create(mesh, &solver), MFMM_OK);
-    for (int32_t i = 0; i < n; i++) {
-        mfmm_source s = tm_vertex_source(src ? src[i] : i);
-        mfmm_error err;
-        assert_int_equal(mfmm_solve(solver, &s, 1, so, ref + (size_t)i * nv, &err), MFMM_OK);
-    }
-    mfmm_solver_destroy(solver);
-    return ref;
-}
-
-typedef struct collect {
-    char *buf;
-    size_t row_bytes;
-    int32_t next;   /* the first row expected next */
-    int32_t calls;
-    int32_t cancel_after; /* calls before asking to stop; < 0: never */
-} collect;
-
+/* tm_collect_rows, and every block holds at least one row */
 static int on_rows(void *user, int32_t first, int32_t n, const void *rows)
 {
-    collect *c = user;
-    assert_int_equal(first, c->next); /* in order, no gaps */
     assert_true(n >= 1);
-    memcpy(c->buf + (size_t)first * c->row_bytes, rows, (size_t)n * c->row_bytes);
-    c->next += n;
-    c->calls++;
-    return c->cancel_after >= 0 && c->calls >= c->cancel_after;
+    return tm_collect_rows(user, first, n, rows);
 }
 
 /* Runs one configuration and compares every row with ref. */
@@ -62,7 +32,7 @@ static void check_backend(const mfmm_mesh *mesh, const int32_t *src, int32_t n,
     size_t esz = dtype == MFMM_FLOAT64 ? 8 : 4;
     size_t total = (size_t)n * (size_t)nv;
     char *out = use_out ? malloc(total * esz) : NULL;
-    collect c = {use_cb ? malloc(total * esz) : NULL, nv * esz, 0, 0, -1};
+    tm_collect c = {use_cb ? malloc(total * esz) : NULL, nv * esz, 0, 0, -1};
     mfmm_matrix_options o;
     mfmm_matrix_options_init(&o);
     o.backend = backend;
@@ -115,7 +85,7 @@ static void test_cpu_backends_equal_solve(void **state)
     for (int m = 0; m < 3; m++) {
         mfmm_mesh *mesh = tm_make(&g[m]);
         int32_t nv = mfmm_mesh_vertex_count(mesh);
-        double *ref = reference_rows(mesh, some_sources, N_SOME, NULL);
+        double *ref = tm_reference_rows(mesh, some_sources, N_SOME, NULL);
         size_t row = (size_t)nv * 8;
         for (int dt = 0; dt < 2; dt++) {
             mfmm_dtype dtype = dt ? MFMM_FLOAT64 : MFMM_FLOAT32;
@@ -163,7 +133,7 @@ static void test_all_vertices_costs_and_limit(void **state)
     so[1].max_distance = 0.9;
     so[2].max_distance = 0.35;
     for (int k = 0; k < 3; k++) {
-        double *ref = reference_rows(mesh, NULL, nv, &so[k]);
+        double *ref = tm_reference_rows(mesh, NULL, nv, &so[k]);
         check_backend(mesh, NULL, nv, ref, MFMM_BACKEND_SERIAL, MFMM_FLOAT64, 0, 0, 1, 1, &so[k]);
         check_backend(mesh, NULL, nv, ref, MFMM_BACKEND_THREADS, MFMM_FLOAT64, 2, 0, 1, 1,
                       &so[k]);
@@ -183,7 +153,7 @@ static void test_no_opencl_fallback(void **state)
     (void)state;
     mfmm_gen_mesh g = mfmm_gen_icosphere(2);
     mfmm_mesh *mesh = tm_make(&g);
-    double *ref = reference_rows(mesh, some_sources, N_SOME, NULL);
+    double *ref = tm_reference_rows(mesh, some_sources, N_SOME, NULL);
     size_t total = (size_t)N_SOME * (size_t)g.nv;
     double *out = malloc(total * sizeof *out);
     assert_non_null(out);
@@ -216,7 +186,7 @@ static void test_cancel(void **state)
     int32_t nv = g.nv;
     mfmm_backend backends[2] = {MFMM_BACKEND_SERIAL, MFMM_BACKEND_THREADS};
     for (int b = 0; b < 2; b++) {
-        collect c = {malloc((size_t)nv * (size_t)nv * 4), (size_t)nv * 4, 0, 0, 2};
+        tm_collect c = {malloc((size_t)nv * (size_t)nv * 4), (size_t)nv * 4, 0, 0, 2};
         assert_non_null(c.buf);
         mfmm_matrix_options o;
         mfmm_matrix_options_init(&o);

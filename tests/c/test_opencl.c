@@ -19,39 +19,6 @@
 static char cache_dir[64] = "/tmp/mfmm_clcache_XXXXXX";
 static int have_device = -1;
 
-static double *reference_rows(const mfmm_mesh *mesh, const int32_t *src, int32_t n,
-                              const mfmm_solve_options *so)
-{
-    int32_t nv = mfmm_mesh_vertex_count(mesh);
-    double *ref = malloc((size_t)n * (size_t)nv * sizeof *ref);
-    assert_non_null(ref);
-    mfmm_solver *solver = NULL;
-    assert_int_equal(mfmm_solver_create(mesh, &solver), MFMM_OK);
-    for (int32_t i = 0; i < n; i++) {
-        mfmm_source s = tm_vertex_source(src ? src[i] : i);
-        mfmm_error err;
-        assert_int_equal(mfmm_solve(solver, &s, 1, so, ref + (size_t)i * nv, &err), MFMM_OK);
-    }
-    mfmm_solver_destroy(solver);
-    return ref;
-}
-
-typedef struct collect {
-    char *buf;
-    size_t row_bytes;
-    int32_t next, calls, cancel_after;
-} collect;
-
-static int on_rows(void *user, int32_t first, int32_t n, const void *rows)
-{
-    collect *c = user;
-    assert_int_equal(first, c->next);
-    memcpy(c->buf + (size_t)first * c->row_bytes, rows, (size_t)n * c->row_bytes);
-    c->next += n;
-    c->calls++;
-    return c->cancel_after >= 0 && c->calls >= c->cancel_after;
-}
-
 /* OpenCL rows (into out, or by callback with a small memory limit: many
  * batches) compared with ref. Returns 0 when there is no device (skip). */
 static int check_opencl(const mfmm_mesh *mesh, const int32_t *src, int32_t n, const double *ref,
@@ -61,7 +28,7 @@ static int check_opencl(const mfmm_mesh *mesh, const int32_t *src, int32_t n, co
     int32_t nv = mfmm_mesh_vertex_count(mesh);
     size_t esz = dtype == MFMM_FLOAT64 ? 8 : 4;
     size_t total = (size_t)n * (size_t)nv;
-    collect c = {malloc(total * esz), (size_t)nv * esz, 0, 0, -1};
+    tm_collect c = {malloc(total * esz), (size_t)nv * esz, 0, 0, -1};
     assert_non_null(c.buf);
     mfmm_matrix_options o;
     mfmm_matrix_options_init(&o);
@@ -69,7 +36,7 @@ static int check_opencl(const mfmm_mesh *mesh, const int32_t *src, int32_t n, co
     o.dtype = dtype;
     o.memory_limit = memory_limit;
     if (use_cb) {
-        o.on_rows = on_rows;
+        o.on_rows = tm_collect_rows;
         o.user = &c;
     } else {
         o.out = c.buf;
@@ -136,7 +103,7 @@ static void test_generated_meshes(void **state)
         assert_non_null(src);
         for (int32_t i = 0; i < n; i++)
             src[i] = (int32_t)(((int64_t)i * 7919) % nv);
-        double *ref = reference_rows(mesh, src, n, NULL);
+        double *ref = tm_reference_rows(mesh, src, n, NULL);
         if (!check_opencl(mesh, src, n, ref, MFMM_FLOAT64, 0, 0, NULL)) {
             have_device = 0;
             free(ref);
@@ -163,7 +130,7 @@ static void test_generated_meshes(void **state)
         so[0].cost_location = MFMM_COST_PER_VERTEX;
         so[1].unfolding = 0;
         for (int k = 0; k < 2; k++) {
-            ref = reference_rows(mesh, src, n, &so[k]);
+            ref = tm_reference_rows(mesh, src, n, &so[k]);
             assert_true(check_opencl(mesh, src, n, ref, MFMM_FLOAT64, 0, 0, &so[k]));
             free(ref);
         }
@@ -172,24 +139,6 @@ static void test_generated_meshes(void **state)
         mfmm_mesh_destroy(mesh);
         mfmm_gen_free(&g[m]);
     }
-}
-
-static mfmm_mesh *load_shared(const char *name, int32_t *nf_out)
-{
-    char path[1024];
-    tm_shared_path(path, sizeof path, name);
-    double *V = NULL;
-    int32_t *F = NULL, nv = 0, nf = 0;
-    mfmm_error err;
-    if (mfmm_load_mesh(path, &V, &nv, &F, &nf, &err) != MFMM_OK)
-        fail_msg("%s: %s", path, err.message);
-    mfmm_mesh *mesh = NULL;
-    if (mfmm_mesh_create(V, nv, F, nf, NULL, &mesh, &err) != MFMM_OK)
-        fail_msg("%s: %s", path, err.message);
-    mfmm_free(V);
-    mfmm_free(F);
-    *nf_out = nf;
-    return mesh;
 }
 
 /* hand_lowres (boundary) and wingnut (many obtuse corners): plain, per-face
@@ -202,7 +151,7 @@ static void test_shared_meshes(void **state)
     const char *names[2] = {"meshes/hand_lowres.obj", "meshes/wingnut.obj"};
     for (int m = 0; m < 2; m++) {
         int32_t nf = 0;
-        mfmm_mesh *mesh = load_shared(names[m], &nf);
+        mfmm_mesh *mesh = tm_load_shared(names[m], NULL, &nf, NULL);
         mfmm_mesh_info info;
         assert_int_equal(mfmm_mesh_get_info(mesh, &info), MFMM_OK);
         if (m == 0)
@@ -225,7 +174,7 @@ static void test_shared_meshes(void **state)
         so[1].cost_location = MFMM_COST_PER_FACE;
         so[2].max_distance = 0.25 * info.bbox_diagonal;
         for (int k = 0; k < 3; k++) {
-            double *ref = reference_rows(mesh, src, N, &so[k]);
+            double *ref = tm_reference_rows(mesh, src, N, &so[k]);
             int finite = 0, inf = 0;
             for (size_t i = 0; i < (size_t)N * (size_t)nv; i++) {
                 if (isinf(ref[i]))
@@ -255,7 +204,7 @@ static void test_cache_corrupt_and_unwritable(void **state)
     mfmm_gen_mesh g = mfmm_gen_grid(6);
     mfmm_mesh *mesh = tm_make(&g);
     int32_t src[5] = {0, 10, 20, 30, 48};
-    double *ref = reference_rows(mesh, src, 5, NULL);
+    double *ref = tm_reference_rows(mesh, src, 5, NULL);
     DIR *d = opendir(cache_dir);
     assert_non_null(d);
     struct dirent *e;
@@ -313,9 +262,9 @@ static void test_device_selection_and_cancel(void **state)
     assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL);
 
     /* cancel after the second batch */
-    collect c = {(char *)out, (size_t)nv * 4, 0, 0, 2};
+    tm_collect c = {(char *)out, (size_t)nv * 4, 0, 0, 2};
     o.out = NULL;
-    o.on_rows = on_rows;
+    o.on_rows = tm_collect_rows;
     o.user = &c;
     o.memory_limit = (size_t)nv * 60 * 4; /* a few rows per batch */
     assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &err), MFMM_ERR_CANCELLED);

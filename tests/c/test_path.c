@@ -14,36 +14,7 @@
 #define PI 3.14159265358979323846
 #define CAP 100000
 
-typedef struct fixture {
-    mfmm_gen_mesh g;
-    mfmm_mesh *mesh;
-    mfmm_solver *solver;
-    double *d;
-    mfmm_surface_point *pts;
-} fixture;
-
-static fixture make_fixture(mfmm_gen_mesh g)
-{
-    fixture fx;
-    fx.g = g;
-    fx.mesh = tm_make(&g);
-    assert_int_equal(mfmm_solver_create(fx.mesh, &fx.solver), MFMM_OK);
-    fx.d = malloc((size_t)g.nv * sizeof *fx.d);
-    fx.pts = malloc(CAP * sizeof *fx.pts);
-    assert_true(fx.d && fx.pts);
-    return fx;
-}
-
-static void free_fixture(fixture *fx)
-{
-    free(fx->d);
-    free(fx->pts);
-    mfmm_solver_destroy(fx->solver);
-    mfmm_mesh_destroy(fx->mesh);
-    mfmm_gen_free(&fx->g);
-}
-
-static void solve1(fixture *fx, const mfmm_source *src, const mfmm_solve_options *opt)
+static void solve1(tm_fixture *fx, const mfmm_source *src, const mfmm_solve_options *opt)
 {
     mfmm_error err;
     if (mfmm_solve(fx->solver, src, 1, opt, fx->d, &err) != MFMM_OK)
@@ -51,7 +22,7 @@ static void solve1(fixture *fx, const mfmm_source *src, const mfmm_solve_options
 }
 
 /* Traces with the source given; fails the test on error. Returns the count. */
-static int32_t trace(fixture *fx, const mfmm_source *src, int32_t n_src, const mfmm_source *target,
+static int32_t trace(tm_fixture *fx, const mfmm_source *src, int32_t n_src, const mfmm_source *target,
                      const double *cost, mfmm_cost_location loc, double *len, double *wlen)
 {
     mfmm_path_options po;
@@ -89,7 +60,7 @@ static double seg_dist(const double *p, const double *a, const double *b)
 }
 
 /* Every point lies in its face: xyz matches the barycentric coordinates. */
-static void check_points(const fixture *fx, int32_t n)
+static void check_points(const tm_fixture *fx, int32_t n)
 {
     for (int32_t i = 0; i < n; i++) {
         const mfmm_surface_point *p = &fx->pts[i];
@@ -145,7 +116,7 @@ static void test_plane_straight(void **state)
     (void)state;
     double prev_dev = INFINITY;
     for (int n = 20; n <= 80; n *= 2) {
-        fixture fx = make_fixture(mfmm_gen_grid(n));
+        tm_fixture fx = tm_fixture_make(mfmm_gen_grid(n), CAP);
         double h = 1.0 / n;
         const double sp[3] = {0.3, 0.4, 0.0};
         mfmm_source src = tm_vertex_source(tm_nearest_vertex(&fx.g, sp));
@@ -202,7 +173,7 @@ static void test_plane_straight(void **state)
                 prev_dev = max_dev;
             }
         }
-        free_fixture(&fx);
+        tm_fixture_free(&fx);
     }
 }
 
@@ -213,7 +184,7 @@ static void test_sphere_great_circles(void **state)
     (void)state;
     double prev = INFINITY;
     for (int level = 3; level <= 5; level++) {
-        fixture fx = make_fixture(mfmm_gen_icosphere(level));
+        tm_fixture fx = tm_fixture_make(mfmm_gen_icosphere(level), CAP);
         const double sp[3] = {0.0, 0.0, 1.0};
         mfmm_source src = tm_vertex_source(tm_nearest_vertex(&fx.g, sp));
         const double *s = fx.g.V + 3 * src.vertex;
@@ -260,7 +231,7 @@ static void test_sphere_great_circles(void **state)
             if (level == 5)
                 assert_true(max_len < 0.01);
         }
-        free_fixture(&fx);
+        tm_fixture_free(&fx);
     }
 }
 
@@ -288,7 +259,7 @@ static void test_snell(void **state)
 {
     (void)state;
     for (int n = 40; n <= 80; n *= 2) {
-        fixture fx = make_fixture(mfmm_gen_grid(n));
+        tm_fixture fx = tm_fixture_make(mfmm_gen_grid(n), CAP);
         double h = 1.0 / n;
         double *cost = malloc((size_t)fx.g.nf * sizeof *cost);
         assert_non_null(cost);
@@ -357,7 +328,7 @@ static void test_snell(void **state)
         assert_true(max_y_err < 2.0);
         assert_true(max_w_err < 0.01);
         free(cost);
-        free_fixture(&fx);
+        tm_fixture_free(&fx);
     }
 }
 
@@ -369,7 +340,7 @@ static void test_torus_sides(void **state)
     (void)state;
     const double R = 1.0, r = 0.35;
     const int nu = 120, nvt = 40;
-    fixture fx = make_fixture(mfmm_gen_torus(nu, nvt, R, r));
+    tm_fixture fx = tm_fixture_make(mfmm_gen_torus(nu, nvt, R, r), CAP);
     double *dt = malloc((size_t)fx.g.nv * sizeof *dt);
     assert_non_null(dt);
     double h = 2 * PI * (R + r) / nu;
@@ -407,7 +378,7 @@ static void test_torus_sides(void **state)
     }
     assert_true(through_hole >= 1 && outside >= 1); /* both sides were exercised */
     free(dt);
-    free_fixture(&fx);
+    tm_fixture_free(&fx);
 }
 
 /* The end: a face source ends at its point, several sources at the one the
@@ -415,7 +386,7 @@ static void test_torus_sides(void **state)
 static void test_ends(void **state)
 {
     (void)state;
-    fixture fx = make_fixture(mfmm_gen_grid(20));
+    tm_fixture fx = tm_fixture_make(mfmm_gen_grid(20), CAP);
     mfmm_source fs = grid_point(&fx.g, 0.33, 0.61);
     double xs[3] = {0.33, 0.61, 0.0};
     solve1(&fx, &fs, NULL);
@@ -449,7 +420,7 @@ static void test_ends(void **state)
     assert_int_equal(mfmm_trace_path(fx.mesh, fx.d, &two[1], &po, fx.pts, CAP, &np, &len, NULL), MFMM_OK);
     assert_int_equal(np, 1);
     assert_true(len == 0.0);
-    free_fixture(&fx);
+    tm_fixture_free(&fx);
 }
 
 /* Every bad input returns its status with a message; nothing is written past
@@ -457,7 +428,7 @@ static void test_ends(void **state)
 static void test_errors(void **state)
 {
     (void)state;
-    fixture fx = make_fixture(mfmm_gen_grid(10));
+    tm_fixture fx = tm_fixture_make(mfmm_gen_grid(10), CAP);
     mfmm_source src = tm_vertex_source(0);
     mfmm_solve_options so;
     mfmm_solve_options_init(&so);
@@ -554,7 +525,7 @@ static void test_errors(void **state)
     assert_int_equal(mfmm_trace_path(fx.mesh, flat, &t0, &po, fx.pts, CAP, &np, &len, &err),
                      MFMM_ERR_BAD_ARGUMENT);
     free(flat);
-    free_fixture(&fx);
+    tm_fixture_free(&fx);
 }
 
 int main(void)

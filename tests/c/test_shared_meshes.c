@@ -14,16 +14,8 @@
 
 static void check_mesh(const char *file, int32_t want_components, int32_t want_unreferenced)
 {
-    char path[1024];
-    tm_shared_path(path, sizeof path, file);
-    double *V = NULL;
     int32_t *F = NULL, nv = 0, nf = 0;
-    mfmm_error err;
-    if (mfmm_load_mesh(path, &V, &nv, &F, &nf, &err) != MFMM_OK)
-        fail_msg("%s: %s", path, err.message);
-    mfmm_mesh *mesh = NULL;
-    if (mfmm_mesh_create(V, nv, F, nf, NULL, &mesh, &err) != MFMM_OK)
-        fail_msg("%s: %s", path, err.message);
+    mfmm_mesh *mesh = tm_load_shared(file, &nv, &nf, &F);
     mfmm_mesh_info info;
     mfmm_mesh_get_info(mesh, &info);
     print_message("%-24s nv=%6d nf=%6d components=%d boundary=%d nonmanifold=%d unref=%d "
@@ -57,7 +49,6 @@ static void check_mesh(const char *file, int32_t want_components, int32_t want_u
     free(d);
     mfmm_solver_destroy(solver);
     mfmm_mesh_destroy(mesh);
-    mfmm_free(V);
     mfmm_free(F);
 }
 

@@ -10,32 +10,6 @@
 
 #include "testutil.h"
 
-typedef struct fixture {
-    mfmm_gen_mesh g;
-    mfmm_mesh *mesh;
-    mfmm_solver *solver;
-    double *d;
-} fixture;
-
-static fixture make_fixture(mfmm_gen_mesh g)
-{
-    fixture fx;
-    fx.g = g;
-    fx.mesh = tm_make(&g);
-    assert_int_equal(mfmm_solver_create(fx.mesh, &fx.solver), MFMM_OK);
-    fx.d = malloc((size_t)g.nv * sizeof *fx.d);
-    assert_non_null(fx.d);
-    return fx;
-}
-
-static void free_fixture(fixture *fx)
-{
-    free(fx->d);
-    mfmm_solver_destroy(fx->solver);
-    mfmm_mesh_destroy(fx->mesh);
-    mfmm_gen_free(&fx->g);
-}
-
 static double dist2d(const double *p, const double *q)
 {
     return sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]));
@@ -48,7 +22,7 @@ static void test_face_source_flat(void **state)
     (void)state;
     double prev = INFINITY;
     for (int n = 16; n <= 128; n *= 2) {
-        fixture fx = make_fixture(mfmm_gen_grid(n));
+        tm_fixture fx = tm_fixture_make(mfmm_gen_grid(n), 0);
         /* the face containing (0.37, 0.52): find by barycentric test */
         const double p[3] = {0.37 + 0.1 / n, 0.52 + 0.3 / n, 0.0};
         mfmm_source src = {0, -1, {0, 0, 0}, 0.0};
@@ -80,7 +54,7 @@ static void test_face_source_flat(void **state)
         assert_true(err < prev);
         prev = err;
         free(e);
-        free_fixture(&fx);
+        tm_fixture_free(&fx);
     }
     assert_true(prev < 1.0); /* n = 128 */
 }
@@ -91,7 +65,7 @@ static void test_several_sources(void **state)
 {
     (void)state;
     int n = 64;
-    fixture fx = make_fixture(mfmm_gen_grid(n));
+    tm_fixture fx = tm_fixture_make(mfmm_gen_grid(n), 0);
     const double p1[3] = {0.2, 0.3, 0}, p2[3] = {0.8, 0.6, 0};
     mfmm_source s[3] = {tm_vertex_source(tm_nearest_vertex(&fx.g, p1)),
                         tm_vertex_source(tm_nearest_vertex(&fx.g, p2)),
@@ -113,7 +87,7 @@ static void test_several_sources(void **state)
     free(d1);
     free(d2);
     free(d3);
-    free_fixture(&fx);
+    tm_fixture_free(&fx);
 }
 
 /* A vertex on another component is +inf, never NaN; unreferenced too. */
@@ -133,7 +107,7 @@ static void test_components(void **state)
         two.F[i] = a.F[i];
         two.F[3 * a.nf + i] = a.F[i] + a.nv;
     }
-    fixture fx = make_fixture(two);
+    tm_fixture fx = tm_fixture_make(two, 0);
     mfmm_mesh_info info;
     mfmm_mesh_get_info(fx.mesh, &info);
     assert_int_equal(info.n_components, 2);
@@ -147,7 +121,7 @@ static void test_components(void **state)
         else
             assert_true(isinf(fx.d[v]) && fx.d[v] > 0);
     }
-    free_fixture(&fx);
+    tm_fixture_free(&fx);
     mfmm_gen_free(&a);
 }
 
@@ -176,7 +150,7 @@ static void test_snell_per_face_cost(void **state)
     (void)state;
     double prev = INFINITY;
     for (int n = 16; n <= 128; n *= 2) {
-        fixture fx = make_fixture(mfmm_gen_grid(n));
+        tm_fixture fx = tm_fixture_make(mfmm_gen_grid(n), 0);
         double *cost = malloc((size_t)fx.g.nf * sizeof *cost);
         double *e = malloc((size_t)fx.g.nv * sizeof *e);
         assert_true(cost && e);
@@ -206,7 +180,7 @@ static void test_snell_per_face_cost(void **state)
         prev = err;
         free(cost);
         free(e);
-        free_fixture(&fx);
+        tm_fixture_free(&fx);
     }
     assert_true(prev < 1.0);
 }
@@ -215,7 +189,7 @@ static void test_snell_per_face_cost(void **state)
 static void test_constant_cost_scales(void **state)
 {
     (void)state;
-    fixture fx = make_fixture(mfmm_gen_icosphere(3));
+    tm_fixture fx = tm_fixture_make(mfmm_gen_icosphere(3), 0);
     double *cost = malloc((size_t)fx.g.nv * sizeof *cost), *d1 = malloc((size_t)fx.g.nv * sizeof *d1);
     assert_true(cost && d1);
     for (int32_t v = 0; v < fx.g.nv; v++)
@@ -231,7 +205,7 @@ static void test_constant_cost_scales(void **state)
         tm_assert_close(fx.d[v], 2.5 * d1[v], 1e-12);
     free(cost);
     free(d1);
-    free_fixture(&fx);
+    tm_fixture_free(&fx);
 }
 
 /* max_distance: values up to it equal the full solve's, the rest are +inf.
@@ -239,7 +213,7 @@ static void test_constant_cost_scales(void **state)
 static void test_early_stop(void **state)
 {
     (void)state;
-    fixture fx = make_fixture(mfmm_gen_sine(40));
+    tm_fixture fx = tm_fixture_make(mfmm_gen_sine(40), 0);
     double *full = malloc((size_t)fx.g.nv * sizeof *full);
     assert_non_null(full);
     mfmm_source src = tm_vertex_source(100);
@@ -273,7 +247,7 @@ static void test_early_stop(void **state)
     }
     assert_true(fx.d[200] == full[200] && fx.d[450] == full[450]);
     free(full);
-    free_fixture(&fx);
+    tm_fixture_free(&fx);
 }
 
 static void expect_mesh_error(const double *V, int32_t nv, const int32_t *F, int32_t nf,
@@ -344,7 +318,7 @@ static void test_degenerate_faces_accepted(void **state)
     mfmm_mesh_destroy(mesh);
 }
 
-static void expect_solve_error(fixture *fx, const mfmm_source *s, int32_t n,
+static void expect_solve_error(tm_fixture *fx, const mfmm_source *s, int32_t n,
                                const mfmm_solve_options *opt, mfmm_status want)
 {
     mfmm_error err;
@@ -356,7 +330,7 @@ static void expect_solve_error(fixture *fx, const mfmm_source *s, int32_t n,
 static void test_bad_solves(void **state)
 {
     (void)state;
-    fixture fx = make_fixture(mfmm_gen_grid(4));
+    tm_fixture fx = tm_fixture_make(mfmm_gen_grid(4), 0);
     mfmm_source ok = tm_vertex_source(0);
     mfmm_error err;
     assert_int_equal(mfmm_solve(NULL, &ok, 1, NULL, fx.d, &err), MFMM_ERR_NULL_POINTER);
@@ -415,7 +389,7 @@ static void test_bad_solves(void **state)
     assert_int_equal(mfmm_mesh_get_info(NULL, NULL), MFMM_ERR_NULL_POINTER);
     assert_string_equal(mfmm_status_string((mfmm_status)999), "unknown status");
     free(cost);
-    free_fixture(&fx);
+    tm_fixture_free(&fx);
 }
 
 int main(void)

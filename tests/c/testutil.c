@@ -4,6 +4,8 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 #include <cmocka.h>
 
 #include "testutil.h"
@@ -81,4 +83,77 @@ double tm_fitted_order(const double *h, const double *err, int n)
 void tm_shared_path(char *out, size_t n, const char *relative)
 {
     snprintf(out, n, "%s/%s", MESHFMM_SHARED_DIR, relative);
+}
+
+mfmm_mesh *tm_load_shared(const char *relative, int32_t *nv_out, int32_t *nf_out,
+                          int32_t **F_out)
+{
+    char path[1024];
+    tm_shared_path(path, sizeof path, relative);
+    double *V = NULL;
+    int32_t *F = NULL, nv = 0, nf = 0;
+    mfmm_error err;
+    if (mfmm_load_mesh(path, &V, &nv, &F, &nf, &err) != MFMM_OK)
+        fail_msg("%s: %s", path, err.message);
+    mfmm_mesh *mesh = NULL;
+    if (mfmm_mesh_create(V, nv, F, nf, NULL, &mesh, &err) != MFMM_OK)
+        fail_msg("%s: %s", path, err.message);
+    mfmm_free(V);
+    if (F_out)
+        *F_out = F;
+    else
+        mfmm_free(F);
+    if (nv_out)
+        *nv_out = nv;
+    if (nf_out)
+        *nf_out = nf;
+    return mesh;
+}
+
+double *tm_reference_rows(const mfmm_mesh *mesh, const int32_t *src, int32_t n,
+                          const mfmm_solve_options *so)
+{
+    int32_t nv = mfmm_mesh_vertex_count(mesh);
+    double *ref = malloc((size_t)n * (size_t)nv * sizeof *ref);
+    assert_non_null(ref);
+    mfmm_solver *solver = NULL;
+    assert_int_equal(mfmm_solver_create(mesh, &solver), MFMM_OK);
+    for (int32_t i = 0; i < n; i++) {
+        mfmm_source s = tm_vertex_source(src ? src[i] : i);
+        mfmm_error err;
+        assert_int_equal(mfmm_solve(solver, &s, 1, so, ref + (size_t)i * nv, &err), MFMM_OK);
+    }
+    mfmm_solver_destroy(solver);
+    return ref;
+}
+
+int tm_collect_rows(void *user, int32_t first, int32_t n, const void *rows)
+{
+    tm_collect *c = user;
+    assert_int_equal(first, c->next); /* in order, no gaps */
+    memcpy(c->buf + (size_t)first * c->row_bytes, rows, (size_t)n * c->row_bytes);
+    c->next += n;
+    c->calls++;
+    return c->cancel_after >= 0 && c->calls >= c->cancel_after;
+}
+
+tm_fixture tm_fixture_make(mfmm_gen_mesh g, int32_t n_points)
+{
+    tm_fixture fx;
+    fx.g = g;
+    fx.mesh = tm_make(&g);
+    assert_int_equal(mfmm_solver_create(fx.mesh, &fx.solver), MFMM_OK);
+    fx.d = malloc((size_t)g.nv * sizeof *fx.d);
+    fx.pts = n_points > 0 ? malloc((size_t)n_points * sizeof *fx.pts) : NULL;
+    assert_true(fx.d && (n_points <= 0 || fx.pts));
+    return fx;
+}
+
+void tm_fixture_free(tm_fixture *fx)
+{
+    free(fx->d);
+    free(fx->pts);
+    mfmm_solver_destroy(fx->solver);
+    mfmm_mesh_destroy(fx->mesh);
+    mfmm_gen_free(&fx->g);
 }

@@ -39,6 +39,43 @@ double tm_max_error(const double *d, const double *exact, int32_t n, double diam
 /* Least-squares slope of log(err) against log(h): the order of convergence. */
 double tm_fitted_order(const double *h, const double *err, int n);
 
+/* Loads ../shared/<relative> (e.g. "meshes/spot.obj") into an mfmm_mesh
+ * (default options); fails the test ("PATH: message") on error. nv_out,
+ * nf_out: the counts (either may be NULL). F_out: when not NULL, receives
+ * the face array (free with mfmm_free); otherwise it is freed. */
+mfmm_mesh *tm_load_shared(const char *relative, int32_t *nv_out, int32_t *nf_out,
+                          int32_t **F_out);
+
+/* Rows from mfmm_solve (float64, n x nv), one per vertex source src[i]
+ * (src NULL: vertex i): the reference for mfmm_distance_matrix. */
+double *tm_reference_rows(const mfmm_mesh *mesh, const int32_t *src, int32_t n,
+                          const mfmm_solve_options *so);
+
+/* An mfmm_distance_matrix on_rows target: tm_collect_rows copies each block
+ * into buf (row_bytes a row), checks that blocks come in order without gaps,
+ * and asks to stop after cancel_after calls. */
+typedef struct tm_collect {
+    char *buf;
+    size_t row_bytes;
+    int32_t next;         /* the first row expected next */
+    int32_t calls;
+    int32_t cancel_after; /* calls before asking to stop; < 0: never */
+} tm_collect;
+int tm_collect_rows(void *user, int32_t first, int32_t n, const void *rows);
+
+/* A generated mesh with its mfmm_mesh, a solver and room for nv distances,
+ * and for n_points path points (pts; NULL when n_points is 0). */
+typedef struct tm_fixture {
+    mfmm_gen_mesh g;
+    mfmm_mesh *mesh;
+    mfmm_solver *solver;
+    double *d;
+    mfmm_surface_point *pts;
+} tm_fixture;
+/* Takes ownership of g; fails the test on error. */
+tm_fixture tm_fixture_make(mfmm_gen_mesh g, int32_t n_points);
+void tm_fixture_free(tm_fixture *fx);
+
 /* Writes the path of `relative` (e.g. "meshes/spot.obj") under ../shared into out. */
 void tm_shared_path(char *out, size_t n, const char *relative);
 
