@@ -61,12 +61,7 @@ static void check_backend(const mfmm_mesh *mesh, const int32_t *src, int32_t n,
         if (dtype == MFMM_FLOAT64) {
             assert_memory_equal(bufs[k], ref, total * 8);
         } else {
-            const float *f = (const float *)bufs[k];
-            for (size_t i = 0; i < total; i++) {
-                float want = (float)ref[i];
-                if (memcmp(&f[i], &want, 4) != 0)
-                    fail_msg("entry %zu: %.9g != (float)%.17g", i, f[i], ref[i]);
-            }
+            tm_assert_float32_of(bufs[k], ref, total);
         }
     }
     if (use_cb)

@@ -63,12 +63,7 @@ static int check_opencl(const mfmm_mesh *mesh, const int32_t *src, int32_t n, co
                 fail_msg("row %zu vertex %zu: opencl %.17g != serial %.17g", i / (size_t)nv,
                          i % (size_t)nv, d[i], ref[i]);
     } else {
-        const float *f = (const float *)c.buf;
-        for (size_t i = 0; i < total; i++) {
-            float want = (float)ref[i];
-            if (memcmp(&f[i], &want, 4) != 0)
-                fail_msg("entry %zu: %.9g != (float)%.17g", i, f[i], ref[i]);
-        }
+        tm_assert_float32_of(c.buf, ref, total);
     }
     if (use_cb)
         assert_int_equal(c.next, n);

@@ -235,23 +235,6 @@ static void test_sphere_great_circles(void **state)
     }
 }
 
-/* Crossing point on x = 0.5 of the least-cost path from s (cost f1, x < 0.5)
- * to p (cost f2, x > 0.5), by golden section. */
-static double refraction_y(const double *s, const double *p, double f1, double f2)
-{
-    double lo = -2.0, hi = 3.0;
-    for (int it = 0; it < 200; it++) {
-        double m1 = lo + (hi - lo) * 0.381966, m2 = lo + (hi - lo) * 0.618034;
-        double c1 = f1 * hypot(0.5 - s[0], m1 - s[1]) + f2 * hypot(p[0] - 0.5, p[1] - m1);
-        double c2 = f1 * hypot(0.5 - s[0], m2 - s[1]) + f2 * hypot(p[0] - 0.5, p[1] - m2);
-        if (c1 < c2)
-            hi = m2;
-        else
-            lo = m1;
-    }
-    return 0.5 * (lo + hi);
-}
-
 /* Snell: per-face costs 1 (x < 0.5) | 2 (x > 0.5). The path bends at the
  * border so that sin(a1) / sin(a2) = F2 / F1 = 2 (angles from the border's
  * normal), and its cost-weighted length matches T(target). */
@@ -310,7 +293,7 @@ static void test_snell(void **state)
             double sin2 = fabs(q2[1] - p2[1]) / hypot(q2[0] - p2[0], q2[1] - p2[1]);
             double sin1 = fabs(q1[1] - p1[1]) / hypot(q1[0] - p1[0], q1[1] - p1[1]);
             double ratio = sin1 / sin2;
-            double y = refraction_y(s, t, 1.0, 2.0);
+            double y = tm_refraction_y(s, t, 1.0, 2.0);
             double exact = hypot(0.5 - s[0], y - s[1]) + 2.0 * hypot(t[0] - 0.5, t[1] - y);
             double Tt = fx.d[tg.vertex];
             max_ratio_err = fmax(max_ratio_err, fabs(ratio - 2.0) / 2.0);

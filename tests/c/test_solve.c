@@ -129,17 +129,7 @@ static void test_components(void **state)
  * (x < 0.5) and f2 (x > 0.5): minimise over the crossing point (Snell). */
 static double refraction_cost(const double *s, const double *p, double f1, double f2)
 {
-    double lo = -2.0, hi = 3.0;
-    for (int it = 0; it < 200; it++) { /* golden section: the cost is convex in y */
-        double m1 = lo + (hi - lo) * 0.381966, m2 = lo + (hi - lo) * 0.618034;
-        double c1 = f1 * hypot(0.5 - s[0], m1 - s[1]) + f2 * hypot(p[0] - 0.5, p[1] - m1);
-        double c2 = f1 * hypot(0.5 - s[0], m2 - s[1]) + f2 * hypot(p[0] - 0.5, p[1] - m2);
-        if (c1 < c2)
-            hi = m2;
-        else
-            lo = m1;
-    }
-    double y = 0.5 * (lo + hi);
+    double y = tm_refraction_y(s, p, f1, f2);
     return f1 * hypot(0.5 - s[0], y - s[1]) + f2 * hypot(p[0] - 0.5, p[1] - y);
 }
 

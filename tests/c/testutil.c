@@ -157,3 +157,28 @@ void tm_fixture_free(tm_fixture *fx)
     mfmm_mesh_destroy(fx->mesh);
     mfmm_gen_free(&fx->g);
 }
+
+void tm_assert_float32_of(const void *buf, const double *ref, size_t total)
+{
+    const float *f = (const float *)buf;
+    for (size_t i = 0; i < total; i++) {
+        float want = (float)ref[i];
+        if (memcmp(&f[i], &want, 4) != 0)
+            fail_msg("entry %zu: %.9g != (float)%.17g", i, f[i], ref[i]);
+    }
+}
+
+double tm_refraction_y(const double *s, const double *p, double f1, double f2)
+{
+    double lo = -2.0, hi = 3.0;
+    for (int it = 0; it < 200; it++) {
+        double m1 = lo + (hi - lo) * 0.381966, m2 = lo + (hi - lo) * 0.618034;
+        double c1 = f1 * hypot(0.5 - s[0], m1 - s[1]) + f2 * hypot(p[0] - 0.5, p[1] - m1);
+        double c2 = f1 * hypot(0.5 - s[0], m2 - s[1]) + f2 * hypot(p[0] - 0.5, p[1] - m2);
+        if (c1 < c2)
+            hi = m2;
+        else
+            lo = m1;
+    }
+    return 0.5 * (lo + hi);
+}

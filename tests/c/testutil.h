@@ -76,6 +76,15 @@ typedef struct tm_fixture {
 tm_fixture tm_fixture_make(mfmm_gen_mesh g, int32_t n_points);
 void tm_fixture_free(tm_fixture *fx);
 
+/* Fails the test unless each of the `total` float32 entries of buf is
+ * (float)ref[i], bit for bit. */
+void tm_assert_float32_of(const void *buf, const double *ref, size_t total);
+
+/* The y where the least-cost path from s (cost f1, x < 0.5) to p (cost f2,
+ * x > 0.5) crosses the line x = 0.5 (Snell), by golden section: the cost is
+ * convex in y. */
+double tm_refraction_y(const double *s, const double *p, double f1, double f2);
+
 /* Writes the path of `relative` (e.g. "meshes/spot.obj") under ../shared into out. */
 void tm_shared_path(char *out, size_t n, const char *relative);
 
