@@ -93,24 +93,25 @@ int mfmm_io_scan_double(const char **p, double *value)
     return 1;
 }
 
+mfmm_status mfmm_io_discard(mfmm_io_vec *verts, mfmm_io_vec *tris, mfmm_status st)
+{
+    mfmm_io_vec_free(verts);
+    mfmm_io_vec_free(tris);
+    return st;
+}
+
 mfmm_status mfmm_io_finish(mfmm_io_vec *verts, mfmm_io_vec *tris, mfmm_io_result *out,
                            mfmm_error *err)
 {
     size_t nv = verts->len / 3, nf = tris->len / 3;
     if (nv == 0) {
-        mfmm_io_vec_free(verts);
-        mfmm_io_vec_free(tris);
-        return mfmm_fail(err, MFMM_ERR_PARSE, -1, "the file has no vertices");
+        return mfmm_io_discard(verts, tris, mfmm_fail(err, MFMM_ERR_PARSE, -1, "the file has no vertices"));
     }
     if (nf == 0) {
-        mfmm_io_vec_free(verts);
-        mfmm_io_vec_free(tris);
-        return mfmm_fail(err, MFMM_ERR_PARSE, -1, "the file has no faces");
+        return mfmm_io_discard(verts, tris, mfmm_fail(err, MFMM_ERR_PARSE, -1, "the file has no faces"));
     }
     if (nv > INT32_MAX || nf > INT32_MAX) {
-        mfmm_io_vec_free(verts);
-        mfmm_io_vec_free(tris);
-        return mfmm_fail(err, MFMM_ERR_PARSE, -1, "the file has more than 2^31-1 vertices or faces");
+        return mfmm_io_discard(verts, tris, mfmm_fail(err, MFMM_ERR_PARSE, -1, "the file has more than 2^31-1 vertices or faces"));
     }
     /* Shrink to fit (failure to shrink is harmless). */
     void *p = realloc(verts->data, nv * 3 * sizeof(double));
@@ -139,11 +140,8 @@ static mfmm_status read_file(const char *path, char **data, size_t *size, mfmm_e
      * (a directory or an unreadable file fails on the first read). */
     size_t cap = 1 << 16, len = 0;
     char *buf = malloc(cap);
-    if (!buf) {
-        fclose(f);
-        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory reading '%.180s'",
-                         path);
-    }
+    if (!buf)
+        goto oom;
     len = fread(buf, 1, cap - 1, f);
     if (len == cap - 1 && fseek(f, 0, SEEK_END) == 0) {
         long end = ftell(f);
@@ -154,12 +152,8 @@ static mfmm_status read_file(const char *path, char **data, size_t *size, mfmm_e
         }
         if (end > 0 && (unsigned long)end > len && (unsigned long)end < SIZE_MAX - 2) {
             char *nb = realloc(buf, (size_t)end + 2); /* room for the NUL and an EOF probe */
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1,
-                                 "out of memory reading '%.180s'", path);
-            }
+            if (!nb)
+                goto oom;
             buf = nb;
             cap = (size_t)end + 2;
         }
@@ -172,12 +166,8 @@ static mfmm_status read_file(const char *path, char **data, size_t *size, mfmm_e
                 return mfmm_fail(err, MFMM_ERR_IO, -1, "'%.180s' is too large", path);
             }
             char *nb = realloc(buf, cap * 2);
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1,
-                                 "out of memory reading '%.180s'", path);
-            }
+            if (!nb)
+                goto oom;
             buf = nb;
             cap *= 2;
         }
@@ -198,6 +188,10 @@ static mfmm_status read_file(const char *path, char **data, size_t *size, mfmm_e
     *data = buf;
     *size = len;
     return MFMM_OK;
+oom:
+    free(buf);
+    fclose(f);
+    return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory reading '%.180s'", path);
 }
 
 static int lower(int c)

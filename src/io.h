@@ -46,6 +46,9 @@ int mfmm_io_scan_int(const char **p, int64_t *value);
  * strtod-accepted text, finiteness is checked by the caller). */
 int mfmm_io_scan_double(const char **p, double *value);
 
+/* Frees both vectors and returns st: a parser's way out on failure. */
+mfmm_status mfmm_io_discard(mfmm_io_vec *verts, mfmm_io_vec *tris, mfmm_status st);
+
 /* Moves the results into out (transfers ownership), checking counts. */
 mfmm_status mfmm_io_finish(mfmm_io_vec *verts, mfmm_io_vec *tris, mfmm_io_result *out,
                            mfmm_error *err);

@@ -470,7 +470,5 @@ mfmm_status mfmm_io_parse_ply(const char *data, size_t size, mfmm_io_result *out
     }
     return mfmm_io_finish(&verts, &tris, out, err);
 fail:
-    mfmm_io_vec_free(&verts);
-    mfmm_io_vec_free(&tris);
-    return st;
+    return mfmm_io_discard(&verts, &tris, st);
 }
