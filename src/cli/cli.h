@@ -50,10 +50,12 @@ int cli_parse_vertex_point(int argc, char **argv, int i, mfmm_source *s);
 int cli_parse_face_point(int argc, char **argv, int i, mfmm_source *s);
 
 /* The positional mesh, --source I, --face-source F W0 W1 W2, --cost FILE,
- * --cost-per-face and -o/--output OUT; `sub` names the subcommand in
- * messages. */
+ * --cost-per-face, -o/--output OUT and --help/-h; `sub` names the
+ * subcommand in messages, `help` prints its help. */
 typedef struct cli_sources_and_cost {
     const char *sub;
+    void (*help)(FILE *out);
+    int help_shown;   /* --help was given: stop with CLI_OK */
     const char *mesh_path;
     const char *out_path;
     const char *cost_path;
@@ -64,11 +66,13 @@ typedef struct cli_sources_and_cost {
 } cli_sources_and_cost;
 
 /* 0, or -1 with "out of memory" printed. argc: the subcommand's. */
-int cli_sources_and_cost_init(cli_sources_and_cost *o, const char *sub, int argc);
+int cli_sources_and_cost_init(cli_sources_and_cost *o, const char *sub, void (*help)(FILE *out),
+                              int argc);
 void cli_sources_and_cost_free(cli_sources_and_cost *o);
 /* Takes argv[*i] (a shared option, with its values, or the mesh) and
  * advances *i past its values; anything else starting with '-' is an unknown
- * option. CLI_OK, or CLI_USAGE with the usage error printed. */
+ * option. CLI_OK, or CLI_USAGE with the usage error printed. On --help it
+ * prints the help on stdout, sets o->help_shown and returns CLI_OK. */
 int cli_sources_and_cost_arg(cli_sources_and_cost *o, int argc, char **argv, int *i);
 /* After the argument loop: a mesh and at least one source. CLI_OK or
  * CLI_USAGE (printed). */

@@ -48,15 +48,11 @@ int cmd_distance(int argc, char **argv)
     cli_sources_and_cost o;
     double *dist = NULL;
     mfmm_mesh *mesh = NULL;
-    if (cli_sources_and_cost_init(&o, "distance", argc))
+    if (cli_sources_and_cost_init(&o, "distance", help, argc))
         return CLI_FAIL;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            help(stdout);
-            rc = CLI_OK;
-            goto done;
-        } else if (strcmp(a, "--max-distance") == 0) {
+        if (strcmp(a, "--max-distance") == 0) {
             if (i + 1 >= argc || !cli_parse_double(argv[i + 1], &opt.max_distance) ||
                 !(opt.max_distance >= 0)) {
                 rc = cli_usage_error("distance", "--max-distance needs a number >= 0");
@@ -65,7 +61,8 @@ int cmd_distance(int argc, char **argv)
             i++;
         } else if (strcmp(a, "--no-unfolding") == 0) {
             opt.unfolding = 0;
-        } else if ((rc = cli_sources_and_cost_arg(&o, argc, argv, &i)) != CLI_OK) {
+        } else if ((rc = cli_sources_and_cost_arg(&o, argc, argv, &i)) != CLI_OK ||
+                   o.help_shown) {
             goto done;
         }
     }

@@ -63,15 +63,11 @@ int cmd_path(int argc, char **argv)
     double *dist = NULL;
     mfmm_surface_point *pts = NULL;
     mfmm_mesh *mesh = NULL;
-    if (cli_sources_and_cost_init(&o, "path", argc))
+    if (cli_sources_and_cost_init(&o, "path", help, argc))
         return CLI_FAIL;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            help(stdout);
-            rc = CLI_OK;
-            goto done;
-        } else if (strcmp(a, "--target") == 0) {
+        if (strcmp(a, "--target") == 0) {
             if (!cli_parse_vertex_point(argc, argv, i, &target)) {
                 rc = cli_usage_error("path", "%s needs a vertex id", a);
                 goto done;
@@ -92,7 +88,8 @@ int cmd_path(int argc, char **argv)
                 goto done;
             }
             i++;
-        } else if ((rc = cli_sources_and_cost_arg(&o, argc, argv, &i)) != CLI_OK) {
+        } else if ((rc = cli_sources_and_cost_arg(&o, argc, argv, &i)) != CLI_OK ||
+                   o.help_shown) {
             goto done;
         }
     }

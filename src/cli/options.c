@@ -28,10 +28,12 @@ int cli_parse_face_point(int argc, char **argv, int i, mfmm_source *s)
     return 1;
 }
 
-int cli_sources_and_cost_init(cli_sources_and_cost *o, const char *sub, int argc)
+int cli_sources_and_cost_init(cli_sources_and_cost *o, const char *sub, void (*help)(FILE *out),
+                              int argc)
 {
     memset(o, 0, sizeof *o);
     o->sub = sub;
+    o->help = help;
     o->src = malloc((size_t)argc * sizeof *o->src); /* at most one per argument */
     if (!o->src) {
         cli_error("out of memory");
@@ -51,7 +53,10 @@ void cli_sources_and_cost_free(cli_sources_and_cost *o)
 int cli_sources_and_cost_arg(cli_sources_and_cost *o, int argc, char **argv, int *i)
 {
     const char *a = argv[*i];
-    if (strcmp(a, "--source") == 0) {
+    if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+        o->help(stdout);
+        o->help_shown = 1;
+    } else if (strcmp(a, "--source") == 0) {
         if (!cli_parse_vertex_point(argc, argv, *i, &o->src[o->n_src]))
             return cli_usage_error(o->sub, "%s needs a vertex id", a);
         o->n_src++;

@@ -246,12 +246,7 @@ static void test_snell(void **state)
         double h = 1.0 / n;
         double *cost = malloc((size_t)fx.g.nf * sizeof *cost);
         assert_non_null(cost);
-        for (int32_t f = 0; f < fx.g.nf; f++) {
-            double cx = 0;
-            for (int k = 0; k < 3; k++)
-                cx += fx.g.V[3 * fx.g.F[3 * f + k]] / 3;
-            cost[f] = cx < 0.5 ? 1.0 : 2.0;
-        }
+        tm_split_face_cost(&fx.g, cost, 1.0, 2.0);
         const double sp[3] = {0.1, 0.1, 0};
         mfmm_source src = tm_vertex_source(tm_nearest_vertex(&fx.g, sp));
         const double *s = fx.g.V + 3 * src.vertex;

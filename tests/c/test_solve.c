@@ -144,12 +144,7 @@ static void test_snell_per_face_cost(void **state)
         double *cost = malloc((size_t)fx.g.nf * sizeof *cost);
         double *e = malloc((size_t)fx.g.nv * sizeof *e);
         assert_true(cost && e);
-        for (int32_t f = 0; f < fx.g.nf; f++) {
-            double cx = 0;
-            for (int k = 0; k < 3; k++)
-                cx += fx.g.V[3 * fx.g.F[3 * f + k]] / 3;
-            cost[f] = cx < 0.5 ? 1.0 : 2.0;
-        }
+        tm_split_face_cost(&fx.g, cost, 1.0, 2.0);
         const double sp[3] = {0.25, 0.25, 0};
         int32_t sv = tm_nearest_vertex(&fx.g, sp);
         const double *s = fx.g.V + 3 * sv;

@@ -168,6 +168,16 @@ void tm_assert_float32_of(const void *buf, const double *ref, size_t total)
     }
 }
 
+void tm_split_face_cost(const mfmm_gen_mesh *g, double *cost, double left, double right)
+{
+    for (int32_t f = 0; f < g->nf; f++) {
+        double cx = 0;
+        for (int k = 0; k < 3; k++)
+            cx += g->V[3 * g->F[3 * f + k]] / 3;
+        cost[f] = cx < 0.5 ? left : right;
+    }
+}
+
 double tm_refraction_y(const double *s, const double *p, double f1, double f2)
 {
     double lo = -2.0, hi = 3.0;

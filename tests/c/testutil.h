@@ -80,6 +80,10 @@ void tm_fixture_free(tm_fixture *fx);
  * (float)ref[i], bit for bit. */
 void tm_assert_float32_of(const void *buf, const double *ref, size_t total);
 
+/* Per-face costs split at x = 0.5: cost[f] = left where the centroid of
+ * face f has x < 0.5, right elsewhere (nf values). */
+void tm_split_face_cost(const mfmm_gen_mesh *g, double *cost, double left, double right);
+
 /* The y where the least-cost path from s (cost f1, x < 0.5) to p (cost f2,
  * x > 0.5) crosses the line x = 0.5 (Snell), by golden section: the cost is
  * convex in y. */
