@@ -36,6 +36,7 @@ void mfmm_matrix_options_init(mfmm_matrix_options *options)
     options->on_rows = NULL;
     options->user = NULL;
     options->backend_used = MFMM_BACKEND_AUTO;
+    options->opencl = NULL;
 }
 
 int mfmm_rows_deliver(const mfmm_rows_job *job, int32_t first, int32_t n, const void *rows)

@@ -1,10 +1,33 @@
 /* The OpenCL backend of mfmm_distance_matrix: device selection, the program
  * (kernels/fmm_rows.cl, embedded at build time) with its binary cached on
  * disk, batches of rows, one work-item per source. Without OpenCL at build
- * time it reports MFMM_ERR_NO_OPENCL. All state lives in one call. */
+ * time it reports MFMM_ERR_NO_OPENCL. The device and the built program live
+ * in an mfmm_opencl_context (the caller's, or one made for the call); a call's
+ * queue, kernel and buffers are its own, so a context serves many threads. */
 #include "opencl_host.h"
 
 #ifndef MESHFMM_HAVE_OPENCL
+
+mfmm_status mfmm_opencl_context_create(mfmm_opencl_context **out, mfmm_error *err)
+{
+    mfmm_ok(err);
+    if (!out)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "out (the context pointer) is NULL");
+    *out = NULL;
+    return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1,
+                     "meshfmm was built without OpenCL (MESHFMM_WITH_OPENCL=OFF or not found)");
+}
+
+void mfmm_opencl_context_destroy(mfmm_opencl_context *context)
+{
+    (void)context;
+}
+
+const char *mfmm_opencl_context_device_name(const mfmm_opencl_context *context)
+{
+    (void)context;
+    return "";
+}
 
 mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *rows_done,
                              mfmm_error *err)
@@ -394,20 +417,29 @@ static mfmm_status build_program(ocl *cl, mfmm_error *err)
     return MFMM_OK;
 }
 
-static void ocl_release(ocl *cl)
+/* Releases what one call made (its queue and kernel). */
+static void ocl_release_call(ocl *cl)
 {
     if (cl->kernel)
         clReleaseKernel(cl->kernel);
-    if (cl->program)
-        clReleaseProgram(cl->program);
     if (cl->queue)
         clReleaseCommandQueue(cl->queue);
+    cl->kernel = NULL;
+    cl->queue = NULL;
+}
+
+static void ocl_release(ocl *cl)
+{
+    ocl_release_call(cl);
+    if (cl->program)
+        clReleaseProgram(cl->program);
     if (cl->context)
         clReleaseContext(cl->context);
     memset(cl, 0, sizeof *cl);
 }
 
-static mfmm_status ocl_open(ocl *cl, int f64, mfmm_error *err)
+/* Device, context and built program. */
+static mfmm_status ocl_open(ocl *cl, mfmm_error *err)
 {
     memset(cl, 0, sizeof *cl);
     mfmm_status st = select_device(cl, err);
@@ -418,17 +450,57 @@ static mfmm_status ocl_open(ocl *cl, int f64, mfmm_error *err)
     if (e != CL_SUCCESS)
         return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1, "clCreateContext on '%s': %s", cl->name,
                          cl_error_name(e));
+    return build_program(cl, err);
+}
+
+/* A call's own queue and kernel on an open context. */
+static mfmm_status ocl_open_call(ocl *cl, int f64, mfmm_error *err)
+{
+    cl_int e;
     cl->queue = clCreateCommandQueue(cl->context, cl->device, 0, &e);
     if (e != CL_SUCCESS)
         return mfmm_fail(err, MFMM_ERR_OPENCL_RUNTIME, -1, "clCreateCommandQueue on '%s': %s",
                          cl->name, cl_error_name(e));
-    st = build_program(cl, err);
-    if (st != MFMM_OK)
-        return st;
     cl->kernel = clCreateKernel(cl->program, f64 ? "fmm_rows_f64" : "fmm_rows_f32", &e);
     if (e != CL_SUCCESS)
         return mfmm_fail(err, MFMM_ERR_OPENCL_BUILD, -1, "clCreateKernel: %s", cl_error_name(e));
     return MFMM_OK;
+}
+
+struct mfmm_opencl_context {
+    ocl cl; /* device, context, program; no queue or kernel */
+};
+
+mfmm_status mfmm_opencl_context_create(mfmm_opencl_context **out, mfmm_error *err)
+{
+    mfmm_ok(err);
+    if (!out)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "out (the context pointer) is NULL");
+    *out = NULL;
+    mfmm_opencl_context *ctx = calloc(1, sizeof *ctx);
+    if (!ctx)
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
+    mfmm_status st = ocl_open(&ctx->cl, err);
+    if (st != MFMM_OK) {
+        ocl_release(&ctx->cl);
+        free(ctx);
+        return st;
+    }
+    *out = ctx;
+    return MFMM_OK;
+}
+
+void mfmm_opencl_context_destroy(mfmm_opencl_context *context)
+{
+    if (!context)
+        return;
+    ocl_release(&context->cl);
+    free(context);
+}
+
+const char *mfmm_opencl_context_device_name(const mfmm_opencl_context *context)
+{
+    return context ? context->cl.name : "";
 }
 
 /* ---- rows ---- */
@@ -487,10 +559,18 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
     const mfmm_mesh *mesh = job->mesh;
     int f64 = job->elem_size == sizeof(double);
     int direct = job->opt->out != NULL;
-    ocl cl;
-    mfmm_status st = ocl_open(&cl, f64, err);
+    mfmm_opencl_context *own = NULL, *ctx = job->opt->opencl;
+    if (!ctx) {
+        mfmm_status cs = mfmm_opencl_context_create(&own, err);
+        if (cs != MFMM_OK)
+            return cs;
+        ctx = own;
+    }
+    ocl cl = ctx->cl; /* shared handles, plus this call's queue and kernel */
+    mfmm_status st = ocl_open_call(&cl, f64, err);
     if (st != MFMM_OK) {
-        ocl_release(&cl);
+        ocl_release_call(&cl);
+        mfmm_opencl_context_destroy(own);
         return st;
     }
     cl_mem mem[MB_COUNT];
@@ -658,7 +738,8 @@ done:
         if (mem[i])
             clReleaseMemObject(mem[i]);
     free(host);
-    ocl_release(&cl);
+    ocl_release_call(&cl);
+    mfmm_opencl_context_destroy(own);
     return st;
 }
 

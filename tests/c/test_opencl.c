@@ -288,6 +288,49 @@ static void remove_cache(void)
     rmdir(cache_dir);
 }
 
+/* A context made once serves several calls (and threads-free reuse): rows
+ * still equal the serial core's; a context's device has a name. */
+static void test_reused_context(void **state)
+{
+    (void)state;
+    mfmm_opencl_context *ctx = NULL;
+    mfmm_error err;
+    mfmm_status st = mfmm_opencl_context_create(&ctx, &err);
+    if (st == MFMM_ERR_NO_OPENCL) {
+        assert_null(ctx);
+        skip();
+    }
+    if (st != MFMM_OK)
+        fail_msg("mfmm_opencl_context_create: %s", err.message);
+    assert_true(strlen(mfmm_opencl_context_device_name(ctx)) > 0);
+    mfmm_gen_mesh g = mfmm_gen_lattice(12, 3.0);
+    mfmm_mesh *mesh = tm_make(&g);
+    int32_t src[7] = {0, 3, 17, 40, 99, 150, 168};
+    double *ref = tm_reference_rows(mesh, src, 7, NULL);
+    double *out = malloc(7 * (size_t)g.nv * sizeof *out);
+    assert_non_null(out);
+    for (int call = 0; call < 3; call++) {
+        mfmm_matrix_options o;
+        mfmm_matrix_options_init(&o);
+        o.backend = MFMM_BACKEND_OPENCL;
+        o.dtype = MFMM_FLOAT64;
+        o.opencl = ctx;
+        o.out = out;
+        memset(out, 0, 7 * (size_t)g.nv * sizeof *out);
+        if (mfmm_distance_matrix(mesh, src, 7, &o, &err) != MFMM_OK)
+            fail_msg("call %d: %s", call, err.message);
+        assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL);
+        assert_memory_equal(out, ref, 7 * (size_t)g.nv * sizeof *out);
+    }
+    free(out);
+    free(ref);
+    mfmm_mesh_destroy(mesh);
+    mfmm_gen_free(&g);
+    mfmm_opencl_context_destroy(ctx);
+    mfmm_opencl_context_destroy(NULL);
+    assert_int_equal(mfmm_opencl_context_create(NULL, &err), MFMM_ERR_NULL_POINTER);
+}
+
 int main(void)
 {
     /* a fresh program cache: the first build is cold, later ones warm */
@@ -300,6 +343,7 @@ int main(void)
         cmocka_unit_test(test_shared_meshes),
         cmocka_unit_test(test_cache_corrupt_and_unwritable),
         cmocka_unit_test(test_device_selection_and_cancel),
+        cmocka_unit_test(test_reused_context),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     remove_cache();

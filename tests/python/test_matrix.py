@@ -126,3 +126,21 @@ def test_no_opencl_device(tmp_path):
                           env=env, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert "OpenCLError" in proc.stdout and "platform" in proc.stdout
+
+
+def test_opencl_context_made_once_per_process():
+    """Every OpenCL call reuses one context (the program is built once per
+    process); rows from repeated calls stay equal to the serial core's."""
+    need_shared()
+    from meshfmm import _mesh
+
+    m = mesh("hand_lowres.obj")
+    ref = rows_of(m, SOURCES)
+    first = None
+    for _ in range(3):
+        D = matrix_or_skip(m, SOURCES, backend="opencl", dtype="float64")
+        assert np.array_equal(D.view(np.uint64), ref.view(np.uint64))
+        ctx = _mesh._shared_opencl_context()
+        assert ctx is not None
+        first = first or ctx.value
+        assert ctx.value == first

@@ -202,6 +202,7 @@ class mfmm_matrix_options(Structure):
         ("on_rows", mfmm_rows_callback),
         ("user", c_void_p),
         ("backend_used", c_enum),
+        ("opencl", c_void_p),  # mfmm_opencl_context *
     ]
 
 
@@ -354,6 +355,12 @@ mfmm_distance_matrix = _proto(
     [c_void_p, c_void_p, c_int32, P(mfmm_matrix_options), P(mfmm_error)],
 )
 # I/O
+mfmm_opencl_context_create = _proto(
+    "mfmm_opencl_context_create", c_enum, [P(c_void_p), P(mfmm_error)]
+)
+mfmm_opencl_context_destroy = _proto("mfmm_opencl_context_destroy", None, [c_void_p])
+mfmm_opencl_context_device_name = _proto("mfmm_opencl_context_device_name", c_char_p, [c_void_p])
+
 mfmm_load_mesh = _proto(
     "mfmm_load_mesh",
     c_enum,

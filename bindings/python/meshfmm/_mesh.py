@@ -5,6 +5,7 @@ All foreign calls go through :mod:`meshfmm._lib`.
 
 from __future__ import annotations
 
+import atexit
 import ctypes
 import dataclasses
 import errno
@@ -624,6 +625,8 @@ class Mesh:
             raise ValueError("memory_limit must be >= 0")
         opts.memory_limit = int(memory_limit)
         opts.out = _addr(out) if out.size else None
+        if opts.backend in (_lib.BACKENDS["auto"], _lib.BACKENDS["opencl"]):
+            opts.opencl = _shared_opencl_context()
 
         caught: List[BaseException] = []
 
@@ -652,6 +655,27 @@ class Mesh:
         name = _lib.mfmm_backend_name(opts.backend_used)
         self.backend_used = name.decode("ascii") if name else None
         return out
+
+
+_opencl_lock = threading.Lock()
+_opencl_context: Optional[ctypes.c_void_p] = None
+
+
+def _shared_opencl_context() -> Optional[ctypes.c_void_p]:
+    """The process's OpenCL context (device and built program), made on first
+    use and reused by every distance_matrix call, so the kernel is built once
+    per process (the C library itself keeps no global state). None when no
+    device works: the library then reports why, or falls back under "auto"."""
+    global _opencl_context
+    with _opencl_lock:
+        if _opencl_context is None:
+            ptr = ctypes.c_void_p()
+            err = _lib.mfmm_error()
+            if _lib.mfmm_opencl_context_create(byref(ptr), byref(err)) != 0 or not ptr:
+                return None
+            _opencl_context = ptr
+            atexit.register(_lib.mfmm_opencl_context_destroy, ptr)
+        return _opencl_context
 
 
 def _index_array(x: Any, what: str) -> np.ndarray:
