@@ -52,23 +52,57 @@ typedef struct result {
     int64_t rows;
     long maxrss_kb; /* the child's own peak */
     double cpu;     /* CPU seconds (user + system) of the timed call */
+    long mesh_kb;   /* resident growth from mfmm_mesh_create: the mesh arrays */
+    long run_kb;    /* peak resident growth during the timed call, above what was
+                       resident before it (mesh, OpenCL runtime, built program) */
 } result;
+
+/* Resident set (VmRSS) or its peak (VmHWM) in kB, from /proc/self/status. */
+static long status_kb(const char *key)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    long kb = -1;
+    size_t n = strlen(key);
+    while (f && fgets(line, sizeof line, f))
+        if (strncmp(line, key, n) == 0 && line[n] == ':')
+            kb = strtol(line + n + 1, NULL, 10);
+    if (f)
+        fclose(f);
+    return kb;
+}
+
+/* Resets VmHWM to the current resident set (Linux: clear_refs 5). */
+static void reset_peak(void)
+{
+    FILE *f = fopen("/proc/self/clear_refs", "w");
+    if (f) {
+        fputs("5", f);
+        fclose(f);
+    }
+}
 
 static size_t memory_limit; /* --memory MB; 0: the library's default */
 
 static void run_child(const char *path, mfmm_backend backend, int threads, int32_t n_rows,
                       int fd)
 {
-    result r = {1, 0.0, 0, 0, 0.0};
+    result r = {1, 0.0, 0, 0, 0.0, 0, 0};
+    mfmm_opencl_context *ctx = NULL;
     double *V = NULL;
     int32_t *F = NULL, nv = 0, nf = 0;
     mfmm_error err;
     mfmm_mesh *mesh = NULL;
-    if (mfmm_load_mesh(path, &V, &nv, &F, &nf, &err) != MFMM_OK ||
-        mfmm_mesh_create(V, nv, F, nf, NULL, &mesh, &err) != MFMM_OK) {
+    if (mfmm_load_mesh(path, &V, &nv, &F, &nf, &err) != MFMM_OK) {
         fprintf(stderr, "%s: %s\n", path, err.message);
         goto out;
     }
+    long rss0 = status_kb("VmRSS");
+    if (mfmm_mesh_create(V, nv, F, nf, NULL, &mesh, &err) != MFMM_OK) {
+        fprintf(stderr, "%s: %s\n", path, err.message);
+        goto out;
+    }
+    r.mesh_kb = status_kb("VmRSS") - rss0;
     mfmm_free(V);
     mfmm_free(F);
     if (n_rows <= 0 || n_rows > nv)
@@ -86,20 +120,30 @@ static void run_child(const char *path, mfmm_backend backend, int threads, int32
     o.on_rows = drop_rows;
     o.user = &r.rows;
     if (backend == MFMM_BACKEND_OPENCL) { /* build (or load) the program first */
+        if (mfmm_opencl_context_create(&ctx, &err) != MFMM_OK) {
+            fprintf(stderr, "%s opencl: %s\n", path, err.message);
+            free(src);
+            goto out;
+        }
+        o.opencl = ctx;
         int64_t warm = 0;
         o.user = &warm;
         mfmm_distance_matrix(mesh, src, 2, &o, &err);
         o.user = &r.rows;
     }
+    reset_peak();
+    long before = status_kb("VmRSS");
     double c0 = cpu_seconds(), t0 = now();
     mfmm_status st = mfmm_distance_matrix(mesh, src, n_rows, &o, &err);
     r.seconds = now() - t0;
     r.cpu = cpu_seconds() - c0;
+    r.run_kb = status_kb("VmHWM") - before;
     if (st != MFMM_OK)
         fprintf(stderr, "%s %s: %s\n", path, mfmm_backend_name(backend), err.message);
     r.status = st;
     free(src);
 out:
+    mfmm_opencl_context_destroy(ctx);
     mfmm_mesh_destroy(mesh);
     struct rusage ru;
     if (getrusage(RUSAGE_SELF, &ru) == 0)
@@ -169,11 +213,12 @@ static void bench_mesh(const char *path, int32_t n_rows, int full)
         if (k == 0)
             serial_rate = rate;
         printf("  %-18s %6lld rows %7.2f s %9.3g entries/s  x%.2f serial  full %s%.1f s  "
-               "%9.3g entries/cpu-s  peak RSS %.1f MiB\n",
+               "%9.3g entries/cpu-s  peak RSS %.1f MiB (the call: +%.1f MiB; mesh arrays "
+               "%.1f MiB)\n",
                runs[k].name, (long long)r.rows, r.seconds, rate,
                serial_rate > 0 ? rate / serial_rate : 0.0, r.rows < nv ? "~" : "",
                (double)nv * nv / rate, r.cpu > 0 ? entries / r.cpu : 0.0,
-               (double)rss / 1024.0);
+               (double)rss / 1024.0, (double)r.run_kb / 1024.0, (double)r.mesh_kb / 1024.0);
     }
 }
 
