@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# The whole comparison against the field, from one command (issue 6):
+#   bash bench/run_all.sh            # ~10-20 minutes on a 2-core machine
+# Sets everything up (scripts/setup.sh: Debian packages, .venv with the peers
+# from requirements-dev.txt, the build), then writes bench/results/*.json,
+# the plots and figures under docs/images/, bench/RESULTS.md and the summary
+# block of README.md (all generated; never edit them by hand).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+bash scripts/setup.sh
+py=.venv/bin/python
+
+# gdist's PyPI wheel (2.1.0) is compiled against numpy 1.x and fails to import
+# under numpy 2 ("numpy.dtype size changed"); rebuilding it from its sdist
+# against the installed numpy fixes that.
+if ! "$py" -c "import gdist" >/dev/null 2>&1; then
+    echo "run_all: gdist does not import with this numpy; rebuilding it from source"
+    "$py" -m pip install -q --no-binary gdist --no-deps --force-reinstall gdist
+fi
+"$py" -c "import gdist, igl, potpourri3d, matplotlib, meshfmm" 
+
+export MESHFMM_CLI="$PWD/build/meshfmm"
+start=$(date +%s)
+step() { echo; echo "== $* ($(( $(date +%s) - start )) s)"; }
+
+step "per-source accuracy and time against the peers"
+"$py" bench/compare_peers.py
+step "all pairs"
+"$py" bench/compare_allpairs.py
+step "paper figures 8b and 10"
+"$py" bench/figures_cost_head.py
+step "plots"
+"$py" bench/plot_bench.py
+step "bench/RESULTS.md and the README block"
+"$py" bench/make_results_md.py
+step "done"
