@@ -103,8 +103,11 @@ MFMM_API void mfmm_mesh_options_init(mfmm_mesh_options *options);
  *   faces:    (nf, 3) int32, row-major, 0-based; copied.
  *   options:  NULL for defaults.
  *   out:      receives the mesh; NULL on failure.
- * Refused: nv < 1, nf < 1, NaN/inf coordinates, indices out of range, a face
- * that repeats a vertex. Accepted: boundaries, several components,
+ * Refused: nv < 1, nf < 1, NaN/inf coordinates (MFMM_ERR_NONFINITE_VERTEX),
+ * coordinates beyond +-1e100 or a bounding box whose diagonal is below 1e-100
+ * (MFMM_ERR_BAD_ARGUMENT: rescale), indices out of
+ * range, a face that repeats a vertex. Results do not depend on the mesh's
+ * scale (a mesh scaled by s gives distances scaled by s). Accepted: boundaries, several components,
  * unreferenced vertices, non-manifold edges, zero-area and needle faces. */
 MFMM_API mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv,
                                       const int32_t *faces, int32_t nf,

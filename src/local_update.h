@@ -88,7 +88,14 @@ MFMM_INLINE double mfmm_triangle_update(double ta, double tb, double a, double b
         s = a; a = b; b = s;
     }
     double edge = mfmm_min(ta + b * f, tb + a * f);
-    double u = tb - ta;
+    if (!(b > 0.0))
+        return edge;
+    /* Eq. 4 is homogeneous of degree 4 in lengths: solve it in units of b,
+     * so that no power of a length overflows or underflows at any scale */
+    double scale = b;
+    a /= scale;
+    double u = (tb - ta) / scale;
+    b = 1.0;
     double sin2 = (1.0 - cos_c) * (1.0 + cos_c);
     /* Eq. 4: q2 t^2 + q1 t + q0 = 0, q2 = c^2 = a^2 + b^2 - 2ab cos theta */
     double q2 = a * a + b * b - 2.0 * a * b * cos_c;
@@ -105,7 +112,7 @@ MFMM_INLINE double mfmm_triangle_update(double ta, double tb, double a, double b
         return edge;
     double x = b * (t - u) / t; /* CD of section 4.1 */
     if (a * cos_c < x && x * cos_c < a)
-        return mfmm_min(ta + t, edge);
+        return mfmm_min(ta + t * scale, edge);
     return edge;
 }
 

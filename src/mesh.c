@@ -8,6 +8,11 @@
 
 #include "mesh.h"
 
+/* Largest coordinate magnitude accepted, and smallest extent: lengths are
+ * squared once (1e200 and 1e-200 are far from overflow and underflow). */
+#define MFMM_MAX_COORDINATE 1e100
+#define MFMM_MIN_DIAGONAL 1e-100
+
 void mfmm_mesh_options_init(mfmm_mesh_options *options)
 {
     if (options)
@@ -193,12 +198,22 @@ static void build_corners(mfmm_mesh *m)
             sub3(e[k], m->xyz + 3 * (size_t)fv[(k + 2) % 3], m->xyz + 3 * (size_t)fv[(k + 1) % 3]);
             len[k] = sqrt(dot3(e[k], e[k]));
         }
-        double cr[3] = {e[0][1] * e[1][2] - e[0][2] * e[1][1], e[0][2] * e[1][0] - e[0][0] * e[1][2],
-                        e[0][0] * e[1][1] - e[0][1] * e[1][0]};
-        double area2 = sqrt(dot3(cr, cr));
+        /* zero area up to rounding (twice the area |e0 x e1| <= 64 eps lmax^2),
+         * tested on unit vectors so that no length is squared twice: no
+         * triangle update there, edges only */
         double lmax = fmax(len[0], fmax(len[1], len[2]));
-        /* zero area up to rounding: no triangle update there, edges only */
-        int degenerate = !(area2 > 64.0 * DBL_EPSILON * lmax * lmax);
+        int degenerate = !(len[0] > 0.0 && len[1] > 0.0);
+        if (!degenerate) {
+            double u0[3], u1[3];
+            for (int d = 0; d < 3; d++) {
+                u0[d] = e[0][d] / len[0];
+                u1[d] = e[1][d] / len[1];
+            }
+            double cr[3] = {u0[1] * u1[2] - u0[2] * u1[1], u0[2] * u1[0] - u0[0] * u1[2],
+                            u0[0] * u1[1] - u0[1] * u1[0]};
+            double sine = sqrt(dot3(cr, cr));
+            degenerate = !(sine > 64.0 * DBL_EPSILON * (lmax / len[0]) * (lmax / len[1]));
+        }
         m->degenerate[f] = (uint8_t)degenerate;
         n_degenerate += degenerate;
         for (int k = 0; k < 3; k++) {
@@ -333,11 +348,18 @@ static mfmm_status build_update_lists(mfmm_mesh *m)
 static mfmm_status validate(const double *vertices, int32_t nv, const int32_t *faces,
                             int32_t nf, mfmm_error *err)
 {
-    for (int64_t i = 0; i < (int64_t)nv * 3; i++)
+    for (int64_t i = 0; i < (int64_t)nv * 3; i++) {
         if (!isfinite(vertices[i]))
             return mfmm_fail(err, MFMM_ERR_NONFINITE_VERTEX, i / 3,
                              "vertex %lld has a coordinate that is NaN or infinite",
                              (long long)(i / 3));
+        /* squared lengths must not overflow */
+        if (fabs(vertices[i]) > MFMM_MAX_COORDINATE)
+            return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, i / 3,
+                             "vertex %lld has a coordinate of magnitude %g; coordinates must be "
+                             "within +-%g (rescale the mesh)",
+                             (long long)(i / 3), fabs(vertices[i]), MFMM_MAX_COORDINATE);
+    }
     for (int64_t f = 0; f < nf; f++) {
         const int32_t *t = faces + 3 * f;
         for (int k = 0; k < 3; k++)
@@ -427,6 +449,15 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
     m->info.bbox_diagonal = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) +
                                  (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                                  (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    /* below this, squared lengths underflow and every edge would measure 0 */
+    if (!(m->info.bbox_diagonal >= MFMM_MIN_DIAGONAL)) {
+        double diag = m->info.bbox_diagonal;
+        mfmm_mesh_destroy(m);
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "the mesh's bounding box diagonal is %g; it must be at least %g "
+                         "(rescale the mesh)",
+                         diag, MFMM_MIN_DIAGONAL);
+    }
     *out = m;
     return MFMM_OK;
 }

@@ -235,6 +235,52 @@ static void test_early_stop(void **state)
     tm_fixture_free(&fx);
 }
 
+/* Distances scale with the mesh, from 1e-90 to 1e90 (Eq. 4 is solved in
+ * units of an edge, so no power of a length overflows); beyond 1e100, or
+ * below a 1e-100 extent, the mesh is refused with a reason. */
+static void test_scale_invariance(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh g = mfmm_gen_lattice(10, 3.0);
+    double *V0 = malloc((size_t)g.nv * 3 * sizeof *V0), *d0 = malloc((size_t)g.nv * sizeof *d0);
+    double *d = malloc((size_t)g.nv * sizeof *d);
+    assert_true(V0 && d0 && d);
+    for (int32_t i = 0; i < 3 * g.nv; i++)
+        V0[i] = g.V[i];
+    mfmm_source src = tm_vertex_source(g.nv / 2);
+    const double scales[] = {1.0, 1e-90, 1e-40, 1e40, 1e90};
+    for (size_t k = 0; k < sizeof scales / sizeof scales[0]; k++) {
+        for (int32_t i = 0; i < 3 * g.nv; i++)
+            g.V[i] = V0[i] * scales[k];
+        mfmm_mesh *mesh = tm_make(&g);
+        mfmm_mesh_info info;
+        mfmm_mesh_get_info(mesh, &info);
+        assert_int_equal(info.n_degenerate_faces, 0);
+        mfmm_solver *solver = NULL;
+        assert_int_equal(mfmm_solver_create(mesh, &solver), MFMM_OK);
+        assert_int_equal(mfmm_solve(solver, &src, 1, NULL, k ? d : d0, NULL), MFMM_OK);
+        for (int32_t v = 0; k && v < g.nv; v++)
+            tm_assert_close(d[v] / scales[k], d0[v], 1e-12 * d0[v]);
+        mfmm_solver_destroy(solver);
+        mfmm_mesh_destroy(mesh);
+    }
+    g.V[7] = 2e100;
+    mfmm_mesh *mesh = NULL;
+    mfmm_error err;
+    assert_int_equal(mfmm_mesh_create(g.V, g.nv, g.F, g.nf, NULL, &mesh, &err),
+                     MFMM_ERR_BAD_ARGUMENT);
+    assert_non_null(strstr(err.message, "rescale"));
+    for (int32_t i = 0; i < 3 * g.nv; i++)
+        g.V[i] = V0[i] * 1e-110;
+    assert_int_equal(mfmm_mesh_create(g.V, g.nv, g.F, g.nf, NULL, &mesh, &err),
+                     MFMM_ERR_BAD_ARGUMENT);
+    assert_non_null(strstr(err.message, "rescale"));
+    free(V0);
+    free(d0);
+    free(d);
+    mfmm_gen_free(&g);
+}
+
 static void expect_mesh_error(const double *V, int32_t nv, const int32_t *F, int32_t nf,
                               mfmm_status want)
 {
@@ -386,6 +432,7 @@ int main(void)
         cmocka_unit_test(test_snell_per_face_cost),
         cmocka_unit_test(test_constant_cost_scales),
         cmocka_unit_test(test_early_stop),
+        cmocka_unit_test(test_scale_invariance),
         cmocka_unit_test(test_bad_meshes),
         cmocka_unit_test(test_degenerate_faces_accepted),
         cmocka_unit_test(test_bad_solves),
