@@ -72,12 +72,23 @@ def _git_commit() -> str:
         return "unknown"
 
 
+def _git_dirty() -> list:
+    """Library sources that differ from the commit (the build is of the working tree)."""
+    try:
+        out = subprocess.run(["git", "-C", str(REPO), "status", "--porcelain", "--", "src",
+                              "include", "kernels", "bindings", "CMakeLists.txt"],
+                             capture_output=True, text=True, timeout=10).stdout
+    except (OSError, subprocess.SubprocessError):
+        return []
+    return [ln[3:] for ln in out.splitlines() if ln.strip()]
+
+
 def versions() -> dict:
     import meshfmm
 
     out = {"python": platform.python_version(), "meshfmm": meshfmm.__version__,
            "meshfmm_library": meshfmm._lib.version(),
-           "meshfmm_git_commit": _git_commit()}
+           "meshfmm_git_commit": _git_commit(), "meshfmm_uncommitted": _git_dirty()}
     for pkg in ("numpy", "scipy", "potpourri3d", "libigl", "gdist", "matplotlib"):
         try:
             out[pkg] = metadata.version(pkg)

@@ -149,7 +149,7 @@ def main():
     # mesh, rows computed (None: all), gdist.local_gdist_matrix radius (fraction of diagonal)
     plan = [("hand_lowres.obj", None, [None, 0.15]),
             ("spot.obj", None, [0.1]),
-            ("nefertiti-lowres.obj", 400, [])]
+            ("nefertiti-lowres.obj", 1000, [])]
     gdist_rows = {"hand_lowres.obj": 16, "spot.obj": 16, "nefertiti-lowres.obj": 4}
     if args.quick:
         plan = [("hand_lowres.obj", None, [0.15]), ("spot.obj", 200, [])]

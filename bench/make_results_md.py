@@ -66,6 +66,10 @@ def machine_line(doc):
 
 def versions_line(doc):
     v = doc["versions"]
+    dirty = v.get("meshfmm_uncommitted")
+    if dirty:
+        v = dict(v, meshfmm_git_commit=f"{v['meshfmm_git_commit']} plus uncommitted changes to "
+                                        + ", ".join(dirty))
     return ", ".join(f"{k} {v[k]}" for k in ("meshfmm", "meshfmm_git_commit", "python", "numpy",
                                            "scipy", "potpourri3d", "libigl", "gdist",
                                            "matplotlib") if k in v)
