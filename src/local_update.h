@@ -92,9 +92,9 @@ MFMM_INLINE double mfmm_triangle_update(double ta, double tb, double a, double b
         return edge;
     /* Eq. 4 is homogeneous of degree 4 in lengths: solve it in units of b,
      * so that no power of a length overflows or underflows at any scale */
-    double scale = b;
-    a /= scale;
-    double u = (tb - ta) / scale;
+    double scale = b, inv = 1.0 / b;
+    a *= inv;
+    double u = (tb - ta) * inv;
     b = 1.0;
     double sin2 = (1.0 - cos_c) * (1.0 + cos_c);
     /* Eq. 4: q2 t^2 + q1 t + q0 = 0, q2 = c^2 = a^2 + b^2 - 2ab cos theta */
@@ -110,8 +110,9 @@ MFMM_INLINE double mfmm_triangle_update(double ta, double tb, double a, double b
     double t = q1 <= 0.0 ? (s - q1) / (2.0 * q2) : (2.0 * q0) / (-q1 - s);
     if (!(t > u)) /* also rejects NaN */
         return edge;
-    double x = b * (t - u) / t; /* CD of section 4.1 */
-    if (a * cos_c < x && x * cos_c < a)
+    /* the test with x = CD = b (t - u) / t of section 4.1, multiplied by t > 0 */
+    double xt = b * (t - u);
+    if (a * cos_c * t < xt && xt * cos_c < a * t)
         return mfmm_min(ta + t * scale, edge);
     return edge;
 }
