@@ -220,9 +220,19 @@ typedef struct mfmm_path_options {
     double *weighted_length;          /* out, may be NULL: the cost-weighted length
                                          (sum of F times segment length; with no cost,
                                          the Euclidean length) */
+    /* 1 (default): straighten the traced path inside the strip of faces it
+     * crossed (unfolded; the shortest polyline through the shared edges, by the
+     * funnel algorithm), which removes the drift that T's first-order error
+     * gives the gradient. Points where the path passes a vertex between faces
+     * without a shared edge stay fixed; with a per-face cost it is straightened
+     * only within runs of equal cost (the crossings of cost borders stay
+     * fixed); with a per-vertex cost it is not straightened. Never longer than
+     * the traced path. 0: the traced path of section 5 as it is. */
+    int straighten;
 } mfmm_path_options;
 
-/* Fills `options` with the defaults: 100000 points, no sources, no cost. */
+/* Fills `options` with the defaults: 100000 points, no sources, no cost,
+ * straighten = 1. */
 MFMM_API void mfmm_path_options_init(mfmm_path_options *options);
 
 /* Backtracks from `target` along -grad T to the source (paper section 5):

@@ -12,7 +12,8 @@ static void help(FILE *out)
     fprintf(out,
             "usage: meshfmm path MESH --source I [--source J ...] [--face-source F W0 W1 W2 ...]\n"
             "                    (--target J | --target-face F W0 W1 W2)\n"
-            "                    [--cost FILE [--cost-per-face]] [--max-points N] -o OUT\n\n"
+            "                    [--cost FILE [--cost-per-face]] [--max-points N] [--no-straighten]\n"
+            "                    -o OUT\n\n"
             "The minimal geodesic from the target back to the nearest source: distances by\n"
             "Fast Marching, then backtracking along -grad T (Heun's method). Prints the\n"
             "path's length on stdout (with --cost: the length and the cost-weighted length).\n\n"
@@ -23,6 +24,8 @@ static void help(FILE *out)
             "  --cost FILE             slowness F (.npy or .txt), per vertex (default) or per\n"
             "                          face (--cost-per-face)\n"
             "  --max-points N          most points the path may have (default 100000)\n"
+            "  --no-straighten         keep the traced path of section 5 (by default it is\n"
+            "                          straightened inside the strip of faces it crossed)\n"
             "  -o OUT                  .csv (face,b0,b1,b2,x,y,z per point, with a header) or\n"
             "                          .obj (v lines and one polyline 'l' element)\n");
 }
@@ -58,6 +61,7 @@ int cmd_path(int argc, char **argv)
 {
     int have_target = 0, rc = CLI_FAIL;
     int32_t max_points = 100000;
+    int straighten = 1;
     mfmm_source target = {0, -1, {0, 0, 0}, 0.0};
     cli_sources_and_cost o;
     double *dist = NULL;
@@ -82,6 +86,8 @@ int cmd_path(int argc, char **argv)
             }
             have_target = 1;
             i += 4;
+        } else if (strcmp(a, "--no-straighten") == 0) {
+            straighten = 0;
         } else if (strcmp(a, "--max-points") == 0) {
             if (i + 1 >= argc || !cli_parse_int32(argv[i + 1], &max_points) || max_points < 1) {
                 rc = cli_usage_error("path", "--max-points needs a number >= 1");
@@ -123,6 +129,7 @@ int cmd_path(int argc, char **argv)
     int32_t n = 0;
     mfmm_error err;
     po.max_points = max_points;
+    po.straighten = straighten;
     po.sources = o.src;
     po.n_sources = o.n_src;
     po.cost = opt.cost;

@@ -21,12 +21,16 @@ static void solve1(tm_fixture *fx, const mfmm_source *src, const mfmm_solve_opti
         fail_msg("mfmm_solve: %s", err.message);
 }
 
-/* Traces with the source given; fails the test on error. Returns the count. */
-static int32_t trace(tm_fixture *fx, const mfmm_source *src, int32_t n_src, const mfmm_source *target,
-                     const double *cost, mfmm_cost_location loc, double *len, double *wlen)
+/* Traces with the source given into `pts` (straightened or not); fails the
+ * test on error. Returns the count. */
+static int32_t trace_into(tm_fixture *fx, mfmm_surface_point *pts, int straighten,
+                          const mfmm_source *src, int32_t n_src, const mfmm_source *target,
+                          const double *cost, mfmm_cost_location loc, double *len, double *wlen)
 {
     mfmm_path_options po;
     mfmm_path_options_init(&po);
+    assert_int_equal(po.straighten, 1);
+    po.straighten = straighten;
     po.sources = src;
     po.n_sources = n_src;
     po.cost = cost;
@@ -34,11 +38,26 @@ static int32_t trace(tm_fixture *fx, const mfmm_source *src, int32_t n_src, cons
     po.weighted_length = wlen;
     int32_t n = 0;
     mfmm_error err;
-    mfmm_status st = mfmm_trace_path(fx->mesh, fx->d, target, &po, fx->pts, CAP, &n, len, &err);
+    mfmm_status st = mfmm_trace_path(fx->mesh, fx->d, target, &po, pts, CAP, &n, len, &err);
     if (st != MFMM_OK)
         fail_msg("mfmm_trace_path: %s", err.message);
     assert_int_equal(err.status, MFMM_OK);
     return n;
+}
+
+/* The default: straightened, into fx->pts. */
+static int32_t trace(tm_fixture *fx, const mfmm_source *src, int32_t n_src, const mfmm_source *target,
+                     const double *cost, mfmm_cost_location loc, double *len, double *wlen)
+{
+    return trace_into(fx, fx->pts, 1, src, n_src, target, cost, loc, len, wlen);
+}
+
+/* The raw traced path of section 5 (straighten = 0), into fx->pts. */
+static int32_t trace_raw(tm_fixture *fx, const mfmm_source *src, int32_t n_src,
+                         const mfmm_source *target, const double *cost, mfmm_cost_location loc,
+                         double *len, double *wlen)
+{
+    return trace_into(fx, fx->pts, 0, src, n_src, target, cost, loc, len, wlen);
 }
 
 static double dist3(const double *a, const double *b)
@@ -106,11 +125,14 @@ static mfmm_source grid_point(const mfmm_gen_mesh *g, double x, double y)
     return s;
 }
 
-/* Flat plane. The tracer alone, on the exact distance |x - s|: every path
- * is the straight segment to the source (deviation a small fraction of h)
- * with the Euclidean length. End to end, on the marched T: lengths within
- * 0.5% of Euclidean, and the deviation (which follows T's own error: its
- * characteristics lean towards the grid's edge directions) shrinks with h. */
+/* Flat plane. The tracer alone (straighten = 0), on the exact distance
+ * |x - s|: every path is the straight segment to the source (deviation a
+ * small fraction of h) with the Euclidean length. End to end, on the marched
+ * T, the traced path: lengths within 0.5% of Euclidean, and the deviation
+ * (which follows T's own error: its characteristics lean towards the grid's
+ * edge directions) shrinks with h, though it grows in units of h. Straightened
+ * (the default): within 0.1 h of the segment and 0.5% of its length at every
+ * n, and never longer than the traced path. */
 static void test_plane_straight(void **state)
 {
     (void)state;
@@ -130,71 +152,86 @@ static void test_plane_straight(void **state)
             } else {
                 solve1(&fx, &src, NULL);
             }
-            uint64_t seed = 12345;
-            double max_dev = 0, max_rel = 0, mean_rel = 0;
-            int count = 0;
-            for (int i = 0; i < 60; i++) {
-                mfmm_source tg;
-                double x = lcg(&seed), y = lcg(&seed);
-                if (i % 2)
-                    tg = tm_vertex_source(tm_nearest_vertex(&fx.g, (double[3]){x, y, 0}));
-                else
-                    tg = grid_point(&fx.g, x, y);
-                double len, wlen;
-                int32_t np = trace(&fx, &src, 1, &tg, NULL, MFMM_COST_NONE, &len, &wlen);
-                check_points(&fx, np);
-                const double *t = fx.pts[0].xyz;
-                double e = dist3(s, t);
-                if (e < 0.2)
-                    continue;
-                assert_true(dist3(fx.pts[np - 1].xyz, s) < 1e-12); /* ends at the source */
-                for (int32_t k = 0; k < np; k++)
-                    max_dev = fmax(max_dev, seg_dist(fx.pts[k].xyz, s, t));
-                double rel = fabs(len - e) / e;
-                max_rel = fmax(max_rel, rel);
-                mean_rel += rel;
-                count++;
-                assert_true(fabs(wlen - len) < 1e-12);
+            /* [0] the traced path, [1] straightened */
+            double max_dev[2] = {0, 0}, max_rel[2] = {0, 0}, mean_rel[2] = {0, 0};
+            for (int straight = 0; straight < 2; straight++) {
+                uint64_t seed = 12345;
+                int count = 0;
+                for (int i = 0; i < 60; i++) {
+                    mfmm_source tg;
+                    double x = lcg(&seed), y = lcg(&seed);
+                    if (i % 2)
+                        tg = tm_vertex_source(tm_nearest_vertex(&fx.g, (double[3]){x, y, 0}));
+                    else
+                        tg = grid_point(&fx.g, x, y);
+                    double len, wlen, raw_len = 0;
+                    if (straight)
+                        trace_raw(&fx, &src, 1, &tg, NULL, MFMM_COST_NONE, &raw_len, NULL);
+                    int32_t np = trace_into(&fx, fx.pts, straight, &src, 1, &tg, NULL,
+                                            MFMM_COST_NONE, &len, &wlen);
+                    check_points(&fx, np);
+                    const double *t = fx.pts[0].xyz;
+                    double e = dist3(s, t);
+                    if (straight)
+                        assert_true(len <= raw_len); /* never longer than the traced path */
+                    if (e < 0.2)
+                        continue;
+                    assert_true(dist3(fx.pts[np - 1].xyz, s) < 1e-12); /* ends at the source */
+                    for (int32_t k = 0; k < np; k++)
+                        max_dev[straight] = fmax(max_dev[straight], seg_dist(fx.pts[k].xyz, s, t));
+                    double rel = fabs(len - e) / e;
+                    max_rel[straight] = fmax(max_rel[straight], rel);
+                    mean_rel[straight] += rel;
+                    count++;
+                    assert_true(fabs(wlen - len) < 1e-12);
+                }
+                mean_rel[straight] /= count;
+                print_message("plane n=%d, %s T, %s: %d paths, max deviation %.4f h (%.5f), "
+                              "length error max %.4f%% mean %.4f%%\n",
+                              n, exact ? "exact" : "marched", straight ? "straightened" : "traced",
+                              count, max_dev[straight] / h, max_dev[straight],
+                              100 * max_rel[straight], 100 * mean_rel[straight]);
             }
-            mean_rel /= count;
-            print_message("plane n=%d, %s T: %d paths, max deviation %.4f h (%.5f), length "
-                          "error max %.4f%% mean %.4f%%\n",
-                          n, exact ? "exact" : "marched", count, max_dev / h, max_dev,
-                          100 * max_rel, 100 * mean_rel);
             if (exact) {
-                assert_true(max_dev < 0.1 * h);
-                assert_true(max_rel < 0.001);
+                assert_true(max_dev[0] < 0.1 * h);
+                assert_true(max_rel[0] < 0.001);
             } else {
                 /* 0.5% is asserted from n = 40 on; at n = 20 (where T itself is
                  * 1.9% off) the worst path measures 0.501%, reported, not hidden */
                 if (n >= 40)
-                    assert_true(max_rel < 0.005);
-                assert_true(max_dev < prev_dev);
-                prev_dev = max_dev;
+                    assert_true(max_rel[0] < 0.005);
+                assert_true(max_dev[0] < prev_dev);
+                prev_dev = max_dev[0];
             }
+            /* straightened: on either field, at every n */
+            assert_true(max_dev[1] < 0.1 * h);
+            assert_true(max_rel[1] < 0.005);
         }
         tm_fixture_free(&fx);
     }
 }
 
 /* Sphere: paths lie on great circles, closer under refinement; at level 5
- * (10242 vertices) lengths are within 1% of the great-circle distance. */
+ * (10242 vertices) lengths are within 1% of the great-circle distance. The
+ * tracer alone (straighten = 0) on the exact field; on the marched field the
+ * traced path and the straightened one (never longer than the traced one;
+ * its distance from the plane and its length error both shrink). */
 static void test_sphere_great_circles(void **state)
 {
     (void)state;
-    double prev = INFINITY;
+    double prev = INFINITY, prev_s = INFINITY, prev_len_s = INFINITY;
     for (int level = 3; level <= 5; level++) {
         tm_fixture fx = tm_fixture_make(mfmm_gen_icosphere(level), CAP);
         const double sp[3] = {0.0, 0.0, 1.0};
         mfmm_source src = tm_vertex_source(tm_nearest_vertex(&fx.g, sp));
         const double *s = fx.g.V + 3 * src.vertex;
-        for (int exact = 1; exact >= 0; exact--) {
-            if (exact)
+        for (int mode = 0; mode < 3; mode++) { /* exact traced, marched traced, straightened */
+            if (mode == 0)
                 for (int32_t v = 0; v < fx.g.nv; v++) {
                     const double *x = fx.g.V + 3 * v;
                     fx.d[v] = acos(fmin(1.0, s[0] * x[0] + s[1] * x[1] + s[2] * x[2]));
                 }
-            else
+            else if (mode == 1)
                 solve1(&fx, &src, NULL);
             double max_plane = 0, max_len = 0;
             for (int i = 0; i < 12; i++) {
@@ -202,9 +239,14 @@ static void test_sphere_great_circles(void **state)
                 double tp[3] = {sin(th) * cos(ph), sin(th) * sin(ph), cos(th)};
                 mfmm_source tg = tm_vertex_source(tm_nearest_vertex(&fx.g, tp));
                 const double *t = fx.g.V + 3 * tg.vertex;
-                double len;
-                int32_t np = trace(&fx, &src, 1, &tg, NULL, MFMM_COST_NONE, &len, NULL);
+                double len, raw_len = 0;
+                if (mode == 2)
+                    trace_raw(&fx, &src, 1, &tg, NULL, MFMM_COST_NONE, &raw_len, NULL);
+                int32_t np = trace_into(&fx, fx.pts, mode == 2, &src, 1, &tg, NULL,
+                                        MFMM_COST_NONE, &len, NULL);
                 check_points(&fx, np);
+                if (mode == 2)
+                    assert_true(len <= raw_len);
                 double nrm[3] = {s[1] * t[2] - s[2] * t[1], s[2] * t[0] - s[0] * t[2],
                                  s[0] * t[1] - s[1] * t[0]};
                 double nn = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
@@ -217,17 +259,26 @@ static void test_sphere_great_circles(void **state)
                 max_len = fmax(max_len, fabs(len - gc) / gc);
                 assert_true(dist3(fx.pts[np - 1].xyz, s) < 1e-12);
             }
-            print_message("icosphere level %d (%d V), %s T: max distance from the great-circle "
+            print_message("icosphere level %d (%d V), %s: max distance from the great-circle "
                           "plane %.5f R, length error max %.4f%%\n",
-                          level, (int)fx.g.nv, exact ? "exact" : "marched", max_plane,
-                          100 * max_len);
-            if (exact) { /* the tracer alone */
+                          level, (int)fx.g.nv,
+                          mode == 0 ? "exact T, traced" : mode == 1 ? "marched T, traced"
+                                                                    : "marched T, straightened",
+                          max_plane, 100 * max_len);
+            if (mode == 0) { /* the tracer alone */
                 assert_true(max_plane < 0.01);
                 assert_true(max_len < 0.0025);
                 continue;
             }
-            assert_true(max_plane < prev);
-            prev = max_plane;
+            if (mode == 1) {
+                assert_true(max_plane < prev);
+                prev = max_plane;
+            } else {
+                assert_true(max_plane < prev_s);
+                assert_true(max_len < prev_len_s);
+                prev_s = max_plane;
+                prev_len_s = max_len;
+            }
             if (level == 5)
                 assert_true(max_len < 0.01);
         }
@@ -247,6 +298,8 @@ static void test_snell(void **state)
         double *cost = malloc((size_t)fx.g.nf * sizeof *cost);
         assert_non_null(cost);
         tm_split_face_cost(&fx.g, cost, 1.0, 2.0);
+        mfmm_surface_point *raw = malloc(CAP * sizeof *raw);
+        assert_non_null(raw);
         const double sp[3] = {0.1, 0.1, 0};
         mfmm_source src = tm_vertex_source(tm_nearest_vertex(&fx.g, sp));
         const double *s = fx.g.V + 3 * src.vertex;
@@ -298,6 +351,36 @@ static void test_snell(void **state)
                           "(%.4f), weighted length %.5f, T %.5f, exact %.5f\n",
                           t[0], t[1], ratio, ycross, y, wlen, Tt, exact);
             assert_true(dist3(fx.pts[np - 1].xyz, s) < 1e-12);
+            /* per-face cost: straightened only within equal cost; the traced
+             * path's crossings of the cost border stay, the cost never grows */
+            double rlen, rwlen;
+            int32_t nr = trace_into(&fx, raw, 0, &src, 1, &tg, cost, MFMM_COST_PER_FACE, &rlen, &rwlen);
+            assert_true(wlen <= rwlen * (1 + 1e-12));
+            int borders = 0;
+            for (int32_t k = 1; k + 1 < nr; k++) {
+                if (cost[raw[k].face] == cost[raw[k + 1].face])
+                    continue;
+                int found = 0;
+                for (int32_t j = 0; j < np; j++)
+                    found |= dist3(fx.pts[j].xyz, raw[k].xyz) == 0.0;
+                assert_true(found);
+                borders++;
+            }
+            assert_true(borders >= 1);
+            /* per-vertex cost: not straightened */
+            double *vcost = malloc((size_t)fx.g.nv * sizeof *vcost);
+            assert_non_null(vcost);
+            for (int32_t v = 0; v < fx.g.nv; v++)
+                vcost[v] = fx.g.V[3 * v] < 0.5 ? 1.0 : 2.0;
+            int32_t n1 = trace_into(&fx, raw, 0, &src, 1, &tg, vcost, MFMM_COST_PER_VERTEX, &rlen, NULL);
+            int32_t n2 = trace_into(&fx, fx.pts, 1, &src, 1, &tg, vcost, MFMM_COST_PER_VERTEX, &len, NULL);
+            assert_int_equal(n1, n2);
+            assert_true(len == rlen);
+            for (int32_t k = 0; k < n1; k++) {
+                assert_int_equal(raw[k].face, fx.pts[k].face);
+                assert_memory_equal(raw[k].bary, fx.pts[k].bary, sizeof raw[k].bary);
+            }
+            free(vcost);
         }
         print_message("Snell grid n=%d: ratio error max %.3f%%, crossing off by %.3f h, "
                       "|weighted length - T| / T max %.4f%%\n",
@@ -305,6 +388,7 @@ static void test_snell(void **state)
         assert_true(max_ratio_err < 0.05);
         assert_true(max_y_err < 2.0);
         assert_true(max_w_err < 0.01);
+        free(raw);
         free(cost);
         tm_fixture_free(&fx);
     }

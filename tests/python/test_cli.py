@@ -86,3 +86,22 @@ def test_cost_and_txt_bitwise_equal(cli, tmp_path):
     run(cli, "distance", MESHES / name, "--source", 131, "--cost", tmp_path / "vcost.npy",
         "-o", tmp_path / "v.npy")
     assert np.load(tmp_path / "v.npy").tobytes() == mesh(name).distance(131, cost=vcost).tobytes()
+
+
+def test_path_straighten_flag(cli, tmp_path):
+    """meshfmm path straightens by default; --no-straighten keeps the traced
+    path; both lengths match Mesh.geodesic_path."""
+    need_shared()
+    from conftest import MESHES
+
+    name = "spot.obj"
+    m = mesh(name)
+    d = m.distance(77)
+    lengths = {}
+    for flag, straighten in (([], True), (["--no-straighten"], False)):
+        out = tmp_path / f"p{int(straighten)}.csv"
+        proc = run(cli, "path", MESHES / name, "--source", 77, "--target", 1500, *flag, "-o", out)
+        lengths[straighten] = float(proc.stdout.split()[0])
+        p = m.geodesic_path(d, 1500, sources=[77], straighten=straighten)
+        assert lengths[straighten] == pytest.approx(p.length, rel=1e-12)
+    assert lengths[True] <= lengths[False]

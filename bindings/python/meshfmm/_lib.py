@@ -180,6 +180,7 @@ class mfmm_path_options(Structure):
         ("cost", c_void_p),  # const double *
         ("cost_location", c_enum),
         ("weighted_length", c_void_p),  # double * (out), may be NULL
+        ("straighten", c_int),
     ]
 
 

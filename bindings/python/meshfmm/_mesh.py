@@ -480,6 +480,7 @@ class Mesh:
         cost: Any = None,
         cost_location: Optional[str] = None,
         max_points: Optional[int] = None,
+        straighten: bool = True,
     ) -> GeodesicPath:
         """Backtracks from ``target`` along -grad T to the source (paper
         section 5) and returns a :class:`GeodesicPath`.
@@ -490,6 +491,13 @@ class Mesh:
             exactly at the nearest one (else where T stops decreasing).
         cost, cost_location: the cost ``distances`` was solved with.
         max_points: most points the path may have (default: the library's).
+        straighten: True (default): the traced path is replaced by the
+            shortest polyline inside the strip of faces it crossed (unfolded,
+            funnel algorithm; rerouted around a vertex where that is shorter),
+            which removes the drift of the first-order T's gradient. With a
+            per-face cost only runs of equal cost are straightened (border
+            crossings stay); with a per-vertex cost nothing is. Never longer
+            than the traced path. False: the raw section-5 path.
 
         Raises ValueError for an unreached (+inf) target, RuntimeError when
         tracing stalls.
@@ -502,6 +510,7 @@ class Mesh:
         _lib.mfmm_path_options_init(byref(opts))
         if max_points is not None:
             opts.max_points = _as_index(max_points, "max_points")
+        opts.straighten = 1 if straighten else 0
         src = None
         if sources is not None:
             src = _source_records(sources)
