@@ -224,10 +224,10 @@ typedef struct mfmm_path_options {
      * crossed (unfolded; the shortest polyline through the shared edges, by the
      * funnel algorithm), which removes the drift that T's first-order error
      * gives the gradient. Points where the path passes a vertex between faces
-     * without a shared edge stay fixed; with a per-face cost it is straightened
-     * only within runs of equal cost (the crossings of cost borders stay
-     * fixed); with a per-vertex cost it is not straightened. Never longer than
-     * the traced path. 0: the traced path of section 5 as it is. */
+     * without a shared edge stay fixed. With a cost array the path is not
+     * straightened (a weighted path refracts where the cost changes, which the
+     * traced path does and straight chords do not). Never longer than the
+     * traced path. 0: the traced path of section 5 as it is. */
     int straighten;
 } mfmm_path_options;
 
