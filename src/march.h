@@ -159,11 +159,9 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
         if (stop_at_targets && (lx & MFMM_TARGET) && --s->targets_left == 0)
             break;
         mfmm_i32 end = m->update_offset[x + 1];
-        /* The march waits on corner records (cache misses). Ask for this
-         * vertex's, and for those of the likely next one, the new heap top,
-         * one iteration ahead. */
-        for (mfmm_i32 j = m->update_offset[x]; j < end; j++)
-            MFMM_PREFETCH(m->corners + m->update_corner[2 * j]);
+        /* The march waits on corner records (cache misses). The next vertex
+         * to settle is almost always the new heap top: ask for its records
+         * one iteration ahead (this vertex's were asked for last iteration). */
         if (s->heap_size > 0) {
             mfmm_i32 y = s->heap_vertex[0];
             for (mfmm_i32 j = m->update_offset[y]; j < m->update_offset[y + 1]; j++)
