@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "opencl_host.h"
+#include "solve.h"
 
 const char *mfmm_backend_name(mfmm_backend backend)
 {
@@ -83,10 +84,10 @@ static void fill_solve_options(const mfmm_rows_job *job, mfmm_solve_options *so)
 }
 
 /* Solves row r into dst (elem_size per entry); tmp is an nv float64 row
- * for float32 output. */
-static mfmm_status solve_row(const mfmm_rows_job *job, mfmm_solver *solver,
-                             const mfmm_solve_options *so, int32_t r, void *dst, double *tmp,
-                             mfmm_error *err)
+ * for float32 output. The job was checked once, in mfmm_distance_matrix, so
+ * rows skip mfmm_solve's checks (the cost array alone is nv or nf values). */
+static void solve_row(const mfmm_rows_job *job, mfmm_solver *solver,
+                      const mfmm_solve_options *so, int32_t r, void *dst, double *tmp)
 {
     mfmm_source src;
     memset(&src, 0, sizeof src);
@@ -94,15 +95,14 @@ static mfmm_status solve_row(const mfmm_rows_job *job, mfmm_solver *solver,
     src.face = -1;
     src.value = 0.0;
     int32_t nv = job->mesh->nv;
-    if (job->elem_size == sizeof(double))
-        return mfmm_solve(solver, &src, 1, so, (double *)dst, err);
-    mfmm_status st = mfmm_solve(solver, &src, 1, so, tmp, err);
-    if (st == MFMM_OK) {
-        float *f = (float *)dst;
-        for (int32_t v = 0; v < nv; v++)
-            f[v] = (float)tmp[v];
+    if (job->elem_size == sizeof(double)) {
+        mfmm_solve_checked(solver, &src, 1, so, (double *)dst);
+        return;
     }
-    return st;
+    mfmm_solve_checked(solver, &src, 1, so, tmp);
+    float *f = (float *)dst;
+    for (int32_t v = 0; v < nv; v++)
+        f[v] = (float)tmp[v];
 }
 
 /* ---- serial: one solver, this thread ---- */
@@ -134,9 +134,7 @@ static mfmm_status run_serial(const mfmm_rows_job *job, int32_t start, mfmm_erro
         int32_t n = job->n_sources - first < block ? job->n_sources - first : block;
         char *base = direct ? (char *)job->opt->out + (size_t)first * row_bytes : buf;
         for (int32_t i = 0; i < n; i++) {
-            st = solve_row(job, solver, &so, first + i, base + (size_t)i * row_bytes, tmp, err);
-            if (st != MFMM_OK)
-                goto done;
+            solve_row(job, solver, &so, first + i, base + (size_t)i * row_bytes, tmp);
         }
         if (mfmm_rows_deliver(job, first, n, base)) {
             st = mfmm_fail(err, MFMM_ERR_CANCELLED, first, "cancelled by the row callback");
@@ -204,8 +202,6 @@ static void *pool_worker(void *arg)
     const mfmm_rows_job *job = p->job;
     mfmm_solver *solver = NULL;
     double *tmp = NULL;
-    mfmm_error e;
-    mfmm_ok(&e);
     mfmm_status st = mfmm_solver_create(job->mesh, &solver);
     if (st == MFMM_OK && job->elem_size != sizeof(double)) {
         tmp = malloc((size_t)job->mesh->nv * sizeof *tmp);
@@ -226,12 +222,8 @@ static void *pool_worker(void *arg)
         }
         p->next_row++;
         pthread_mutex_unlock(&p->mu);
-        st = solve_row(job, solver, &so, r, row_dest(p, r), tmp, &e);
+        solve_row(job, solver, &so, r, row_dest(p, r), tmp);
         pthread_mutex_lock(&p->mu);
-        if (st != MFMM_OK) {
-            pool_failed(p, st, &e);
-            break;
-        }
         if (++p->done[b & 1] == block_len(p, b))
             pthread_cond_broadcast(&p->cv_main);
     }
@@ -380,29 +372,11 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
                                  "source %d is vertex %d, outside [0, %d)", (int)i,
                                  (int)sources[i], (int)nv);
     }
-    const double *cost = NULL;
-    int cost_location = 0;
-    if (o->cost) {
-        int32_t n_cost;
-        if (o->cost_location == MFMM_COST_PER_VERTEX)
-            n_cost = nv;
-        else if (o->cost_location == MFMM_COST_PER_FACE)
-            n_cost = mesh->nf;
-        else if (o->cost_location == MFMM_COST_NONE)
-            return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
-                             "a cost array was given without a cost location "
-                             "(per vertex or per face)");
-        else
-            return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "unknown cost location %d",
-                             (int)o->cost_location);
-        for (int32_t i = 0; i < n_cost; i++)
-            if (!(isfinite(o->cost[i]) && o->cost[i] > 0.0))
-                return mfmm_fail(err, MFMM_ERR_BAD_COST, i,
-                                 "cost[%d] = %g; costs must be finite and > 0", (int)i,
-                                 o->cost[i]);
-        cost = o->cost;
-        cost_location = (int)o->cost_location;
-    }
+    const double *cost = o->cost;
+    int cost_location = cost ? (int)o->cost_location : 0;
+    mfmm_status cst = mfmm_check_cost(mesh, cost, o->cost_location, err);
+    if (cst != MFMM_OK)
+        return cst;
 
     int32_t *all = NULL;
     if (!sources) {

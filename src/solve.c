@@ -236,7 +236,17 @@ mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources, int32_t 
         if (st != MFMM_OK)
             return st;
     }
+    mfmm_solve_checked(solver, sources, n_sources, &opt, distances);
+    return MFMM_OK;
+}
 
+void mfmm_solve_checked(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
+                        const mfmm_solve_options *options, double *distances)
+{
+    const mfmm_mesh *mesh = solver->mesh;
+    mfmm_solve_options opt = *options;
+    if (!opt.cost)
+        opt.cost_location = MFMM_COST_NONE;
     mfmm_march_state s;
     s.T = distances;
     s.label = solver->label;
@@ -259,7 +269,6 @@ mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources, int32_t 
         mfmm_seed_source(mesh, &s, sources + i);
     mfmm_march_mesh mm = mfmm_mesh_march_view(mesh);
     mfmm_march_run(&s, &mm);
-    return MFMM_OK;
 }
 
 const mfmm_mesh *mfmm_solver_mesh(const mfmm_solver *solver)

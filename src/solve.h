@@ -16,6 +16,11 @@ mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int
 /* Seeds a checked source into a reset march state (cost fields set). */
 void mfmm_seed_source(const mfmm_mesh *mesh, mfmm_march_state *st, const mfmm_source *src);
 
+/* mfmm_solve without the checks, for callers that checked the arguments
+ * once for many solves (the matrix backends). options must not be NULL. */
+void mfmm_solve_checked(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
+                        const mfmm_solve_options *options, double *distances);
+
 /* The mesh a solver was made for. */
 const mfmm_mesh *mfmm_solver_mesh(const mfmm_solver *solver);
 
