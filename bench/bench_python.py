@@ -32,18 +32,11 @@ from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[1]
-SHARED = Path(os.environ.get("MESHFMM_SHARED_DIR", REPO.parent / "shared"))
-MESHES = [
-    "hand_lowres.obj",
-    "spot.obj",
-    "wingnut.obj",
-    "fertility_FE_10k.off",
-    "decimated-max.obj",
-    "camelhead.off",
-    "nefertiti-lowres.obj",
-    "stanford-bunny.obj",
-]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from benchlib import REPO, SHARED, SHARED_MESHES  # noqa: E402
+
+# the manifold meshes with stored exact references (not beetle, not igea)
+MESHES = [m for m in SHARED_MESHES if m not in ("beetle.obj", "igea.ply")]
 
 import meshfmm  # noqa: E402
 from meshfmm import _lib  # noqa: E402
