@@ -270,8 +270,3 @@ void mfmm_solve_checked(mfmm_solver *solver, const mfmm_source *sources, int32_t
     mfmm_march_mesh mm = mfmm_mesh_march_view(mesh);
     mfmm_march_run(&s, &mm);
 }
-
-const mfmm_mesh *mfmm_solver_mesh(const mfmm_solver *solver)
-{
-    return solver ? solver->mesh : NULL;
-}

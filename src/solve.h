@@ -21,7 +21,4 @@ void mfmm_seed_source(const mfmm_mesh *mesh, mfmm_march_state *st, const mfmm_so
 void mfmm_solve_checked(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
                         const mfmm_solve_options *options, double *distances);
 
-/* The mesh a solver was made for. */
-const mfmm_mesh *mfmm_solver_mesh(const mfmm_solver *solver);
-
 #endif
