@@ -44,11 +44,11 @@ message(STATUS "meshfmm: OpenCL backend on (${OpenCL_LIBRARIES})")
 set(MESHFMM_KERNEL_C ${CMAKE_CURRENT_BINARY_DIR}/generated/fmm_rows_cl.c)
 add_custom_command(OUTPUT ${MESHFMM_KERNEL_C}
   COMMAND ${CMAKE_COMMAND} -DKERNEL=${CMAKE_CURRENT_SOURCE_DIR}/kernels/fmm_rows.cl
-          -DSRC_DIR=${CMAKE_CURRENT_SOURCE_DIR}/src -DOUT=${MESHFMM_KERNEL_C}
+          -DSRC_DIR=${CMAKE_CURRENT_SOURCE_DIR}/src/core -DOUT=${MESHFMM_KERNEL_C}
           -P ${CMAKE_CURRENT_SOURCE_DIR}/cmake/opencl.cmake
   DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/kernels/fmm_rows.cl
-          ${CMAKE_CURRENT_SOURCE_DIR}/src/local_update.h
-          ${CMAKE_CURRENT_SOURCE_DIR}/src/march.h
+          ${CMAKE_CURRENT_SOURCE_DIR}/src/core/local_update.h
+          ${CMAKE_CURRENT_SOURCE_DIR}/src/core/march.h
           ${CMAKE_CURRENT_SOURCE_DIR}/cmake/opencl.cmake
   COMMENT "Embedding kernels/fmm_rows.cl"
   VERBATIM)

@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
-#include "../generate.h" /* internal; the CLI target has no src/ include path */
+#include "io/generate.h"
 
 static void help(FILE *out)
 {

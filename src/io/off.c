@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "io.h"
-#include "mesh.h"
+#include "core/mesh.h"
 
 typedef struct off_cursor {
     const char *p, *end;

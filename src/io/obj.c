@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "io.h"
-#include "mesh.h"
+#include "core/mesh.h"
 
 static int is_blank(char c)
 {

@@ -4,7 +4,7 @@
  * time it reports MFMM_ERR_NO_OPENCL. The device and the built program live
  * in an mfmm_opencl_context (the caller's, or one made for the call); a call's
  * queue, kernel and buffers are its own, so a context serves many threads. */
-#include "opencl_host.h"
+#include "rows.h"
 
 #ifndef MESHFMM_HAVE_OPENCL
 

@@ -1,9 +1,10 @@
-/* Internal: the row engines of mfmm_distance_matrix (src/matrix.c) and the
- * OpenCL backend (src/opencl_host.c). */
-#ifndef MFMM_OPENCL_HOST_H
-#define MFMM_OPENCL_HOST_H
+/* Internal: a validated many-source job and the delivery of its rows
+ * (rows.c), shared by the CPU engines (matrix.c) and the OpenCL backend
+ * (opencl_host.c). */
+#ifndef MFMM_MATRIX_ROWS_H
+#define MFMM_MATRIX_ROWS_H
 
-#include "mesh.h"
+#include "core/mesh.h"
 
 /* A validated matrix job. */
 typedef struct mfmm_rows_job {

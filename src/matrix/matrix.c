@@ -6,8 +6,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "opencl_host.h"
-#include "solve.h"
+#include "rows.h"
+#include "core/solve.h"
 
 const char *mfmm_backend_name(mfmm_backend backend)
 {
@@ -38,21 +38,6 @@ void mfmm_matrix_options_init(mfmm_matrix_options *options)
     options->user = NULL;
     options->backend_used = MFMM_BACKEND_AUTO;
     options->opencl = NULL;
-}
-
-int mfmm_rows_deliver(const mfmm_rows_job *job, int32_t first, int32_t n, const void *rows)
-{
-    const mfmm_matrix_options *o = job->opt;
-    size_t row_bytes = (size_t)job->mesh->nv * job->elem_size;
-    if (o->out) {
-        char *dst = (char *)o->out + (size_t)first * row_bytes;
-        if (dst != (const char *)rows)
-            memcpy(dst, rows, (size_t)n * row_bytes);
-        rows = dst;
-    }
-    if (o->on_rows)
-        return o->on_rows(o->user, first, n, rows);
-    return 0;
 }
 
 /* Rows per block for the CPU engines: the budget less the solvers'

@@ -1,0 +1,30 @@
+/* Small surface-point helpers shared by path tracing (trace.c) and
+ * straightening (straighten.c). */
+#ifndef MFMM_PATHS_SURFACE_H
+#define MFMM_PATHS_SURFACE_H
+
+#include <math.h>
+
+#include "core/mesh.h"
+
+#define ON_EDGE 1e-12 /* barycentric coordinate treated as 0 (on the edge) */
+
+static inline double mfmm_dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static inline double mfmm_dist3(const double *a, const double *b)
+{
+    double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+    return sqrt(mfmm_dot3(d, d));
+}
+
+static inline void mfmm_bary_to_xyz(const mfmm_mesh *m, int32_t f, const double b[3], double x[3])
+{
+    for (int i = 0; i < 3; i++)
+        x[i] = 0.0;
+    for (int k = 0; k < 3; k++) {
+        const double *X = m->xyz + 3 * (size_t)m->faces[3 * f + k];
+        for (int i = 0; i < 3; i++)
+            x[i] += b[k] * X[i];
+    }
+}
+
+#endif
