@@ -5,7 +5,7 @@
  *
  *   bench_allpairs [--rows N] [--full] [--memory MB] [MESH ...]
  *
- * Default meshes: camelhead.off and nefertiti-lowres.obj from ../shared.
+ * Default meshes: camelhead.off and nefertiti-lowres.obj from tests/data/meshes.
  * --rows: rows per run (spread over the mesh), extrapolated to nv x nv;
  * --full: all nv rows with OpenCL and threads (slow on big meshes);
  * --memory: the memory_limit passed to the library. */
@@ -240,13 +240,13 @@ int main(int argc, char **argv)
     }
     static char defaults[2][1024];
     if (n == 0) {
-        /* ../shared/meshes beside the repository holding this file */
+        /* tests/data/meshes beside the repository holding this file */
         const char *names[2] = {"camelhead.off", "nefertiti-lowres.obj"};
         const char *file = __FILE__;
         const char *cut = strstr(file, "/bench/bench_allpairs.c");
         int len = cut ? (int)(cut - file) : 0;
         for (int k = 0; k < 2; k++) {
-            snprintf(defaults[k], sizeof defaults[k], "%.*s/../shared/meshes/%s", len, file,
+            snprintf(defaults[k], sizeof defaults[k], "%.*s/tests/data/meshes/%s", len, file,
                      names[k]);
             meshes[n++] = defaults[k];
         }

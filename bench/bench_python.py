@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """meshfmm from Python against geometry-central (potpourri3d), in one process.
 
-For each mesh of ../shared/meshes: the median time per source of
+For each mesh of tests/data/meshes: the median time per source of
 ``Mesh.distance`` against potpourri3d's fast marching
 (MeshFastMarchingDistanceSolver) and heat method (MeshHeatMethodDistanceSolver,
 timed after its precompute: solver built and one solve done), with the mean
@@ -33,10 +33,10 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from benchlib import REPO, SHARED, SHARED_MESHES  # noqa: E402
+from benchlib import REPO, DATA, DATA_MESHES  # noqa: E402
 
 # the manifold meshes with stored exact references (not beetle, not igea)
-MESHES = [m for m in SHARED_MESHES if m not in ("beetle.obj", "igea.ply")]
+MESHES = [m for m in DATA_MESHES if m not in ("beetle.obj", "igea.ply")]
 
 import meshfmm  # noqa: E402
 from meshfmm import _lib  # noqa: E402
@@ -65,7 +65,7 @@ def timed(fn, *args):
 def bench_mesh(name, n_sources, repeats):
     import potpourri3d as pp3d
 
-    V, F = meshfmm.load_mesh(SHARED / "meshes" / name)
+    V, F = meshfmm.load_mesh(DATA / "meshes" / name)
     V2, F2, old_of_new, new_of_old = compact(V, F)
     t_build, mesh = timed(meshfmm.Mesh, V, F)
     t_gc_build, fmm = timed(pp3d.MeshFastMarchingDistanceSolver, V2, F2)
@@ -102,7 +102,7 @@ def bench_mesh(name, n_sources, repeats):
     row["speedup_vs_gc_fmm"] = row["gc_fmm_s"] / row["meshfmm_s"]
     row["speedup_vs_gc_heat"] = row["gc_heat_s"] / row["meshfmm_s"]
     row["meshfmm_vertices_per_s"] = V.shape[0] / row["meshfmm_s"]
-    ref = SHARED / "reference" / (Path(name).stem + ".npz")
+    ref = DATA / "reference" / (Path(name).stem + ".npz")
     if ref.is_file():
         z = np.load(ref)
         errs = {"meshfmm": [], "gc_fmm": [], "gc_heat": []}
@@ -231,8 +231,8 @@ def main():
     ap.add_argument("--large", action="store_true", help="also igea.ply (134k vertices)")
     ap.add_argument("-o", default=str(REPO / "bench" / "results" / "python_speed.json"))
     args = ap.parse_args()
-    if not (SHARED / "meshes").is_dir():
-        sys.exit(f"no meshes at {SHARED / 'meshes'} (set MESHFMM_SHARED_DIR)")
+    if not (DATA / "meshes").is_dir():
+        sys.exit(f"no meshes at {DATA / 'meshes'} (set MESHFMM_TEST_DATA_DIR)")
     meshes = list(args.meshes) + (["igea.ply"] if args.large else [])
 
     rows = {}

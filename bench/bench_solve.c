@@ -1,7 +1,7 @@
 /* One serial solve, timed: median of repeats on a built mesh, in vertices per
  * second (issue 2's figure of merit). Usage:
  *   bench_solve [--repeats R] [--sources S] MESH...
- * With no MESH, the larger meshes of ../shared/meshes and generated spheres. */
+ * With no MESH, the larger meshes of tests/data/meshes and generated spheres. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -9,7 +9,7 @@
 #include <time.h>
 
 #include "meshfmm.h"
-#include "generate.h"
+#include "io/generate.h"
 
 static double now(void)
 {
@@ -89,10 +89,10 @@ int main(int argc, char **argv)
         fprintf(stderr, "repeats and sources must be >= 1\n");
         return 2;
     }
-    static const char *defaults[] = {"../shared/meshes/camelhead.off",
-                                     "../shared/meshes/nefertiti-lowres.obj",
-                                     "../shared/meshes/stanford-bunny.obj",
-                                     "../shared/meshes/igea.ply"};
+    static const char *defaults[] = {"tests/data/meshes/camelhead.off",
+                                     "tests/data/meshes/nefertiti-lowres.obj",
+                                     "tests/data/meshes/stanford-bunny.obj",
+                                     "tests/data/meshes/igea.ply"};
     const char **paths = (const char **)(argv + first);
     int n_paths = argc - first;
     if (n_paths == 0) {

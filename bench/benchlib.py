@@ -14,13 +14,13 @@ from pathlib import Path
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
-SHARED = Path(os.environ.get("MESHFMM_SHARED_DIR", REPO.parent / "shared"))
+DATA = REPO / "tests" / "data"  # meshes/ and reference/ (copied into the repository)
 RESULTS = REPO / "bench" / "results"
 IMAGES = REPO / "docs" / "images"
 CLI = Path(os.environ.get("MESHFMM_CLI", REPO / "build" / "meshfmm"))
 
-# every mesh of ../shared/meshes, smallest first
-SHARED_MESHES = [
+# every mesh of tests/data/meshes, smallest first
+DATA_MESHES = [
     "hand_lowres.obj",
     "beetle.obj",
     "spot.obj",
@@ -137,10 +137,10 @@ def compact(V: np.ndarray, F: np.ndarray):
     return np.ascontiguousarray(V[old_of_new]), new_of_old[F].astype(np.int64), old_of_new, new_of_old
 
 
-def load_shared(name: str):
+def load_data(name: str):
     import meshfmm
 
-    return meshfmm.load_mesh(SHARED / "meshes" / name)
+    return meshfmm.load_mesh(DATA / "meshes" / name)
 
 
 def generate(shape: str, n: int, workdir: Path):

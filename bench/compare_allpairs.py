@@ -60,7 +60,7 @@ def run_child_rss(cmd, env=None):
 def worker(kind, mesh_name, rows_file, out_file, radius):
     import meshfmm
 
-    V, F = meshfmm.load_mesh(bl.SHARED / "meshes" / mesh_name)
+    V, F = meshfmm.load_mesh(bl.DATA / "meshes" / mesh_name)
     V, F, old_of_new, new_of_old = bl.compact(V, F)
     rows = np.load(rows_file) if rows_file != "-" else None
     res = {}
@@ -165,14 +165,14 @@ def main():
         out_file = tmp / "D.npy"
         # warm the OpenCL program cache so no run below pays for the kernel build
         try:
-            meshfmm_run(bl.SHARED / "meshes" / "hand_lowres.obj", "opencl", None, out_file)
+            meshfmm_run(bl.DATA / "meshes" / "hand_lowres.obj", "opencl", None, out_file)
             have_opencl = True
         except RuntimeError as exc:
             have_opencl = False
             log(f"OpenCL unavailable: {exc}")
         base_wall, base_rss, _ = py_worker("baseline", "hand_lowres.obj", None, out_file)
         for name, n_rows, radii in plan:
-            path = bl.SHARED / "meshes" / name
+            path = bl.DATA / "meshes" / name
             V, F = meshfmm.load_mesh(path)
             Vc, Fc, old_of_new, new_of_old = bl.compact(V, F)
             nv = V.shape[0]

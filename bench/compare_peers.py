@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Per-source accuracy and time of meshfmm against the libraries a user would
-use instead, on every mesh of ../shared/meshes and on generated families.
+use instead, on every mesh of tests/data/meshes and on generated families.
 
 Methods (same source vertices for all; several fixed sources per mesh):
   meshfmm            Mesh.distance (FMM with unfolding of obtuse angles)
@@ -11,7 +11,7 @@ Methods (same source vertices for all; several fixed sources per mesh):
   gdist              gdist.compute_gdist (exact, MMP)
   igl_exact          igl.exact_geodesic (exact, MMP; the reference where it runs)
 
-References: ../shared/reference (igl.exact_geodesic, with the stored timings of
+References: tests/data/reference (igl.exact_geodesic, with the stored timings of
 index.json), great-circle distance on icospheres, Euclidean distance on the
 planar stretched lattice, igl.exact_geodesic run here on the small sine
 surfaces, and gdist (the same exact polyhedral distance; the agreement with
@@ -209,7 +209,7 @@ def run_case(case, rounds, exact_plan, log):
         row["methods"][m] = out
     if ref_time is not None:  # the stored igl.exact_geodesic timing (index.json)
         row["methods"].setdefault("igl_exact", {}).update(
-            {"time_s": ref_time, "timing_from": "stored (../shared/reference/index.json)"})
+            {"time_s": ref_time, "timing_from": "stored (tests/data/reference/index.json)"})
     row["reference_available"] = [k for k in range(len(sources)) if refs[k] is not None]
     if "check" in case:
         row["reference_check"] = case["check"](results)
@@ -231,14 +231,14 @@ def nearest(V, points):
 
 
 def shared_cases(index, log):
-    for name in bl.SHARED_MESHES:
-        path = bl.SHARED / "meshes" / name
+    for name in bl.DATA_MESHES:
+        path = bl.DATA / "meshes" / name
         if not path.is_file():
             log(f"missing {path}")
             continue
-        V, F = bl.load_shared(name)
+        V, F = bl.load_data(name)
         _, _, old_of_new, new_of_old = bl.compact(V, F)
-        ref_path = bl.SHARED / "reference" / (Path(name).stem + ".npz")
+        ref_path = bl.DATA / "reference" / (Path(name).stem + ".npz")
         case = {"family": "shared", "name": name, "V": V, "F": F}
         if ref_path.is_file():
             z = np.load(ref_path)
@@ -354,7 +354,7 @@ def main():
     sizes = {"sphere": [4, 5, 6, 7], "lattice": [50, 100, 200, 400], "sine": [50, 100, 200, 500]}
     if args.quick:
         sizes = {"sphere": [3, 4], "lattice": [20, 40], "sine": [20, 40]}
-    index = json.loads((bl.SHARED / "reference" / "index.json").read_text())
+    index = json.loads((bl.DATA / "reference" / "index.json").read_text())
     t_start = now()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:

@@ -7,7 +7,7 @@
   (F1 sin a1 = F2 sin a2, angles from the edge's normal), which the figure checks
   numerically. -> docs/images/fig8b_snell_polyhedron.png
 - Fig. 10: distance isolines and minimal geodesics on a head
-  (../shared/meshes/decimated-max.obj, the Max Planck head with very skinny
+  (tests/data/meshes/decimated-max.obj, the Max Planck head with very skinny
   triangles). -> docs/images/fig10_head_paths.png
 
 Both are drawn with bench/render.py (a z-buffer, so hidden curves stay hidden).
@@ -185,7 +185,7 @@ def fig8b(out: Path, record: dict) -> Path:
 # ---------------------------------------------------------------- Fig. 10
 def fig10(out: Path, record: dict) -> Path:
     name = "decimated-max.obj"
-    V, F = bl.load_shared(name)
+    V, F = bl.load_data(name)
     mesh = meshfmm.Mesh(V, F)
     # the face looks towards -z, y is up
     src = int(np.argmin(V[:, 2]))  # the tip of the nose

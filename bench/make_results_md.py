@@ -169,7 +169,7 @@ def render_summary(peers):
     text += (" Times are one thread each, medians over rounds of all sources; heat methods after "
              "their precompute (shown for nefertiti, with setup + one solve: meshfmm's setup is "
              "its mesh build, the heat methods' their factorisations); the exact methods' times are per source too "
-             "(igl.exact_geodesic's from ../shared/reference/index.json).")
+             "(igl.exact_geodesic's from tests/data/reference/index.json).")
     return text
 
 
@@ -315,9 +315,9 @@ def main():
          "diagonal, `100 max |d−e| / diag`, the worst over the sources. Every method gets the "
          "same source vertices (3 per mesh). Times are medians per source, one thread, "
          "from Python (meshfmm through its ctypes binding, the peers through theirs).", "",
-         "## Summary (meshes of ../shared/meshes)", "", summary, "",
+         "## Summary (meshes of tests/data/meshes)", "", summary, "",
          "## Per mesh", "",
-         per_mesh_tables(peers, "shared", "Meshes of ../shared/meshes"),
+         per_mesh_tables(peers, "shared", "Meshes of tests/data/meshes"),
          per_mesh_tables(peers, "sphere", "Icospheres (analytic great-circle distance)"),
          per_mesh_tables(peers, "lattice",
                          "Stretched obtuse lattice (x stretched 3x: every triangle has a 120° "

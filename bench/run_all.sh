@@ -24,6 +24,8 @@ export MESHFMM_CLI="$PWD/build/meshfmm"
 start=$(date +%s)
 step() { echo; echo "== $* ($(( $(date +%s) - start )) s)"; }
 
+step "accuracy against the stored exact references (pytest)"
+MESHFMM_ACCURACY_JSON="$PWD/bench/results/accuracy_python.json" "$py" -m pytest -q tests/python/test_accuracy.py
 step "per-source accuracy and time against the peers"
 "$py" bench/compare_peers.py
 step "all pairs"

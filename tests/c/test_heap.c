@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <cmocka.h>
 
-#include "march.h"
+#include "core/march.h"
 
 #define N 2000
 

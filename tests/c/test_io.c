@@ -113,7 +113,7 @@ static void test_shared_meshes(void **state)
     };
     for (size_t i = 0; i < sizeof meshes / sizeof meshes[0]; i++) {
         char path[1024];
-        snprintf(path, sizeof path, "%s/meshes/%s", MESHFMM_SHARED_DIR, meshes[i].name);
+        snprintf(path, sizeof path, "%s/meshes/%s", MESHFMM_TEST_DATA_DIR, meshes[i].name);
         clock_t t0 = clock();
         loaded r = load(path);
         double secs = (double)(clock() - t0) / CLOCKS_PER_SEC;
@@ -145,20 +145,20 @@ static void test_shared_mesh_records(void **state)
 {
     (void)state;
     char path[1024];
-    snprintf(path, sizeof path, "%s/meshes/spot.obj", MESHFMM_SHARED_DIR);
+    snprintf(path, sizeof path, "%s/meshes/spot.obj", MESHFMM_TEST_DATA_DIR);
     loaded r = load(path);
     assert_int_equal(r.st, MFMM_OK);
     assert_vertex(&r, 0, 0.348799, -0.334989, -0.0832331);
     assert_face(&r, 0, 738, 734, 735); /* "f 739/1 735/2 736/3" */
     unload(&r);
-    snprintf(path, sizeof path, "%s/meshes/camelhead.off", MESHFMM_SHARED_DIR);
+    snprintf(path, sizeof path, "%s/meshes/camelhead.off", MESHFMM_TEST_DATA_DIR);
     r = load(path);
     assert_int_equal(r.st, MFMM_OK);
     assert_vertex(&r, 0, -0.105873, 0.121359, 0.0271172);
     assert_vertex(&r, 8, 6.14986e-005, -0.105286, 0.256351);
     assert_face(&r, 0, 691, 2839, 2841);
     unload(&r);
-    snprintf(path, sizeof path, "%s/meshes/igea.ply", MESHFMM_SHARED_DIR);
+    snprintf(path, sizeof path, "%s/meshes/igea.ply", MESHFMM_TEST_DATA_DIR);
     r = load(path);
     assert_int_equal(r.st, MFMM_OK);
     assert_vertex(&r, 0, (double)0.008178f, (double)-0.049651f, (double)0.014658f);

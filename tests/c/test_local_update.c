@@ -7,7 +7,7 @@
 #include <stddef.h>
 #include <cmocka.h>
 
-#include "local_update.h"
+#include "core/local_update.h"
 #include "testutil.h"
 
 static const double PI = 3.14159265358979323846;

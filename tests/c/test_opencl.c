@@ -1,6 +1,6 @@
 /* The OpenCL backend against mfmm_solve rows: float64 bit for bit (memcmp),
  * float32 = (float)float64, on generated meshes and on meshes from
- * ../shared/meshes (with boundary, with many obtuse corners), with costs and
+ * tests/data/meshes (with boundary, with many obtuse corners), with costs and
  * max_distance; the program cache cold, warm and corrupt; device selection;
  * cancellation. Skipped when this machine has no OpenCL device. */
 #include <dirent.h>
@@ -146,7 +146,7 @@ static void test_shared_meshes(void **state)
     const char *names[2] = {"meshes/hand_lowres.obj", "meshes/wingnut.obj"};
     for (int m = 0; m < 2; m++) {
         int32_t nf = 0;
-        mfmm_mesh *mesh = tm_load_shared(names[m], NULL, &nf, NULL);
+        mfmm_mesh *mesh = tm_load_data(names[m], NULL, &nf, NULL);
         mfmm_mesh_info info;
         assert_int_equal(mfmm_mesh_get_info(mesh, &info), MFMM_OK);
         if (m == 0)

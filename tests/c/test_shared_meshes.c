@@ -1,4 +1,4 @@
-/* Every mesh of ../shared/meshes (real, imperfect: boundaries, holes,
+/* Every mesh of tests/data/meshes (real, imperfect: boundaries, holes,
  * non-manifold edges, unreferenced vertices, needles) loads, and a solve
  * gives finite values on the source's component, +inf elsewhere, never NaN. */
 #include <math.h>
@@ -9,13 +9,13 @@
 #include <stdlib.h>
 #include <cmocka.h>
 
-#include "mesh.h"
+#include "core/mesh.h"
 #include "testutil.h"
 
 static void check_mesh(const char *file, int32_t want_components, int32_t want_unreferenced)
 {
     int32_t *F = NULL, nv = 0, nf = 0;
-    mfmm_mesh *mesh = tm_load_shared(file, &nv, &nf, &F);
+    mfmm_mesh *mesh = tm_load_data(file, &nv, &nf, &F);
     mfmm_mesh_info info;
     mfmm_mesh_get_info(mesh, &info);
     print_message("%-24s nv=%6d nf=%6d components=%d boundary=%d nonmanifold=%d unref=%d "

@@ -80,16 +80,16 @@ double tm_fitted_order(const double *h, const double *err, int n)
     return (n * sxy - sx * sy) / (n * sxx - sx * sx);
 }
 
-void tm_shared_path(char *out, size_t n, const char *relative)
+void tm_data_path(char *out, size_t n, const char *relative)
 {
-    snprintf(out, n, "%s/%s", MESHFMM_SHARED_DIR, relative);
+    snprintf(out, n, "%s/%s", MESHFMM_TEST_DATA_DIR, relative);
 }
 
-mfmm_mesh *tm_load_shared(const char *relative, int32_t *nv_out, int32_t *nf_out,
+mfmm_mesh *tm_load_data(const char *relative, int32_t *nv_out, int32_t *nf_out,
                           int32_t **F_out)
 {
     char path[1024];
-    tm_shared_path(path, sizeof path, relative);
+    tm_data_path(path, sizeof path, relative);
     double *V = NULL;
     int32_t *F = NULL, nv = 0, nf = 0;
     mfmm_error err;

@@ -7,7 +7,7 @@
 #include <math.h>
 #include <stdint.h>
 #include "meshfmm.h"
-#include "generate.h"
+#include "io/generate.h"
 
 #define TM_PI 3.14159265358979323846
 
@@ -39,11 +39,11 @@ double tm_max_error(const double *d, const double *exact, int32_t n, double diam
 /* Least-squares slope of log(err) against log(h): the order of convergence. */
 double tm_fitted_order(const double *h, const double *err, int n);
 
-/* Loads ../shared/<relative> (e.g. "meshes/spot.obj") into an mfmm_mesh
+/* Loads tests/data/<relative> (e.g. "meshes/spot.obj") into an mfmm_mesh
  * (default options); fails the test ("PATH: message") on error. nv_out,
  * nf_out: the counts (either may be NULL). F_out: when not NULL, receives
  * the face array (free with mfmm_free); otherwise it is freed. */
-mfmm_mesh *tm_load_shared(const char *relative, int32_t *nv_out, int32_t *nf_out,
+mfmm_mesh *tm_load_data(const char *relative, int32_t *nv_out, int32_t *nf_out,
                           int32_t **F_out);
 
 /* Rows from mfmm_solve (float64, n x nv), one per vertex source src[i]
@@ -89,7 +89,7 @@ void tm_split_face_cost(const mfmm_gen_mesh *g, double *cost, double left, doubl
  * convex in y. */
 double tm_refraction_y(const double *s, const double *p, double f1, double f2);
 
-/* Writes the path of `relative` (e.g. "meshes/spot.obj") under ../shared into out. */
-void tm_shared_path(char *out, size_t n, const char *relative);
+/* Writes the path of `relative` (e.g. "meshes/spot.obj") under tests/data into out. */
+void tm_data_path(char *out, size_t n, const char *relative);
 
 #endif

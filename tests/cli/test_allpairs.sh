@@ -6,14 +6,14 @@
 #   test_allpairs.sh MESHFMM SHARED_DIR [PYTHON]
 set -u
 M=$1
-SHARED=$2
+DATA=$2
 PY=${3:-}
 if [ -n "$PY" ] && ! "$PY" -c "import numpy" >/dev/null 2>&1; then PY=; fi
 T=$(mktemp -d /tmp/mfmm_allpairs.XXXXXX)
 trap 'rm -rf "$T"' EXIT
 export MESHFMM_CACHE_DIR="$T/cache"
-MESH="$SHARED/meshes/hand_lowres.obj"
-BIG="$SHARED/meshes/camelhead.off"
+MESH="$DATA/meshes/hand_lowres.obj"
+BIG="$DATA/meshes/camelhead.off"
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
 # float64 rows of a few sources, on every backend

@@ -4,7 +4,7 @@
 # distances on a generated grid against the exact values along its edges.
 set -u
 BIN=${1:?usage: test_cli.sh MESHFMM SHARED_DIR}
-SHARED=${2:?usage: test_cli.sh MESHFMM SHARED_DIR}
+DATA=${2:?usage: test_cli.sh MESHFMM SHARED_DIR}
 [ -x "$BIN" ] || { echo "FAIL: no executable $BIN"; exit 1; }
 T=$(mktemp -d "${TMPDIR:-/tmp}/mfmm_cli.XXXXXX") || exit 1
 trap 'rm -rf "$T"' EXIT INT TERM
@@ -48,15 +48,15 @@ expect 2 "no command" "$BIN"
 expect 2 "unknown command" "$BIN" frobnicate
 expect 2 "info without a mesh" "$BIN" info
 expect 2 "info unknown option" "$BIN" info --bogus x.obj
-expect 2 "distance without a source" "$BIN" distance "$SHARED/meshes/hand_lowres.obj" -o "$T/d.txt"
-expect 2 "distance without -o" "$BIN" distance "$SHARED/meshes/hand_lowres.obj" --source 0
-expect 2 "distance bad output extension" "$BIN" distance "$SHARED/meshes/hand_lowres.obj" --source 0 -o "$T/d.csv"
-expect 2 "distance bad source number" "$BIN" distance "$SHARED/meshes/hand_lowres.obj" --source 1x -o "$T/d.txt"
+expect 2 "distance without a source" "$BIN" distance "$DATA/meshes/hand_lowres.obj" -o "$T/d.txt"
+expect 2 "distance without -o" "$BIN" distance "$DATA/meshes/hand_lowres.obj" --source 0
+expect 2 "distance bad output extension" "$BIN" distance "$DATA/meshes/hand_lowres.obj" --source 0 -o "$T/d.csv"
+expect 2 "distance bad source number" "$BIN" distance "$DATA/meshes/hand_lowres.obj" --source 1x -o "$T/d.txt"
 expect 2 "generate unknown shape" "$BIN" generate cube 3 -o "$T/c.obj"
 expect 2 "generate bad N" "$BIN" generate grid 0 -o "$T/c.obj"
 
 # ---- info on hand_lowres.obj: README counts ----
-if expect 0 "info hand_lowres.obj" "$BIN" info "$SHARED/meshes/hand_lowres.obj"; then
+if expect 0 "info hand_lowres.obj" "$BIN" info "$DATA/meshes/hand_lowres.obj"; then
     for kv in "vertices=810" "faces=1602" "edges=2411" "boundary edges=16" "components=1" \
               "non-manifold edges=0" "unreferenced vertices=0"; do
         k=${kv%=*}; v=${kv#*=}
@@ -64,15 +64,15 @@ if expect 0 "info hand_lowres.obj" "$BIN" info "$SHARED/meshes/hand_lowres.obj";
         [ "$got" = "$v" ] && ok "info: $k = $v" || fail "info: $k = '$got', want $v"
     done
 fi
-if expect 0 "info --json" "$BIN" info --json "$SHARED/meshes/hand_lowres.obj"; then
+if expect 0 "info --json" "$BIN" info --json "$DATA/meshes/hand_lowres.obj"; then
     grep -q '"vertices": 810, "faces": 1602, "edges": 2411, "boundary_edges": 16, "nonmanifold_edges": 0, "components": 1' "$T/out" &&
         ok "info --json counts" || fail "info --json: $(cat "$T/out")"
 fi
 # beetle: 2 components, 47 non-manifold edges; bunny: 1113 unreferenced vertices.
-expect 0 "info beetle.obj" "$BIN" info "$SHARED/meshes/beetle.obj" &&
+expect 0 "info beetle.obj" "$BIN" info "$DATA/meshes/beetle.obj" &&
     { [ "$(value components "$T/out")" = 2 ] && [ "$(value "non-manifold edges" "$T/out")" = 47 ] &&
       ok "beetle counts" || fail "beetle counts: $(cat "$T/out")"; }
-expect 0 "info stanford-bunny.obj" "$BIN" info "$SHARED/meshes/stanford-bunny.obj" &&
+expect 0 "info stanford-bunny.obj" "$BIN" info "$DATA/meshes/stanford-bunny.obj" &&
     { [ "$(value "unreferenced vertices" "$T/out")" = 1113 ] && ok "bunny unreferenced" ||
       fail "bunny unreferenced: $(cat "$T/out")"; }
 
@@ -81,7 +81,7 @@ printf '' >"$T/empty.obj"
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n' >"$T/range.obj"
 printf 'OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n' >"$T/nan.off"
 printf 'ply\nformat binary_little_endian 1.0\nelement vertex 2147483647\nproperty float x\nend_header\n' >"$T/huge.ply"
-head -c 1000 "$SHARED/meshes/igea.ply" >"$T/cut.ply"
+head -c 1000 "$DATA/meshes/igea.ply" >"$T/cut.ply"
 head -c 3000 /dev/urandom >"$T/noise.off" 2>/dev/null || printf '\001\002garbage' >"$T/noise.off"
 for f in empty.obj range.obj nan.off huge.ply cut.ply noise.off missing.obj; do
     expect 1 "info $f fails" "$BIN" info "$T/$f"

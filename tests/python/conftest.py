@@ -1,8 +1,8 @@
 """Shared fixtures for the meshfmm Python tests.
 
-The meshes and exact references live in the shared folder beside the
-repository (``../shared``, or ``$MESHFMM_SHARED_DIR``); tests that need them
-skip with a reason when it is absent. For a development build without
+The meshes and exact references live in the repository, in tests/data
+(copied from the project's reference shelf with their licences; see
+tests/data/meshes/README.md); a missing file is a failure, not a skip. For a development build without
 ``pip install .``, point ``MESHFMM_LIBRARY`` at a built libmeshfmm and put
 ``bindings/python`` on ``PYTHONPATH``.
 """
@@ -17,11 +17,11 @@ import numpy as np
 import pytest
 
 REPO = Path(__file__).resolve().parents[2]
-SHARED = Path(os.environ.get("MESHFMM_SHARED_DIR", REPO.parent / "shared")).resolve()
-MESHES = SHARED / "meshes"
-REFERENCE = SHARED / "reference"
+DATA = (REPO / "tests" / "data").resolve()
+MESHES = DATA / "meshes"
+REFERENCE = DATA / "reference"
 
-# Every mesh of ../shared/meshes with its role in the tests.
+# Every mesh of tests/data/meshes with its role in the tests.
 MANIFOLD_MESHES = [
     "hand_lowres.obj",
     "spot.obj",
@@ -38,21 +38,21 @@ NONMANIFOLD_MESHES = ["beetle.obj"]
 LARGE_MESHES = ["igea.ply"]
 
 
-def need_shared() -> None:
+def need_data() -> None:
     if not MESHES.is_dir():
-        pytest.skip(f"shared meshes not found at {MESHES} (set MESHFMM_SHARED_DIR)")
+        pytest.fail(f"test meshes not found at {MESHES}")
 
 
 @pytest.fixture(scope="session")
 def meshes_dir() -> Path:
-    need_shared()
+    need_data()
     return MESHES
 
 
 @pytest.fixture(scope="session")
 def reference_dir() -> Path:
     if not REFERENCE.is_dir():
-        pytest.skip(f"shared references not found at {REFERENCE} (set MESHFMM_SHARED_DIR)")
+        pytest.fail(f"stored references not found at {REFERENCE}")
     return REFERENCE
 
 
@@ -61,7 +61,7 @@ def load(name: str):
     """(V, F) of a shared mesh through meshfmm's own readers (cached)."""
     import meshfmm
 
-    need_shared()
+    need_data()
     V, F = meshfmm.load_mesh(MESHES / name)
     V.setflags(write=False)
     F.setflags(write=False)
@@ -108,9 +108,11 @@ def errors(d: np.ndarray, e: np.ndarray, diameter: float):
 
 
 # ------------------------------------------------------- accuracy table
-# Filled by test_accuracy.py; printed and written at the end of the session.
+# Filled by test_accuracy.py; printed at the end of the session, and written
+# only where $MESHFMM_ACCURACY_JSON names a file (tests write nothing tracked;
+# bench/run_all.sh sets it to bench/results/accuracy_python.json).
 ACCURACY: dict = {}
-ACCURACY_JSON = REPO / "bench" / "results" / "accuracy_python.json"
+ACCURACY_JSON = os.environ.get("MESHFMM_ACCURACY_JSON")
 
 
 def _accuracy_table() -> str:
@@ -142,24 +144,27 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
         "MRE: mean relative error (%), mean over the sources; max: max error in % of the "
         "bounding-box diagonal, max over the sources; ratio: geometry-central / meshfmm"
     )
+    if not ACCURACY_JSON:
+        return
+    path = Path(ACCURACY_JSON)
     try:
-        ACCURACY_JSON.parent.mkdir(parents=True, exist_ok=True)
+        path.parent.mkdir(parents=True, exist_ok=True)
         doc = {
             "metrics": {
                 "mean_rel_error_pct": "100/N sum |d-e|/e over vertices with e > 0, averaged over sources",
                 "max_error_pct_diameter": "100 max |d-e| / bounding-box diagonal (referenced vertices), max over sources",
             },
-            "reference": "igl.exact_geodesic (stored in ../shared/reference)",
+            "reference": "igl.exact_geodesic (stored in tests/data/reference)",
             "competitor": "potpourri3d.MeshFastMarchingDistanceSolver (geometry-central FMM)",
             "meshes": {},
         }
-        if ACCURACY_JSON.is_file():  # a partial run updates its meshes only
+        if path.is_file():  # a partial run updates its meshes only
             try:
-                doc["meshes"] = json.loads(ACCURACY_JSON.read_text()).get("meshes", {})
+                doc["meshes"] = json.loads(path.read_text()).get("meshes", {})
             except ValueError:
                 pass
         doc["meshes"].update(ACCURACY)
-        ACCURACY_JSON.write_text(json.dumps(doc, indent=1) + "\n")
-        terminalreporter.write_line(f"written to {ACCURACY_JSON}")
-    except OSError as exc:  # read-only checkout: the table above is the record
-        terminalreporter.write_line(f"could not write {ACCURACY_JSON}: {exc}")
+        path.write_text(json.dumps(doc, indent=1) + "\n")
+        terminalreporter.write_line(f"written to {path}")
+    except OSError as exc:
+        terminalreporter.write_line(f"could not write {path}: {exc}")

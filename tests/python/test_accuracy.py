@@ -26,7 +26,7 @@ from conftest import (
     errors,
     load,
     mesh,
-    need_shared,
+    need_data,
     reference,
 )
 
@@ -71,7 +71,7 @@ def diameter(name: str) -> float:
 
 @pytest.mark.parametrize("name", MANIFOLD_MESHES)
 def test_against_exact_and_geometry_central(name):
-    need_shared()
+    need_data()
     sources, exact = reference(name)
     m = mesh(name)
     assert m.info.n_nonmanifold_edges == 0
@@ -183,7 +183,7 @@ def test_nonmanifold_beetle_solves():
     """beetle: non-manifold, two components. It loads, its diagnostics say
     so, and a solve is finite on the source's component, +inf on the other,
     never NaN."""
-    need_shared()
+    need_data()
     m = mesh("beetle.obj")
     info = m.info
     assert info.n_nonmanifold_edges == 47
@@ -227,7 +227,7 @@ def test_nonmanifold_beetle_solves():
 def test_large_mesh_solves(name):
     """igea (134k vertices, PLY tristrips): no stored reference; it loads and
     a solve is finite everywhere (closed, one component)."""
-    need_shared()
+    need_data()
     m = mesh(name)
     assert m.n_faces == 268686 and m.info.n_components == 1
     d = m.distance(0)

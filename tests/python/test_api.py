@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import meshfmm
-from conftest import load, need_shared
+from conftest import load, need_data
 
 
 def grid(n: int = 8):

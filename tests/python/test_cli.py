@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import meshfmm
-from conftest import REPO, load, mesh, need_shared
+from conftest import REPO, load, mesh, need_data
 
 
 def find_cli():
@@ -56,7 +56,7 @@ CASES = [
 
 @pytest.mark.parametrize("name,args,kwargs", CASES, ids=[f"{c[0]}{c[1]}" for c in CASES])
 def test_distance_bitwise_equal(cli, tmp_path, name, args, kwargs):
-    need_shared()
+    need_data()
     from conftest import MESHES
 
     out = tmp_path / "d.npy"
@@ -68,7 +68,7 @@ def test_distance_bitwise_equal(cli, tmp_path, name, args, kwargs):
 
 
 def test_cost_and_txt_bitwise_equal(cli, tmp_path):
-    need_shared()
+    need_data()
     from conftest import MESHES
 
     name = "fertility_FE_10k.off"
@@ -91,7 +91,7 @@ def test_cost_and_txt_bitwise_equal(cli, tmp_path):
 def test_path_straighten_flag(cli, tmp_path):
     """meshfmm path straightens by default; --no-straighten keeps the traced
     path; both lengths match Mesh.geodesic_path."""
-    need_shared()
+    need_data()
     from conftest import MESHES
 
     name = "spot.obj"

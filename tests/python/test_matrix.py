@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import meshfmm
-from conftest import MESHES, mesh, need_shared
+from conftest import MESHES, mesh, need_data
 from test_cli import find_cli
 
 SOURCES = [0, 17, 400, 809, 3, 17]
@@ -37,7 +37,7 @@ def matrix_or_skip(m, *args, **kw):
 @pytest.mark.parametrize("backend", ["serial", "threads", "opencl", "auto"])
 @pytest.mark.parametrize("name", ["hand_lowres.obj", "wingnut.obj"])
 def test_rows_equal_distance(name, backend):
-    need_shared()
+    need_data()
     m = mesh(name)
     src = SOURCES if name == "hand_lowres.obj" else [5, 80, 2593, 1000]
     ref = rows_of(m, src)
@@ -53,7 +53,7 @@ def test_rows_equal_distance(name, backend):
 
 @pytest.mark.parametrize("backend", ["threads", "opencl"])
 def test_costs_and_max_distance(backend):
-    need_shared()
+    need_data()
     m = mesh("hand_lowres.obj")
     rng = np.random.default_rng(4)
     cost = rng.uniform(0.5, 3.0, m.n_faces)
@@ -65,7 +65,7 @@ def test_costs_and_max_distance(backend):
 
 
 def test_memmap_out_all_vertices(tmp_path):
-    need_shared()
+    need_data()
     m = mesh("hand_lowres.obj")
     n = m.n_vertices
     path = tmp_path / "all.npy"
@@ -83,7 +83,7 @@ def test_memmap_out_all_vertices(tmp_path):
 
 
 def test_cli_agrees(tmp_path):
-    need_shared()
+    need_data()
     cli = find_cli()
     if cli is None:
         pytest.skip("no meshfmm command line found (set MESHFMM_CLI or build with CMake)")
@@ -131,7 +131,7 @@ def test_no_opencl_device(tmp_path):
 def test_opencl_context_made_once_per_process():
     """Every OpenCL call reuses one context (the program is built once per
     process); rows from repeated calls stay equal to the serial core's."""
-    need_shared()
+    need_data()
     from meshfmm import _mesh
 
     m = mesh("hand_lowres.obj")

@@ -1,4 +1,4 @@
-"""Mesh.geodesic_path (paper section 5) on every manifold mesh of ../shared/meshes
+"""Mesh.geodesic_path (paper section 5) on every manifold mesh of tests/data/meshes
 against the stored exact distances (igl.exact_geodesic): 20 random targets
 each from the stored source."""
 

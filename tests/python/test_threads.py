@@ -7,11 +7,11 @@ import threading
 import numpy as np
 
 import meshfmm
-from conftest import mesh, need_shared
+from conftest import mesh, need_data
 
 
 def test_four_threads_equal_serial():
-    need_shared()
+    need_data()
     m = mesh("camelhead.off")
     rng = np.random.default_rng(5)
     sources = [int(s) for s in rng.choice(m.n_vertices, size=24, replace=False)]
@@ -48,7 +48,7 @@ def test_four_threads_equal_serial():
 def test_close_while_busy_is_refused():
     """close() from one thread while another computes raises instead of
     freeing the mesh under it."""
-    need_shared()
+    need_data()
     from conftest import load
 
     V, F = load("nefertiti-lowres.obj")
