@@ -1,0 +1,452 @@
+"""Distance matrices on a Dask cluster, written into a Zarr v3 array.
+
+``distance_matrix(mesh, store, ...)`` splits the rows into blocks; each block
+is one task that computes its rows with the in-process backends (threads or
+OpenCL inside the worker) and writes them into its own chunk of the array, so
+tasks are independent, idempotent and retryable (the model of Dask's own
+array code). The mesh goes to each worker once, as V and F, and is built once
+per worker.
+
+Resuming: the array's attributes record the job (mesh hash, sources, targets,
+options, meshfmm version). Chunks carry a CRC-32C (Zarr's crc32c codec) and
+the array's fill value is NaN, which the library never returns, so a block is
+complete exactly when its chunk reads back without a checksum error and
+without NaN. Re-running the same job skips those blocks; a different job on
+the same store is refused.
+
+Needs ``dask[distributed]`` and ``zarr>=3``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import sys
+import time
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from . import __version__
+from ._mesh import Mesh
+
+__all__ = ["distance_matrix", "job_description", "complete_blocks", "symmetrize"]
+
+JOB_ATTR = "meshfmm_job"
+RUN_ATTR = "meshfmm_last_run"
+# Bytes of one block: large enough that scheduling is noise, small enough
+# that a 2-worker cluster gets many tasks and a lost worker loses little.
+_BLOCK_BYTES = 8 << 20
+
+
+def _sha256(*arrays: Optional[np.ndarray]) -> Optional[str]:
+    if all(a is None for a in arrays):
+        return None
+    h = hashlib.sha256()
+    for a in arrays:
+        if a is None:
+            h.update(b"none")
+            continue
+        a = np.ascontiguousarray(a)
+        h.update(str(a.dtype).encode() + str(a.shape).encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def _ids(x: Any, what: str, n: int) -> np.ndarray:
+    a = np.asarray(x)
+    if a.ndim != 1 or a.size == 0:
+        raise ValueError(f"{what} must be a non-empty 1-D sequence of vertex ids")
+    if not np.issubdtype(a.dtype, np.integer):
+        raise TypeError(f"{what} must be integers, not {a.dtype}")
+    if a.min() < 0 or a.max() >= n:
+        raise ValueError(f"{what} must be vertex ids in [0, {n}); got {a.min()}..{a.max()}")
+    return a.astype(np.int32)
+
+
+def job_description(mesh: Mesh, sources: Optional[np.ndarray], targets: Optional[np.ndarray],
+                    dtype: str, max_distance: Optional[float], cost: Optional[np.ndarray],
+                    cost_location: Optional[str], unfolding: bool) -> Dict[str, Any]:
+    """What identifies a job (stored in the array's attributes): hashes of the
+    mesh, sources, targets and cost, and the options that change the numbers.
+    The backend and block size do not change them and are not part of it."""
+    V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
+    F = np.ascontiguousarray(mesh.faces, dtype=np.int32)
+    return {
+        "meshfmm_version": __version__,
+        "mesh_sha256": _sha256(V, F),
+        "n_vertices": int(V.shape[0]),
+        "n_faces": int(F.shape[0]),
+        "sources_sha256": _sha256(sources) if sources is not None else "all",
+        "n_sources": int(V.shape[0] if sources is None else sources.shape[0]),
+        "targets_sha256": _sha256(targets) if targets is not None else "all",
+        "n_targets": int(V.shape[0] if targets is None else targets.shape[0]),
+        "dtype": dtype,
+        "max_distance": None if max_distance is None else float(max_distance),
+        "cost_sha256": _sha256(cost) if cost is not None else None,
+        "cost_location": cost_location if cost is not None else None,
+        "unfolding": bool(unfolding),
+    }
+
+
+def _same_job(stored: Dict[str, Any], job: Dict[str, Any]) -> List[str]:
+    """The keys on which two jobs differ (the version is not compared: a
+    store written by another release is refused only if its numbers differ)."""
+    return [k for k in job if k != "meshfmm_version" and stored.get(k) != job[k]]
+
+
+# ------------------------------------------------------------- worker side
+
+def _worker_cache() -> Dict[str, Mesh]:
+    """Meshes built on this worker, keyed by mesh hash (held by the worker
+    object, so a worker builds each mesh once whatever the number of tasks)."""
+    try:
+        from distributed import get_worker
+
+        w = get_worker()
+    except (ImportError, ValueError):  # run in the client process
+        w = sys.modules[__name__]
+    cache = getattr(w, "_meshfmm_meshes", None)
+    if cache is None:
+        cache = {}
+        setattr(w, "_meshfmm_meshes", cache)
+    return cache
+
+
+def _compute_block(key: str, V: np.ndarray, F: np.ndarray, url: str,
+                   storage_options: Optional[dict], r0: int, r1: int,
+                   src: Optional[np.ndarray], targets: Optional[np.ndarray],
+                   opts: Dict[str, Any]) -> Tuple[int, int, float]:
+    """One task: rows [r0, r1) into their own chunk. Idempotent: a retry
+    writes the same bytes."""
+    import zarr
+
+    cache = _worker_cache()
+    mesh = cache.get(key)
+    if mesh is None:
+        mesh = cache[key] = Mesh(V, F)
+    t0 = time.perf_counter()
+    rows_src = np.arange(r0, r1, dtype=np.int32) if src is None else src[r0:r1]
+    kw = dict(backend=opts["backend"], dtype=opts["dtype"], n_threads=opts["n_threads"],
+              max_distance=opts["max_distance"], unfolding=opts["unfolding"])
+    if opts["cost"] is not None:
+        kw.update(cost=opts["cost"], cost_location=opts["cost_location"])
+    rows = mesh.distance_matrix(rows_src, **kw)
+    if targets is not None:
+        rows = np.ascontiguousarray(rows[:, targets])
+    arr = zarr.open_array(url, mode="r+", storage_options=storage_options)
+    arr[r0:r1, :] = rows
+    return r0, r1, time.perf_counter() - t0
+
+
+# ------------------------------------------------------------- client side
+
+def _open_store(store: Any, storage_options: Optional[dict]) -> Tuple[str, Optional[dict]]:
+    url = os.fspath(store) if isinstance(store, (str, os.PathLike)) else None
+    if url is None:
+        raise TypeError("store must be a path or an fsspec URL (a string), not "
+                        f"{type(store).__name__}")
+    return url, storage_options
+
+
+def complete_blocks(arr: Any, block_rows: int) -> List[int]:
+    """Indices of the row blocks of `arr` that are complete and verified: the
+    chunk decodes (its CRC-32C matches) and holds no NaN (the fill value of a
+    chunk never written)."""
+    n_rows = arr.shape[0]
+    done = []
+    for b in range(math.ceil(n_rows / block_rows)):
+        r0, r1 = b * block_rows, min(n_rows, (b + 1) * block_rows)
+        try:
+            block = arr[r0:r1, :]
+        except ValueError:  # checksum mismatch: a torn or altered chunk
+            continue
+        if not np.isnan(block).any():
+            done.append(b)
+    return done
+
+
+class _Progress:
+    """A progress bar on a terminal (rows done, rows/s, time left), plain lines
+    every ~10 % or 30 s when piped."""
+
+    def __init__(self, total: int, stream=None) -> None:
+        self.total, self.done = total, 0
+        self.stream = stream or sys.stderr
+        self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
+        self.t0 = self.last = time.monotonic()
+        self.last_frac = 0.0
+
+    def __call__(self, rows: int) -> None:
+        self.done += rows
+        now = time.monotonic()
+        rate = self.done / max(now - self.t0, 1e-9)
+        left = (self.total - self.done) / rate if rate > 0 else float("inf")
+        frac = self.done / self.total
+        msg = (f"{self.done}/{self.total} rows ({100 * frac:.1f} %), {rate:.1f} rows/s, "
+               f"{left:.0f} s left")
+        if self.tty:
+            w = 30
+            bar = "#" * int(w * frac) + "-" * (w - int(w * frac))
+            self.stream.write(f"\r[{bar}] {msg}   ")
+            if self.done >= self.total:
+                self.stream.write("\n")
+            self.stream.flush()
+        elif frac - self.last_frac >= 0.1 or now - self.last >= 30 or self.done >= self.total:
+            self.stream.write(msg + "\n")
+            self.stream.flush()
+            self.last, self.last_frac = now, frac
+
+
+def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = None,
+                    client: Any = None, dtype: str = "float32", resume: bool = True, *,
+                    block_rows: Optional[int] = None, backend: str = "threads",
+                    n_threads: int = 0, max_distance: Optional[float] = None,
+                    cost: Any = None, cost_location: Optional[str] = None,
+                    unfolding: bool = True, n_workers: Optional[int] = None,
+                    storage_options: Optional[dict] = None, compression: str = "zstd",
+                    progress: Any = True, retries: int = 3) -> Any:
+    """Computes a dense S x N (or S x T) distance matrix as Dask tasks writing
+    a Zarr v3 array at `store`, and returns the ``zarr.Array``.
+
+    mesh: a :class:`meshfmm.Mesh`; shipped to the workers as V and F.
+    store: a directory path or an fsspec URL (with `storage_options`).
+    sources: vertex ids (S,), None for every vertex; targets: vertex ids
+        (T,) for the columns, in the given order; None for every vertex.
+    client: a ``distributed.Client``; None starts a ``LocalCluster`` of
+        `n_workers` processes (default: the machine's cores) with one thread
+        each, and prints its dashboard address.
+    dtype: "float32" or "float64"; the values equal ``mesh.distance`` per row
+        (float64 bit for bit, float32 the same rounding).
+    resume: True skips blocks already complete and verified when the store
+        holds the same job, and refuses a store holding another job; False
+        starts over, overwriting the store.
+    block_rows: rows per task and chunk (default: about 8 MiB a chunk, at
+        least 4 tasks a worker).
+    backend, n_threads: the in-process backend each task runs ("threads",
+        "serial", "opencl", "auto") and its threads (0: all cores of the
+        worker; a LocalCluster's workers get 1).
+    max_distance, cost, cost_location, unfolding: as in ``Mesh.distance``.
+    compression: "zstd" (Blosc zstd with byte shuffle, the default) or
+        "none"; chunks always carry a CRC-32C.
+    progress: True for a progress bar on a terminal (plain lines when piped),
+        False for none, or a callable ``progress(rows_done, n_rows)``; an
+        exception it raises stops the job (blocks in flight still finish).
+    retries: times a failed task is retried (a killed worker's tasks are
+        rescheduled by Dask regardless).
+
+    The attribute ``meshfmm_last_run`` of the returned array records how many
+    blocks this call computed and skipped.
+    """
+    import zarr
+    from zarr.codecs import BloscCodec, BloscShuffle, Crc32cCodec
+
+    if not isinstance(mesh, Mesh):
+        raise TypeError(f"mesh must be a meshfmm.Mesh, not {type(mesh).__name__}")
+    nv = mesh.n_vertices
+    src = None if sources is None else _ids(sources, "sources", nv)
+    tgt = None if targets is None else _ids(targets, "targets", nv)
+    dt = np.dtype(dtype)
+    if dt not in (np.float32, np.float64):
+        raise ValueError(f"dtype must be float32 or float64, not {dtype}")
+    if max_distance is not None:
+        if isinstance(max_distance, (str, bytes)) or not np.isscalar(max_distance):
+            raise TypeError("max_distance must be a number")
+        if not (float(max_distance) >= 0.0):
+            raise ValueError(f"max_distance must be >= 0, not {max_distance}")
+    cost_arr = None if cost is None else np.ascontiguousarray(cost, dtype=np.float64)
+    if compression not in ("zstd", "none"):
+        raise ValueError(f"compression must be 'zstd' or 'none', not {compression!r}")
+    if backend not in ("auto", "threads", "serial", "opencl"):
+        raise ValueError(f"backend must be auto, threads, serial or opencl, not {backend!r}")
+    url, storage_options = _open_store(store, storage_options)
+    n_rows = nv if src is None else src.shape[0]
+    n_cols = nv if tgt is None else tgt.shape[0]
+    job = job_description(mesh, src, tgt, dt.name, max_distance, cost_arr, cost_location,
+                          unfolding)
+
+    own_cluster = None
+    if client is None:
+        from distributed import Client, LocalCluster
+
+        workers = n_workers or os.cpu_count() or 1
+        own_cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                   dashboard_address=":0")
+        client = Client(own_cluster)
+        link = getattr(own_cluster, "dashboard_link", None)
+        if progress and link:
+            print(f"meshfmm: Dask dashboard at {link}", file=sys.stderr)
+    try:
+        n_workers_now = max(1, len(client.scheduler_info().get("workers", {})))
+        arr = None
+        if resume:
+            try:
+                arr = zarr.open_array(url, mode="r+", storage_options=storage_options)
+            except FileNotFoundError:
+                arr = None
+            if arr is not None:
+                stored = dict(arr.attrs.get(JOB_ATTR) or {})
+                diff = _same_job(stored, job) if stored else ["(no meshfmm job recorded)"]
+                if diff or arr.shape != (n_rows, n_cols):
+                    raise ValueError(
+                        f"the store {url} holds a different job (differs in: "
+                        f"{', '.join(diff) or 'shape'}); use another store, or resume=False "
+                        "to overwrite it")
+        if arr is None:
+            if block_rows is None:
+                per_row = n_cols * dt.itemsize
+                block_rows = max(1, min(_BLOCK_BYTES // per_row,
+                                        math.ceil(n_rows / (4 * n_workers_now))))
+            if int(block_rows) < 1:
+                raise ValueError(f"block_rows must be >= 1, not {block_rows}")
+            compressors = [Crc32cCodec()]
+            if compression == "zstd":
+                compressors.insert(0, BloscCodec(cname="zstd", clevel=3,
+                                                 shuffle=BloscShuffle.shuffle,
+                                                 typesize=dt.itemsize))
+            arr = zarr.create_array(url, shape=(n_rows, n_cols), chunks=(int(block_rows), n_cols),
+                                    dtype=dt, fill_value=np.nan, compressors=compressors,
+                                    attributes={JOB_ATTR: job}, overwrite=True,
+                                    storage_options=storage_options)
+        block_rows = int(arr.chunks[0])
+        n_blocks = math.ceil(n_rows / block_rows)
+        done = set(complete_blocks(arr, block_rows)) if resume else set()
+        todo = [b for b in range(n_blocks) if b not in done]
+
+        report: Optional[Callable[[int], None]] = None
+        if progress is True:
+            bar = _Progress(n_rows)
+            bar(sum(min(n_rows, (b + 1) * block_rows) - b * block_rows for b in done))
+            report = bar
+        elif callable(progress):
+            rows_done = [sum(min(n_rows, (b + 1) * block_rows) - b * block_rows for b in done)]
+
+            def report(rows: int) -> None:
+                rows_done[0] += rows
+                progress(rows_done[0], n_rows)
+
+        opts = {"backend": backend, "dtype": dt.name, "max_distance": max_distance,
+                "unfolding": unfolding, "cost": cost_arr, "cost_location": cost_location,
+                "n_threads": n_threads}
+        V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
+        F = np.ascontiguousarray(mesh.faces, dtype=np.int32)
+        computed = 0
+        if todo:
+            from distributed import as_completed
+
+            V_f, F_f = client.scatter([V, F], broadcast=True)
+            src_f = client.scatter(src, broadcast=True) if src is not None else None
+            key = job["mesh_sha256"]
+            futures = [client.submit(_compute_block, key, V_f, F_f, url, storage_options,
+                                     b * block_rows, min(n_rows, (b + 1) * block_rows),
+                                     src_f, tgt, opts, retries=retries, pure=False,
+                                     key=f"meshfmm-block-{key[:12]}-{b}-{time.time_ns()}")
+                       for b in todo]
+            try:
+                for fut in as_completed(futures):
+                    r0, r1, _ = fut.result()
+                    computed += 1
+                    if report:
+                        report(r1 - r0)
+            except BaseException:
+                client.cancel(futures)
+                raise
+        arr.attrs[RUN_ATTR] = {"blocks": n_blocks, "blocks_computed": computed,
+                               "blocks_skipped": len(done), "block_rows": block_rows}
+        return arr
+    finally:
+        if own_cluster is not None:
+            client.close()
+            own_cluster.close()
+
+
+def symmetrize(store: Any, out: Any, storage_options: Optional[dict] = None) -> Any:
+    """(D + D^T) / 2 of a square matrix in a Zarr store, written to `out`, with
+    Dask arrays (chunk by chunk, never the whole matrix in memory):
+    ``da.from_zarr(store)`` then ``((D + D.T) / 2).astype(D.dtype).to_zarr(out)``.
+    Returns the new ``zarr.Array``."""
+    import dask.array as da
+    import zarr
+
+    D = da.from_zarr(store, storage_options=storage_options)
+    if D.ndim != 2 or D.shape[0] != D.shape[1]:
+        raise ValueError(f"symmetrize needs a square matrix, not {D.shape}")
+    S = ((D + D.T) / 2).astype(D.dtype)
+    S.to_zarr(out, overwrite=True, storage_options=storage_options)
+    return zarr.open_array(out, mode="r", storage_options=storage_options)
+
+
+# ------------------------------------------------------------- command line
+
+def _read_ids(path: str, what: str) -> np.ndarray:
+    if path.endswith(".npy"):
+        a = np.load(path, allow_pickle=False)
+    else:
+        a = np.loadtxt(path, dtype=np.int64, ndmin=1)
+    if a.ndim != 1 or not np.issubdtype(a.dtype, np.integer):
+        raise ValueError(f"{path}: {what} must be a 1-D integer array")
+    return a
+
+
+def cli_allpairs_zarr(argv: Sequence[str]) -> int:
+    """``meshfmm allpairs MESH -o OUT.zarr [--scheduler ADDRESS | --workers N]
+    [--resume] ...``: the distributed all-pairs job from the command line."""
+    import argparse
+
+    ap = argparse.ArgumentParser(prog="meshfmm allpairs",
+                                 description="All-pairs geodesic distances on a Dask cluster, "
+                                             "written into a Zarr v3 array.")
+    ap.add_argument("mesh")
+    ap.add_argument("-o", "--output", required=True, help="OUT.zarr (a directory or fsspec URL)")
+    g = ap.add_mutually_exclusive_group()
+    g.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:port)")
+    g.add_argument("--workers", type=int, help="worker processes of a local cluster (default: cores)")
+    ap.add_argument("--resume", action="store_true",
+                    help="go on with a job already in OUT (default: start over)")
+    ap.add_argument("--dtype", choices=["float32", "float64"], default="float32")
+    ap.add_argument("--sources", help="vertex ids (.npy or .txt)")
+    ap.add_argument("--targets", help="vertex ids for the columns (.npy or .txt)")
+    ap.add_argument("--max-distance", type=float)
+    ap.add_argument("--cost", help="per-vertex or per-face cost (.npy or .txt)")
+    ap.add_argument("--backend", choices=["threads", "serial", "opencl", "auto"], default="threads")
+    ap.add_argument("--block-rows", type=int)
+    ap.add_argument("--no-progress", action="store_true")
+    a = ap.parse_args(list(argv))
+    try:
+        from ._mesh import load_mesh
+
+        mesh = Mesh(*load_mesh(a.mesh))
+        src = _read_ids(a.sources, "sources") if a.sources else None
+        tgt = _read_ids(a.targets, "targets") if a.targets else None
+        cost = None
+        if a.cost:
+            cost = np.load(a.cost) if a.cost.endswith(".npy") else np.loadtxt(a.cost, ndmin=1)
+        client = None
+        if a.scheduler:
+            from distributed import Client
+
+            client = Client(a.scheduler)
+        Z = distance_matrix(mesh, a.output, sources=src, targets=tgt, client=client,
+                            dtype=a.dtype, resume=a.resume, block_rows=a.block_rows,
+                            backend=a.backend, max_distance=a.max_distance, cost=cost,
+                            n_workers=a.workers, progress=not a.no_progress)
+        run = Z.attrs.get(RUN_ATTR, {})
+        print(f"meshfmm: wrote {Z.shape[0]} x {Z.shape[1]} {Z.dtype} to {a.output} "
+              f"({run.get('blocks_computed')} blocks computed, {run.get('blocks_skipped')} "
+              "already complete)", file=sys.stderr)
+        if client is not None:
+            client.close()
+        return 0
+    except KeyboardInterrupt:
+        print("meshfmm: interrupted; complete blocks are kept (run again with --resume)",
+              file=sys.stderr)
+        return 130
+    except (ValueError, TypeError, OSError) as e:
+        print(f"meshfmm: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(cli_allpairs_zarr(sys.argv[1:]))

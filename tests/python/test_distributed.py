@@ -1,0 +1,214 @@
+"""meshfmm.distributed: all-pairs rows as Dask tasks writing a Zarr v3 array,
+on real clusters started here (a LocalCluster of 2 worker processes, and a
+scheduler and two workers started as separate processes on 127.0.0.1).
+Every result is compared with the serial rows (float64 bit for bit)."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+pytest.importorskip("distributed")
+zarr = pytest.importorskip("zarr")
+
+import meshfmm  # noqa: E402
+import meshfmm.distributed as md  # noqa: E402
+from conftest import MESHES  # noqa: E402
+
+SOURCES = np.arange(0, 810, 7, dtype=np.int32)  # 116 rows of hand_lowres
+
+
+@pytest.fixture(scope="module")
+def hand():
+    return meshfmm.Mesh(*meshfmm.load_mesh(MESHES / "hand_lowres.obj"))
+
+
+@pytest.fixture(scope="module")
+def serial64(hand):
+    return hand.distance_matrix(SOURCES, backend="serial", dtype="float64")
+
+
+@pytest.fixture(scope="module")
+def client():
+    from distributed import Client, LocalCluster
+
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                           dashboard_address=":0")
+    c = Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def test_rows_equal_serial_float64_and_float32(hand, serial64, client, tmp_path):
+    Z = md.distance_matrix(hand, str(tmp_path / "d64.zarr"), sources=SOURCES, client=client,
+                           dtype="float64", block_rows=16, progress=False)
+    assert Z.shape == (len(SOURCES), hand.n_vertices) and Z.dtype == np.float64
+    assert np.array_equal(Z[:], serial64)
+    for i in (0, 57, 115):  # and each row is Mesh.distance's
+        assert np.array_equal(Z[i], hand.distance(int(SOURCES[i])))
+    Z32 = md.distance_matrix(hand, str(tmp_path / "d32.zarr"), sources=SOURCES, client=client,
+                             dtype="float32", block_rows=16, progress=False)
+    assert np.array_equal(Z32[:], serial64.astype(np.float32))
+    run = Z32.attrs[md.RUN_ATTR]
+    assert run["blocks"] == 8 and run["blocks_computed"] == 8
+
+
+def test_targets_give_the_columns_of_full_rows(hand, serial64, client, tmp_path):
+    targets = np.array([809, 3, 400, 3, 12], dtype=np.int32)
+    Z = md.distance_matrix(hand, str(tmp_path / "st.zarr"), sources=SOURCES, targets=targets,
+                           client=client, dtype="float64", block_rows=32, progress=False)
+    assert Z.shape == (len(SOURCES), len(targets))
+    assert np.array_equal(Z[:], serial64[:, targets])
+
+
+class _Stop(Exception):
+    pass
+
+
+def test_interrupt_then_resume_computes_only_the_rest(hand, serial64, client, tmp_path):
+    store = str(tmp_path / "r.zarr")
+    calls = []
+
+    def stop_after_3(done, total):
+        calls.append(done)
+        if len(calls) == 3:
+            raise _Stop()
+
+    with pytest.raises(_Stop):
+        md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                           block_rows=8, progress=stop_after_3)
+    time.sleep(1.0)  # blocks in flight may still land: they are complete or absent
+    Z = zarr.open_array(store, mode="r")
+    n_blocks = 15
+    complete = md.complete_blocks(Z, 8)
+    assert 3 <= len(complete) < n_blocks
+    Z = md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                           progress=False)
+    run = Z.attrs[md.RUN_ATTR]
+    assert run["blocks_skipped"] == len(complete)
+    assert run["blocks_computed"] == n_blocks - len(complete)
+    assert np.array_equal(Z[:], serial64)
+    # a torn chunk (its checksum no longer matches) is recomputed, not trusted
+    chunk = os.path.join(store, "c", "2", "0")
+    data = open(chunk, "rb").read()
+    open(chunk, "wb").write(data[:-5])
+    Z = md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                           progress=False)
+    assert Z.attrs[md.RUN_ATTR]["blocks_computed"] == 1
+    assert np.array_equal(Z[:], serial64)
+    # another job on the same store is refused with a message
+    with pytest.raises(ValueError, match="different job"):
+        md.distance_matrix(hand, store, sources=SOURCES[:-1], client=client, progress=False)
+    with pytest.raises(ValueError, match="different job"):
+        md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float32",
+                           progress=False)
+
+
+def test_a_killed_worker_is_replaced_and_the_result_equals_serial(hand, serial64, tmp_path):
+    from distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=":0") as cluster, Client(cluster) as c:
+        pids = list(c.run(os.getpid).values())
+        killed = []
+
+        def kill_one(done, total):
+            if not killed:
+                os.kill(pids[0], signal.SIGKILL)
+                killed.append(pids[0])
+
+        Z = md.distance_matrix(hand, str(tmp_path / "k.zarr"), sources=SOURCES, client=c,
+                               dtype="float64", block_rows=4, progress=kill_one)
+        assert killed
+        assert np.array_equal(Z[:], serial64)
+
+
+def _wait_for(path, seconds=60.0):
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < seconds:
+        if os.path.exists(path) and os.path.getsize(path) > 0:
+            try:
+                return json.load(open(path))
+            except ValueError:
+                pass
+        time.sleep(0.2)
+    raise TimeoutError(f"{path} did not appear")
+
+
+def test_separate_scheduler_and_worker_processes(hand, serial64, tmp_path):
+    from distributed import Client
+
+    sched_file = str(tmp_path / "scheduler.json")
+    dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
+    worker = [sys.executable, "-m", "distributed.cli.dask_worker"]
+    procs = [subprocess.Popen(dask + ["--host", "127.0.0.1", "--port", "0",
+                                      "--dashboard-address", ":0",
+                                      "--scheduler-file", sched_file],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        _wait_for(sched_file)
+        for _ in range(2):
+            procs.append(subprocess.Popen(worker + ["--scheduler-file", sched_file,
+                                                    "--host", "127.0.0.1", "--nthreads", "1",
+                                                    "--no-dashboard"],
+                                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        with Client(scheduler_file=sched_file, timeout=60) as c:
+            c.wait_for_workers(2, timeout=60)
+            Z = md.distance_matrix(hand, str(tmp_path / "sep.zarr"), sources=SOURCES,
+                                   client=c, dtype="float64", block_rows=16, progress=False)
+            assert np.array_equal(Z[:], serial64)
+    finally:
+        for p in reversed(procs):
+            p.terminate()
+        for p in procs:
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                p.kill()
+
+
+def test_symmetrize_matches_numpy(hand, tmp_path):
+    store = str(tmp_path / "sq.zarr")
+    sq = np.arange(0, 810, 20, dtype=np.int32)
+    V, F = hand.vertices, hand.faces
+    sub = meshfmm.Mesh(V, F)
+    Z = md.distance_matrix(sub, store, sources=sq, targets=sq, n_workers=1, dtype="float64",
+                           progress=False)
+    S = md.symmetrize(store, str(tmp_path / "sym.zarr"))
+    D = Z[:]
+    assert np.allclose(S[:], (D + D.T) / 2, rtol=0, atol=0)
+
+
+def test_bad_arguments_are_refused(hand, tmp_path):
+    with pytest.raises(ValueError, match="targets"):
+        md.distance_matrix(hand, str(tmp_path / "x.zarr"), targets=[10**6], n_workers=1)
+    with pytest.raises(TypeError, match="max_distance"):
+        md.distance_matrix(hand, str(tmp_path / "x.zarr"), max_distance="2.5", n_workers=1)
+    with pytest.raises(ValueError, match="max_distance"):
+        md.distance_matrix(hand, str(tmp_path / "x.zarr"), max_distance=-1.0, n_workers=1)
+    with pytest.raises(TypeError, match="store"):
+        md.distance_matrix(hand, 3, n_workers=1)
+
+
+def test_command_line(tmp_path):
+    out = str(tmp_path / "cli.zarr")
+    src = tmp_path / "s.txt"
+    src.write_text("0\n5\n9\n")
+    code = ("import sys; from meshfmm.distributed import cli_allpairs_zarr;"
+            "sys.exit(cli_allpairs_zarr(sys.argv[1:]))")
+    r = subprocess.run([sys.executable, "-c", code, str(MESHES / "hand_lowres.obj"), "-o", out,
+                        "--workers", "1", "--sources", str(src), "--dtype", "float64"],
+                       capture_output=True, text=True, timeout=180)
+    assert r.returncode == 0, r.stderr
+    assert "3 x 810" in r.stderr
+    mesh = meshfmm.Mesh(*meshfmm.load_mesh(MESHES / "hand_lowres.obj"))
+    assert np.array_equal(zarr.open_array(out, mode="r")[:],
+                          mesh.distance_matrix([0, 5, 9], backend="serial", dtype="float64"))
