@@ -10,6 +10,9 @@ peers' best routes to the same matrix:
                   sparse matrix), against `meshfmm allpairs --max-distance` with the
                   same radius
   gdist_loop      gdist.compute_gdist per row (exact), a few rows, extrapolated
+  heat_batched_pN the heat method batched over blocks of 32 sources (bench/heat_batched.py:
+                  intrinsic Delaunay Laplacian, one CHOLMOD factorisation per process), in N
+                  processes of one BLAS thread each; its rows are checked against meshfmm's
 
 Every run is its own child process; peak memory is that child's ru_maxrss
 (os.wait4). Times are wall seconds of the whole child (load, precompute,
@@ -92,6 +95,28 @@ def worker(kind, mesh_name, rows_file, out_file, radius):
             out[i] = solve(int(s))
         out.flush()
         res["rows_s"] = time.perf_counter() - t1
+    elif kind.startswith("heat_batched_p"):
+        nproc = int(kind[len("heat_batched_p"):])
+        out = np.lib.format.open_memmap(out_file, mode="w+", dtype=np.float32,
+                                        shape=(rows.size, V.shape[0]))
+        del out
+        parts = np.array_split(np.arange(rows.size), nproc)
+        import multiprocessing as mp
+
+        ctx = mp.get_context("fork")
+        with ctx.Pool(nproc) as pool:
+            times = pool.starmap(_heat_part, [(V, F, rows, p, out_file) for p in parts])
+        res["precompute_s"] = max(t[0] for t in times)
+        res["rows_s"] = time.perf_counter() - t0 - res["precompute_s"]
+        # agreement with meshfmm on a few rows (mean relative difference)
+        import meshfmm as mf
+
+        D = np.load(out_file, mmap_mode="r")
+        pick = np.linspace(0, rows.size - 1, min(8, rows.size)).astype(int)
+        ref = mf.Mesh(V, F).distance_matrix(rows[pick], backend="serial", dtype="float64")
+        got = np.asarray(D[pick], dtype=np.float64)
+        pos = ref > 0
+        res["mean_rel_diff_vs_meshfmm_pct"] = float(100 * np.mean(np.abs(got[pos] - ref[pos]) / ref[pos]))
     elif kind == "gdist_loop":
         import gdist
 
@@ -112,6 +137,22 @@ def worker(kind, mesh_name, rows_file, out_file, radius):
     print(json.dumps(res))
 
 
+def _heat_part(V, F, rows, part, out_file):
+    """One process of heat_batched_pN: factor, then its share of the rows."""
+    from heat_batched import BatchedHeat
+
+    t0 = time.perf_counter()
+    h = BatchedHeat(V, F)
+    t1 = time.perf_counter()
+    out = np.load(out_file, mmap_mode="r+")
+    step = 512
+    for i in range(0, part.size, step):
+        idx = part[i:i + step]
+        out[idx] = h.rows(rows[idx])
+    out.flush()
+    return t1 - t0, time.perf_counter() - t1
+
+
 # ---------------------------------------------------------------- driver
 def meshfmm_run(mesh_path, backend, rows_file, out_file, radius=None, threads=None):
     cmd = [str(bl.CLI), "allpairs", str(mesh_path), "-o", str(out_file), "--backend", backend,
@@ -129,7 +170,9 @@ def meshfmm_run(mesh_path, backend, rows_file, out_file, radius=None, threads=No
 def py_worker(kind, mesh, rows_file, out_file, radius=0.0):
     cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", kind, mesh,
            str(rows_file) if rows_file else "-", str(out_file), repr(float(radius))]
-    wall, rss, out = run_child_rss(cmd)
+    # one BLAS thread per process (set before numpy loads): peers run one thread each
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    wall, rss, out = run_child_rss(cmd, env=env)
     return wall, rss, json.loads(out.strip().splitlines()[-1])
 
 
@@ -206,7 +249,7 @@ def main():
                 wall, rss = meshfmm_run(path, be, rows_file if n_rows else None, out_file)
                 add(f"meshfmm_{be}", wall, wall, rss, rows.size)
                 out_file.unlink(missing_ok=True)
-            for kind in ("gc_heat_loop", "igl_heat_loop"):
+            for kind in ("gc_heat_loop", "igl_heat_loop", "heat_batched_p1", "heat_batched_p2"):
                 wall, rss, res = py_worker(kind, name, rows_c_file, out_file)
                 # full matrix = precompute once + rows scaled up
                 t = res["precompute_s"] + res["rows_s"]

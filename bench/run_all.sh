@@ -11,6 +11,17 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 py=.venv/bin/python
 
+# The peers' own needs: CHOLMOD and a threaded OpenBLAS (Debian), then bench/requirements.txt.
+bench_debs=(libsuitesparse-dev libopenblas0-pthread)
+for p in "${bench_debs[@]}"; do
+    if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+            "${bench_debs[@]}" >/dev/null
+        break
+    fi
+done
+"$py" -m pip install -q -r bench/requirements.txt
+
 # gdist's PyPI wheel (2.1.0) is compiled against numpy 1.x and fails to import
 # under numpy 2 ("numpy.dtype size changed"); rebuilding it from its sdist
 # against the installed numpy fixes that.
@@ -18,7 +29,7 @@ if ! "$py" -c "import gdist" >/dev/null 2>&1; then
     echo "run_all: gdist does not import with this numpy; rebuilding it from source"
     "$py" -m pip install -q --no-binary gdist --no-deps --force-reinstall gdist
 fi
-"$py" -c "import gdist, igl, potpourri3d, matplotlib, meshfmm" 
+"$py" -c "import gdist, igl, potpourri3d, matplotlib, meshfmm, robust_laplacian, sksparse.cholmod"
 
 export MESHFMM_CLI="$PWD/build/meshfmm"
 start=$(date +%s)
