@@ -12,7 +12,6 @@ sdist) against the installed package.
 from __future__ import annotations
 
 import os
-import shutil
 import signal
 import subprocess
 import sys

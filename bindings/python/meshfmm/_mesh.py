@@ -11,6 +11,7 @@ import ctypes
 import dataclasses
 import errno
 import math
+import numbers
 import operator
 import os
 import signal
@@ -241,7 +242,7 @@ def _max_distance(x: Any) -> float:
     float("2.5")); NaN and negative values a ValueError."""
     if x is None:
         return math.inf
-    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)):
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, numbers.Real):
         raise TypeError(f"max_distance must be a real number or None, got {type(x).__name__} {x!r}")
     d = float(x)
     if math.isnan(d):
