@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from . import _lib
 from ._lib import MeshError, OpenCLError
+from ._memmap import open_memmap
 from ._mesh import GeodesicPath, Mesh, MeshInfo, SurfacePoint, load_mesh
 
 #: Version of the loaded libmeshfmm ("MAJOR.MINOR.PATCH").
@@ -30,6 +31,7 @@ __all__ = [
     "MeshError",
     "OpenCLError",
     "load_mesh",
+    "open_memmap",
     "library_path",
     "__version__",
 ]

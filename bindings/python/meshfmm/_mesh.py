@@ -6,15 +6,18 @@ All foreign calls go through :mod:`meshfmm._lib`.
 from __future__ import annotations
 
 import atexit
+import contextlib
 import ctypes
 import dataclasses
 import errno
 import math
+import numbers
 import operator
 import os
+import signal
 import threading
 from ctypes import byref
-from typing import Any, Callable, List, NamedTuple, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Iterator, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -233,13 +236,20 @@ def _cost_array(cost: Any, cost_location: Optional[str], nv: int, nf: int) -> Tu
     return c, loc
 
 
-def _max_distance(x: Optional[float]) -> float:
+def _max_distance(x: Any) -> float:
+    """max_distance as a C double: None -> +inf; a real number >= 0 (+inf
+    allowed). Strings, bools and other types are a TypeError (no silent
+    float("2.5")); NaN and negative values a ValueError."""
     if x is None:
         return math.inf
-    try:
-        return float(x)
-    except (TypeError, ValueError):
-        raise TypeError(f"max_distance must be a number, got {type(x).__name__}") from None
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, numbers.Real):
+        raise TypeError(f"max_distance must be a real number or None, got {type(x).__name__} {x!r}")
+    d = float(x)
+    if math.isnan(d):
+        raise ValueError("max_distance is NaN; give a number >= 0, or None for no limit")
+    if d < 0:
+        raise ValueError(f"max_distance must be >= 0, got {d!r}")
+    return d
 
 
 # --------------------------------------------------------------------- mesh
@@ -252,6 +262,9 @@ class Mesh:
     values fit). Both are copied. ``max_unfold_steps`` bounds the unfolding
     walk that finds the virtual edge of an obtuse corner (default 64).
 
+    ``Mesh(obj)``: any object with ``.vertices`` and ``.faces`` (a
+    ``trimesh.Trimesh``, for one). ``Mesh.from_file(path)`` reads a file.
+
     Raises :class:`meshfmm.MeshError` (a ValueError) with the reason for wrong
     shapes, NaN or infinite coordinates, face indices out of range or a face
     that repeats a vertex. Boundaries, several components, unreferenced
@@ -261,10 +274,24 @@ class Mesh:
     gets its own solver workspace, and the C calls release the GIL. Free it
     early with :meth:`close` or a ``with`` block; otherwise it is freed when
     garbage-collected.
+
+    Copies are independent: ``copy.copy``, ``copy.deepcopy`` and pickling
+    rebuild the C mesh from ``vertices``, ``faces`` and the options, so
+    closing one copy leaves the others working.
     """
 
-    def __init__(self, V: Any, F: Any, *, max_unfold_steps: Optional[int] = None) -> None:
+    def __init__(self, V: Any, F: Any = None, *, max_unfold_steps: Optional[int] = None) -> None:
         self._ptr: Optional[int] = None
+        if F is None:
+            # Mesh(obj): anything with .vertices and .faces (a trimesh.Trimesh,
+            # another Mesh, ...).
+            if not (hasattr(V, "vertices") and hasattr(V, "faces")):
+                raise TypeError(
+                    "Mesh(V, F) needs faces F, or one object with .vertices and .faces "
+                    f"(e.g. a trimesh.Trimesh); got {type(V).__name__} without them"
+                )
+            V, F = V.vertices, V.faces
+        self._max_unfold_steps = max_unfold_steps
         self._lock = threading.Lock()
         self._active = 0
         self._solvers: List[int] = []
@@ -319,6 +346,33 @@ class Mesh:
         self._info = MeshInfo(**{name: getattr(info, name) for name, _ in info._fields_})
         self._opts_template = _lib.mfmm_solve_options()
         _lib.mfmm_solve_options_init(byref(self._opts_template))
+
+    @classmethod
+    def from_file(cls, path: Union[str, "os.PathLike[str]"], **kwargs: Any) -> "Mesh":
+        """Reads a mesh file with :func:`load_mesh` (OBJ, OFF, PLY, STL) and
+        builds a Mesh; keyword arguments go to the constructor."""
+        V, F = load_mesh(path)
+        return cls(V, F, **kwargs)
+
+    # ---- copies and pickling: by vertices, faces and options, never the C pointer
+    def _options(self) -> dict:
+        return {"max_unfold_steps": self._max_unfold_steps}
+
+    def __reduce__(self) -> Tuple[Any, ...]:
+        if self._ptr is None:
+            raise ValueError("cannot pickle or copy a closed mesh")
+        return (_rebuild_mesh, (type(self), self._V, self._F, self._options()))
+
+    def __copy__(self) -> "Mesh":
+        # a new C mesh (the vertex and face arrays are read-only, so shared)
+        if self._ptr is None:
+            raise ValueError("cannot copy a closed mesh")
+        return _rebuild_mesh(type(self), self._V, self._F, self._options())
+
+    def __deepcopy__(self, memo: dict) -> "Mesh":
+        if self._ptr is None:
+            raise ValueError("cannot copy a closed mesh")
+        return _rebuild_mesh(type(self), self._V.copy(), self._F.copy(), self._options())
 
     # ---- lifetime
     def close(self) -> None:
@@ -623,6 +677,14 @@ class Mesh:
         opts.backend = _lib.BACKENDS[backend.lower()]
         opts.dtype = cdt
         c, loc = _cost_array(cost, cost_location, self._nv, self._nf)
+        # The library writes rows into `out` while it still reads the sources
+        # and the cost: an input that shares memory with `out` (a view of
+        # it) would be overwritten mid-job (wrong rows, or vertex ids that
+        # are garbage). Such inputs are copied first.
+        if src is not None and np.may_share_memory(src, out):
+            src = src.copy()
+        if c is not None and np.may_share_memory(c, out):
+            c = c.copy()
         if c is not None:
             opts.cost = _addr(c)
             opts.cost_location = loc
@@ -638,9 +700,15 @@ class Mesh:
             opts.opencl = _shared_opencl_context()
 
         caught: List[BaseException] = []
+        interrupted: List[int] = []
 
         def on_rows(user: Any, first: int, n: int, rows: Any) -> int:
+            # Returns the cancel code instead of raising: an exception escaping
+            # a ctypes callback is printed ("Exception ignored on calling
+            # ctypes callback function") and the job goes on.
             try:
+                if interrupted:
+                    return 1
                 if progress is not None:
                     progress(first + n, n_rows)
                 return 0
@@ -653,17 +721,55 @@ class Mesh:
         err = _lib.mfmm_error()
         mesh_ptr = self._enter()
         try:
-            status = _lib.mfmm_distance_matrix(
-                mesh_ptr, None if src is None else _addr(src), n_rows, byref(opts), byref(err)
-            )
+            with _sigint_as_flag(interrupted):
+                status = _lib.mfmm_distance_matrix(
+                    mesh_ptr, None if src is None else _addr(src), n_rows, byref(opts), byref(err)
+                )
         finally:
             self._leave()
         if caught:
             raise caught[0]
+        if interrupted:
+            raise KeyboardInterrupt
         _lib.check(status, err)
         name = _lib.mfmm_backend_name(opts.backend_used)
         self.backend_used = name.decode("ascii") if name else None
         return out
+
+
+@contextlib.contextmanager
+def _sigint_as_flag(flag: List[int]) -> Iterator[None]:
+    """While a long C call runs on the main thread, Ctrl-C appends to `flag`
+    instead of raising KeyboardInterrupt inside a ctypes callback (where
+    Python can only print it and go on); the row callback then returns the
+    cancel code and the caller raises one KeyboardInterrupt after the call.
+    Leaves a handler other than Python's default one alone, and does nothing
+    off the main thread (signals are only handled there)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    try:
+        previous = signal.getsignal(signal.SIGINT)
+    except (ValueError, OSError):  # pragma: no cover
+        yield
+        return
+    if previous is not signal.default_int_handler:
+        yield
+        return
+
+    def handler(signum: int, frame: Any) -> None:
+        flag.append(signum)
+
+    signal.signal(signal.SIGINT, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _rebuild_mesh(cls: type, V: np.ndarray, F: np.ndarray, options: dict) -> Mesh:
+    """Unpickling and copying: a new, independent C mesh from V, F, options."""
+    return cls(V, F, **options)
 
 
 _opencl_lock = threading.Lock()

@@ -1,0 +1,83 @@
+"""The `meshfmm` command: ``python -m meshfmm ...`` and the ``meshfmm``
+console script that ``pip install .`` installs.
+
+The commands are the C command line's (src/cli), built into the wheel as
+``meshfmm/_bin/meshfmm``: this wrapper replaces itself with that binary
+(os.execv), so arguments, output, signals (Ctrl-C) and exit codes are the
+binary's own. Only ``allpairs ... -o OUT.zarr`` (Dask + Zarr) is Python's,
+dispatched in :func:`main` before the exec.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+from typing import List, Optional
+
+__all__ = ["main", "cli_path"]
+
+_NAME = "meshfmm.exe" if sys.platform == "win32" else "meshfmm"
+
+
+def cli_path() -> Optional[str]:
+    """The C command line: the one inside the package (a wheel or
+    ``pip install .``), else $MESHFMM_CLI (a development build), else None."""
+    inside = Path(__file__).resolve().parent / "_bin" / _NAME
+    if inside.is_file() and os.access(inside, os.X_OK):
+        return str(inside)
+    env = os.environ.get("MESHFMM_CLI")
+    if env and os.path.isfile(env) and os.access(env, os.X_OK):
+        return env
+    return None
+
+
+def _output(args: List[str]) -> Optional[str]:
+    """The value of -o/--output (last one wins), or None."""
+    out = None
+    for i, a in enumerate(args):
+        if a in ("-o", "--output") and i + 1 < len(args):
+            out = args[i + 1]
+        elif a.startswith("--output="):
+            out = a[len("--output="):]
+    return out
+
+
+def _allpairs_zarr(args: List[str]) -> int:
+    """`meshfmm allpairs MESH -o OUT.zarr`: the Dask + Zarr job (DESIGN.md),
+    run by meshfmm.distributed."""
+    try:
+        from .distributed import cli_allpairs_zarr
+        import distributed  # noqa: F401
+        import zarr  # noqa: F401
+    except ImportError as e:
+        sys.stderr.write(f"meshfmm allpairs: output to .zarr needs Dask and Zarr "
+                         f"(pip install 'dask[distributed]' 'zarr>=3'): {e}\n")
+        return 2
+    return cli_allpairs_zarr(args)
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    args = list(sys.argv[1:] if argv is None else argv)
+    if args and args[0] == "allpairs":
+        out = _output(args[1:])
+        if out is not None and out.rstrip("/").lower().endswith(".zarr"):
+            return _allpairs_zarr(args[1:])
+    exe = cli_path()
+    if exe is None:
+        sys.stderr.write(
+            "meshfmm: the command-line binary is not installed with this package "
+            f"(looked for {Path(__file__).resolve().parent / '_bin' / _NAME} and $MESHFMM_CLI); "
+            "install with `pip install .` at the repository root, or point MESHFMM_CLI "
+            "at a built build/meshfmm\n"
+        )
+        return 2
+    sys.stdout.flush()
+    sys.stderr.flush()
+    # argv[0] "meshfmm", so that usage messages name the command.
+    os.execv(exe, ["meshfmm", *args])
+    return 127  # not reached
+
+
+if __name__ == "__main__":
+    sys.exit(main())
