@@ -168,7 +168,7 @@ static void test_no_opencl_fallback(void **state)
     assert_int_equal(err.status, MFMM_ERR_NO_OPENCL);
     assert_true(strlen(err.message) > 0);
     mfmm_opencl_context *ctx = (mfmm_opencl_context *)&o;
-    assert_int_equal(mfmm_opencl_context_create(&ctx, &err), MFMM_ERR_NO_OPENCL);
+    assert_int_equal(mfmm_opencl_context_create(NULL, &ctx, &err), MFMM_ERR_NO_OPENCL);
     assert_null(ctx);
     assert_true(strlen(err.message) > 0);
     free(out);

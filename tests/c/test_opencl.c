@@ -295,7 +295,7 @@ static void test_reused_context(void **state)
     (void)state;
     mfmm_opencl_context *ctx = NULL;
     mfmm_error err;
-    mfmm_status st = mfmm_opencl_context_create(&ctx, &err);
+    mfmm_status st = mfmm_opencl_context_create(NULL, &ctx, &err);
     if (st == MFMM_ERR_NO_OPENCL) {
         assert_null(ctx);
         skip();
@@ -328,7 +328,7 @@ static void test_reused_context(void **state)
     mfmm_gen_free(&g);
     mfmm_opencl_context_destroy(ctx);
     mfmm_opencl_context_destroy(NULL);
-    assert_int_equal(mfmm_opencl_context_create(NULL, &err), MFMM_ERR_NULL_POINTER);
+    assert_int_equal(mfmm_opencl_context_create(NULL, NULL, &err), MFMM_ERR_NULL_POINTER);
 }
 
 int main(void)
