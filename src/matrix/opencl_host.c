@@ -247,9 +247,14 @@ static mfmm_status select_device(ocl *cl, const char *want, mfmm_error *err)
  * build options, platform, device, driver). The file holds the key itself,
  * the binary and a checksum; a binary is used only when its key text equals
  * ours, and only after a self-test on a small mesh against the serial core.
- * Whatever fails (read, checksum, key, load, build, self-test) makes the
- * program be built from source and the entry be replaced. Entries are written
- * to a temporary file made exclusively beside them and renamed over. */
+ * The checksum is keyed with a random secret kept in the folder (file
+ * `secret`, mode 0600): drivers parse binaries without checks (PoCL 3.1
+ * crashes in clCreateProgramWithBinary on a binary with bytes changed inside),
+ * so an entry altered by anything but this library, its plain checksum
+ * recomputed or not, never reaches the driver. Whatever fails (read, checksum,
+ * key, load, build, self-test) makes the program be built from source and the
+ * entry be replaced. Files are written to a temporary file made exclusively
+ * beside them and renamed (the secret: linked) into place. */
 
 static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
 {
@@ -321,18 +326,67 @@ static void make_dirs(const char *path)
         if (buf[i] == '/' || buf[i] == '\0') {
             char c = buf[i];
             buf[i] = '\0';
-            mkdir(buf, 0755); /* errors show up when the file is written */
+            mkdir(buf, 0700); /* errors show up when the file is written */
             buf[i] = c;
         }
     }
 }
 
-/* File: magic, key length, key text, binary length, binary, FNV-1a of the
- * key text and binary. All integers uint64 in host order. */
+/* The folder's secret (16 bytes), made on first use; 0 when it can be
+ * neither read nor made (no disk cache then). */
+static int cache_secret(const char *dir, unsigned char secret[16])
+{
+    char path[1100], tmp[1200];
+    if (snprintf(path, sizeof path, "%s/secret", dir) >= (int)sizeof path ||
+        snprintf(tmp, sizeof tmp, "%s.XXXXXX", path) >= (int)sizeof tmp)
+        return 0;
+    for (int attempt = 0; attempt < 2; attempt++) {
+        FILE *f = fopen(path, "rb");
+        if (f) {
+            int ok = fread(secret, 1, 16, f) == 16 && fgetc(f) == EOF;
+            fclose(f);
+            return ok;
+        }
+        if (attempt > 0)
+            return 0;
+        make_dirs(dir);
+        FILE *r = fopen("/dev/urandom", "rb");
+        if (!r)
+            return 0;
+        int got = fread(secret, 1, 16, r) == 16;
+        fclose(r);
+        int fd = got ? mkstemp(tmp) : -1; /* mode 0600 */
+        if (fd < 0)
+            return 0;
+        int ok = write(fd, secret, 16) == 16;
+        ok = close(fd) == 0 && ok;
+        /* link, unlike rename, keeps a secret another process made first */
+        if (ok && link(tmp, path) == 0) {
+            unlink(tmp);
+            return 1;
+        }
+        unlink(tmp);
+    }
+    return 0;
+}
+
+/* The entry's checksum: FNV-1a over secret, key text, binary, secret. */
+static uint64_t cache_sum(const unsigned char secret[16], const char *key, size_t key_len,
+                          const unsigned char *bin, size_t n)
+{
+    uint64_t h = fnv1a(MFMM_FNV_BASIS, secret, 16);
+    h = fnv1a(h, key, key_len);
+    h = fnv1a(h, bin, n);
+    return fnv1a(h, secret, 16);
+}
+
+/* File: magic, key length, key text, binary length, binary, cache_sum.
+ * All integers uint64 in host order. */
 static const char cache_magic[8] = {'M', 'F', 'M', 'M', 'C', 'L', 'B', '2'};
 #define MFMM_CACHE_MAX_BINARY ((uint64_t)1 << 30)
 
-static unsigned char *cache_load(const char *path, const char *key, size_t *size)
+static unsigned char *cache_load(const char *path, const unsigned char secret[16],
+                                 const char *key, size_t *size)
 {
     FILE *f = fopen(path, "rb");
     if (!f)
@@ -351,7 +405,7 @@ static unsigned char *cache_load(const char *path, const char *key, size_t *size
         goto bad;
     bin = malloc((size_t)n);
     if (!bin || fread(bin, 1, (size_t)n, f) != (size_t)n || fread(&sum, sizeof sum, 1, f) != 1 ||
-        fgetc(f) != EOF || sum != fnv1a(fnv1a(MFMM_FNV_BASIS, key, key_len), bin, (size_t)n))
+        fgetc(f) != EOF || sum != cache_sum(secret, key, key_len, bin, (size_t)n))
         goto bad;
     free(k);
     fclose(f);
@@ -365,11 +419,10 @@ bad:
 }
 
 /* Best effort: an unwritable cache is not an error. */
-static void cache_store(const char *dir, const char *path, const char *key,
+static void cache_store(const char *path, const unsigned char secret[16], const char *key,
                         const unsigned char *bin, size_t n)
 {
     char tmp[1200];
-    make_dirs(dir);
     if (snprintf(tmp, sizeof tmp, "%s.XXXXXX", path) >= (int)sizeof tmp)
         return;
     int fd = mkstemp(tmp); /* a new, unique file (O_CREAT | O_EXCL) */
@@ -382,7 +435,7 @@ static void cache_store(const char *dir, const char *path, const char *key,
         return;
     }
     uint64_t klen = strlen(key), len = n;
-    uint64_t sum = fnv1a(fnv1a(MFMM_FNV_BASIS, key, (size_t)klen), bin, n);
+    uint64_t sum = cache_sum(secret, key, (size_t)klen, bin, n);
     int ok = fwrite(cache_magic, 1, 8, f) == 8 && fwrite(&klen, sizeof klen, 1, f) == 1 &&
              fwrite(key, 1, (size_t)klen, f) == (size_t)klen &&
              fwrite(&len, sizeof len, 1, f) == 1 && fwrite(bin, 1, n, f) == n &&
@@ -425,10 +478,11 @@ static mfmm_status self_test(ocl *cl, mfmm_error *err);
 
 /* A program from a cached binary, built and self-tested; NULL when any step
  * fails. */
-static cl_program program_from_cache(ocl *cl, const char *path, const char *key)
+static cl_program program_from_cache(ocl *cl, const char *path,
+                                     const unsigned char secret[16], const char *key)
 {
     size_t n = 0;
-    unsigned char *bin = cache_load(path, key, &n);
+    unsigned char *bin = cache_load(path, secret, key, &n);
     if (!bin)
         return NULL;
     const unsigned char *bins[1] = {bin};
@@ -457,13 +511,15 @@ static cl_program program_from_cache(ocl *cl, const char *path, const char *key)
 static mfmm_status build_program(ocl *cl, const char *cache_option, mfmm_error *err)
 {
     char dir[1024], path[1100], key[2048];
-    int have_dir = program_key(cl, key, sizeof key) && cache_dir(cache_option, dir, sizeof dir);
+    unsigned char secret[16];
+    int have_dir = program_key(cl, key, sizeof key) && cache_dir(cache_option, dir, sizeof dir) &&
+                   cache_secret(dir, secret);
     if (have_dir && snprintf(path, sizeof path, "%s/fmm_rows-%016llx.bin", dir,
                              (unsigned long long)fnv1a(MFMM_FNV_BASIS, key, strlen(key))) >=
                         (int)sizeof path)
         have_dir = 0;
     if (have_dir) {
-        cl_program prog = program_from_cache(cl, path, key);
+        cl_program prog = program_from_cache(cl, path, secret, key);
         if (prog) {
             cl->program = prog;
             return MFMM_OK;
@@ -485,7 +541,8 @@ static mfmm_status build_program(ocl *cl, const char *cache_option, mfmm_error *
                          cl->name, cl_error_name(e), log[0] ? ": " : "", log);
     }
     cl->program = prog;
-    if (have_dir) {
+    /* only a program that passes the self-test is cached (a cached one must pass it) */
+    if (have_dir && self_test(cl, NULL) == MFMM_OK) {
         size_t n = 0;
         if (cl->api->clGetProgramInfo(prog, CL_PROGRAM_BINARY_SIZES, sizeof n, &n, NULL) ==
                 CL_SUCCESS &&
@@ -494,7 +551,7 @@ static mfmm_status build_program(ocl *cl, const char *cache_option, mfmm_error *
             unsigned char *bins[1] = {bin};
             if (bin && cl->api->clGetProgramInfo(prog, CL_PROGRAM_BINARIES, sizeof bins, bins,
                                                  NULL) == CL_SUCCESS)
-                cache_store(dir, path, key, bin, n);
+                cache_store(path, secret, key, bin, n);
             free(bin);
         }
     }
@@ -876,10 +933,10 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
     return st;
 }
 
-/* ---- the self-test of a program loaded from the cache ----
+/* ---- the self-test of a program before it goes to or comes from the cache ----
  * All rows of a small mesh with obtuse corners (a sheared 5 x 4 grid), in
- * float64 and float32, against mfmm_solve. A binary that fails to build a
- * kernel, to run or to give these rows is not used. */
+ * float64 and float32, against mfmm_solve, bit for bit. A cached binary that
+ * fails to make a kernel, to run or to give exactly these rows is not used. */
 static mfmm_status self_test(ocl *cl, mfmm_error *err)
 {
     enum { NX = 5, NY = 4, NV = NX * NY, NF = 2 * (NX - 1) * (NY - 1) };
@@ -934,7 +991,7 @@ static mfmm_status self_test(ocl *cl, mfmm_error *err)
         for (int i = 0; st == MFMM_OK && i < NV * NV; i++) {
             double r = f64 ? got.d[i] : (double)got.f[i];
             double want = f64 ? ref[i] : (double)(float)ref[i];
-            if (!(r == want || fabs(r - want) <= 1e-6 * (1.0 + fabs(want))))
+            if (memcmp(&r, &want, sizeof r) != 0)
                 st = mfmm_fail(err, MFMM_ERR_OPENCL_RUNTIME, i,
                                "OpenCL self-test: row %d vertex %d is %.17g, not %.17g",
                                i / NV, i % NV, r, want);
