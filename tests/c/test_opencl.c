@@ -469,6 +469,122 @@ static void test_cache_altered_entries(void **state)
 }
 #endif
 
+static int batch_first_n = 0;
+static int first_batch(void *user, int32_t first, int32_t n, const void *rows)
+{
+    (void)user;
+    (void)rows;
+    if (first == 0)
+        batch_first_n = n;
+    return 0;
+}
+
+/* Issue 13: with the default memory budget (16 MiB) a batch held one row of a
+ * mesh above ~227k vertices (37 bytes per vertex and row), and OpenCL ran on
+ * one core. A batch now holds a row per compute unit (this machine's cores,
+ * on PoCL); and auto runs threads, saying why, when memory_limit keeps
+ * OpenCL from filling every compute unit. */
+static void test_batches_fill_compute_units(void **state)
+{
+    (void)state;
+    if (have_device == 0)
+        skip();
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    if (cores < 2)
+        skip();
+    mfmm_gen_mesh g = mfmm_gen_grid(500); /* 251001 vertices */
+    mfmm_mesh *mesh = tm_make(&g);
+    int32_t src[4] = {0, 1000, 125000, 250000};
+    mfmm_matrix_options o;
+    mfmm_matrix_options_init(&o);
+    o.backend = MFMM_BACKEND_OPENCL;
+    o.max_distance = 1e-9; /* each row stops at its source: the batch size is what counts */
+    o.on_rows = first_batch;
+    mfmm_error err;
+    if (mfmm_distance_matrix(mesh, src, 4, &o, &err) != MFMM_OK)
+        fail_msg("%s", err.message);
+    assert_true(batch_first_n >= 2);
+    mfmm_mesh_destroy(mesh);
+    mfmm_gen_free(&g);
+
+    g = mfmm_gen_grid(20);
+    mesh = tm_make(&g);
+    int32_t nv = g.nv;
+    src[1] = 200;
+    double *ref = tm_reference_rows(mesh, src, 2, NULL);
+    double *out = malloc(2 * (size_t)nv * sizeof *out);
+    assert_non_null(out);
+    mfmm_matrix_options_init(&o);
+    o.dtype = MFMM_FLOAT64;
+    o.out = out;
+    o.memory_limit = (size_t)nv * 40; /* one row at a time */
+    assert_int_equal(mfmm_distance_matrix(mesh, src, 2, &o, &err), MFMM_OK);
+    assert_int_equal(o.backend_used, MFMM_BACKEND_THREADS);
+    assert_non_null(strstr(o.fallback_reason, "compute units"));
+    assert_memory_equal(out, ref, 2 * (size_t)nv * sizeof *out);
+    o.memory_limit = 0; /* the default: OpenCL, no reason */
+    assert_int_equal(mfmm_distance_matrix(mesh, src, 2, &o, &err), MFMM_OK);
+    assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL);
+    assert_string_equal(o.fallback_reason, "");
+    assert_memory_equal(out, ref, 2 * (size_t)nv * sizeof *out);
+    free(out);
+    free(ref);
+    mfmm_mesh_destroy(mesh);
+    mfmm_gen_free(&g);
+}
+
+/* The device and cache folder through mfmm_opencl_options (they win over the
+ * environment); a wrong struct_size is refused. */
+static void test_opencl_options(void **state)
+{
+    (void)state;
+    if (have_device == 0)
+        skip();
+    char dir[64] = "/tmp/mfmm_clopt_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char sub[128];
+    snprintf(sub, sizeof sub, "%s/a/b", dir);
+    mfmm_opencl_options co;
+    mfmm_opencl_options_init(&co);
+    assert_int_equal(co.struct_size, sizeof co);
+    co.cache_dir = sub;
+    co.device = "0";
+    setenv("MESHFMM_OPENCL_DEVICE", "no-such-device-name", 1);
+    mfmm_opencl_context *ctx = NULL;
+    mfmm_error err;
+    if (mfmm_opencl_context_create(&co, &ctx, &err) != MFMM_OK)
+        fail_msg("%s", err.message);
+    unsetenv("MESHFMM_OPENCL_DEVICE");
+    mfmm_opencl_context_destroy(ctx);
+    char entry[512];
+    DIR *d = opendir(sub);
+    assert_non_null(d);
+    int bins = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        if (e->d_name[0] == '.')
+            continue;
+        bins += strstr(e->d_name, ".bin") != NULL;
+        snprintf(entry, sizeof entry, "%s/%s", sub, e->d_name);
+        remove(entry);
+    }
+    closedir(d);
+    assert_int_equal(bins, 1);
+    rmdir(sub);
+    snprintf(sub, sizeof sub, "%s/a", dir);
+    rmdir(sub);
+    rmdir(dir);
+
+    co.device = "no-such-device-name";
+    assert_int_equal(mfmm_opencl_context_create(&co, &ctx, &err), MFMM_ERR_NO_OPENCL);
+    assert_non_null(strstr(err.message, "no-such-device-name"));
+    co.device = NULL;
+    co.struct_size = sizeof co - 8;
+    assert_int_equal(mfmm_opencl_context_create(&co, &ctx, &err), MFMM_ERR_BAD_ARGUMENT);
+    assert_non_null(strstr(err.message, "struct_size"));
+    assert_null(ctx);
+}
+
 /* MESHFMM_OPENCL_DEVICE: an index or a name substring; a wrong one is
  * MFMM_ERR_NO_OPENCL (auto then falls back to threads). */
 static void test_device_selection_and_cancel(void **state)
@@ -591,6 +707,8 @@ int main(void)
 #endif
         cmocka_unit_test(test_device_selection_and_cancel),
         cmocka_unit_test(test_reused_context),
+        cmocka_unit_test(test_batches_fill_compute_units),
+        cmocka_unit_test(test_opencl_options),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     remove_cache();
