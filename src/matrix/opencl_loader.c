@@ -58,10 +58,11 @@ mfmm_status mfmm_cl_api_load(mfmm_cl_api *api, const char *library, mfmm_error *
     return MFMM_OK;
 }
 
+/* The loader is not dlclose'd: drivers (PoCL) keep worker threads and
+ * allocations for the life of the process, which must not outlive their code.
+ * A later dlopen of the loaded library only counts a reference. */
 void mfmm_cl_api_unload(mfmm_cl_api *api)
 {
-    if (api->handle)
-        dlclose(api->handle);
     memset(api, 0, sizeof *api);
 }
 
