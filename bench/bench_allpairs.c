@@ -120,7 +120,7 @@ static void run_child(const char *path, mfmm_backend backend, int threads, int32
     o.on_rows = drop_rows;
     o.user = &r.rows;
     if (backend == MFMM_BACKEND_OPENCL) { /* build (or load) the program first */
-        if (mfmm_opencl_context_create(&ctx, &err) != MFMM_OK) {
+        if (mfmm_opencl_context_create(NULL, &ctx, &err) != MFMM_OK) {
             fprintf(stderr, "%s opencl: %s\n", path, err.message);
             free(src);
             goto out;

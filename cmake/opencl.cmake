@@ -34,12 +34,17 @@ if(NOT MESHFMM_WITH_OPENCL)
   return()
 endif()
 
-find_package(OpenCL)
-if(NOT OpenCL_FOUND)
-  message(STATUS "meshfmm: OpenCL not found; the opencl backend will report MFMM_ERR_NO_OPENCL")
+# Only the headers: libmeshfmm opens the ICD loader (libOpenCL.so.1) at run
+# time (src/matrix/opencl_loader.c), so it links no OpenCL library and loads on
+# machines without one.
+find_path(MESHFMM_OPENCL_INCLUDE_DIR CL/cl.h
+  HINTS ${OpenCL_INCLUDE_DIR} ENV OpenCL_ROOT
+  DOC "Folder holding CL/cl.h (the opencl-headers package)")
+if(NOT MESHFMM_OPENCL_INCLUDE_DIR)
+  message(STATUS "meshfmm: OpenCL headers (CL/cl.h) not found; the opencl backend will report MFMM_ERR_NO_OPENCL")
   return()
 endif()
-message(STATUS "meshfmm: OpenCL backend on (${OpenCL_LIBRARIES})")
+message(STATUS "meshfmm: OpenCL backend on (headers in ${MESHFMM_OPENCL_INCLUDE_DIR}; libOpenCL.so.1 loaded at run time)")
 
 set(MESHFMM_KERNEL_C ${CMAKE_CURRENT_BINARY_DIR}/generated/fmm_rows_cl.c)
 add_custom_command(OUTPUT ${MESHFMM_KERNEL_C}
@@ -54,5 +59,4 @@ add_custom_command(OUTPUT ${MESHFMM_KERNEL_C}
   VERBATIM)
 target_sources(meshfmm_objects PRIVATE ${MESHFMM_KERNEL_C})
 target_compile_definitions(meshfmm_objects PRIVATE MESHFMM_HAVE_OPENCL CL_TARGET_OPENCL_VERSION=120)
-target_link_libraries(meshfmm_objects PRIVATE OpenCL::OpenCL)
-list(APPEND MESHFMM_LINK_LIBS OpenCL::OpenCL)
+target_include_directories(meshfmm_objects SYSTEM PRIVATE ${MESHFMM_OPENCL_INCLUDE_DIR})

@@ -39,6 +39,19 @@ extern "C" {
 #define MFMM_VERSION_MINOR 1
 #define MFMM_VERSION_PATCH 0
 
+/* ABI policy. The shared library's soname is libmeshfmm.so.MAJOR (the CMake
+ * SOVERSION is the major version). While MAJOR is 0, a MINOR release may break
+ * the ABI and the API (the CMake package then accepts only the same MINOR:
+ * find_package(meshfmm 0.1) takes 0.1.x); PATCH releases never do. From 1.0
+ * on, only a MAJOR release breaks the ABI (and changes the soname).
+ * Every option struct starts with `size_t struct_size`, which its _init
+ * function sets to the sizeof the caller was compiled with: a struct that
+ * later grows gains fields at its end, and the library reads a caller's
+ * smaller, older struct by its size. Always fill an option struct with its
+ * _init function before setting fields. A struct_size the library does not
+ * know (not from an _init, or from a newer header than the library) is
+ * refused with MFMM_ERR_BAD_ARGUMENT and a message naming both sizes. */
+
 /* ---------------------------------------------------------------- status */
 
 typedef enum mfmm_status {
@@ -87,6 +100,7 @@ MFMM_API const char *mfmm_version(void);
 typedef struct mfmm_mesh mfmm_mesh;
 
 typedef struct mfmm_mesh_options {
+    size_t struct_size;   /* sizeof(mfmm_mesh_options), set by the _init function */
     /* Most faces one unfolding walk may cross to find the virtual edge of an
      * obtuse corner (paper section 4.2); a walk that needs more fails and the
      * corner keeps its plain stencil. Default 64; must be >= 1. */
@@ -175,6 +189,7 @@ MFMM_API mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out
 MFMM_API void mfmm_solver_destroy(mfmm_solver *solver);
 
 typedef struct mfmm_solve_options {
+    size_t struct_size;              /* sizeof(mfmm_solve_options), set by the _init function */
     const double *cost;              /* NULL: F = 1 */
     mfmm_cost_location cost_location;/* ignored when cost is NULL */
     double max_distance;             /* stop past it; vertices beyond are +inf. Default +inf */
@@ -208,6 +223,7 @@ typedef struct mfmm_surface_point {
 } mfmm_surface_point;
 
 typedef struct mfmm_path_options {
+    size_t struct_size;   /* sizeof(mfmm_path_options), set by the _init function */
     int32_t max_points;   /* most points a path may have; default 100000 */
     /* Sources the distances came from (as given to mfmm_solve): the path ends
      * exactly at the one the target's distance came from (a vertex source at
@@ -274,16 +290,52 @@ MFMM_API const char *mfmm_backend_name(mfmm_backend backend);
 /* An OpenCL device with meshfmm's program built for it (building takes
  * 0.03 s with warm caches, about 1 s cold). Make one and pass it in
  * mfmm_matrix_options.opencl to build once for many calls. Thread-safe: each
- * call makes its own queue and kernel. */
+ * call makes its own queue and kernel.
+ *
+ * OpenCL is loaded at run time: the library does not link libOpenCL, and
+ * opens the ICD loader (libOpenCL.so.1) only when a context is made, so
+ * meshfmm loads and solves on a machine without any OpenCL, and only the
+ * OpenCL backend needs it. The context holds the loader's function table (no
+ * global state). */
 typedef struct mfmm_opencl_context mfmm_opencl_context;
 
-/* Selects the device (environment MESHFMM_OPENCL_DEVICE: an index over all
- * platforms' devices or a substring of a device name; default the first CPU
- * device) and builds the program, from the disk cache when it can
- * (MESHFMM_CACHE_DIR, else $XDG_CACHE_HOME/meshfmm, else ~/.cache/meshfmm).
- * MFMM_ERR_NO_OPENCL when no device works or meshfmm was built without
- * OpenCL; MFMM_ERR_OPENCL_BUILD when the program does not build. */
-MFMM_API mfmm_status mfmm_opencl_context_create(mfmm_opencl_context **out, mfmm_error *err);
+/* How to make an OpenCL context. Every field NULL means the default, which
+ * an environment variable may set; a field set here wins over the environment.
+ *   device:    an index over all platforms' devices in order ("0", "1", ...),
+ *              or a case-insensitive substring of a device name ("pthread",
+ *              "NVIDIA"). NULL: $MESHFMM_OPENCL_DEVICE, else the first CPU
+ *              device, else the first device.
+ *   cache_dir: the folder for the built program binary. NULL:
+ *              $MESHFMM_CACHE_DIR, else $XDG_CACHE_HOME/meshfmm, else
+ *              $HOME/.cache/meshfmm. "" : no disk cache (always build).
+ *              Entries are files fmm_rows-<key>.bin, <key> a hash of the kernel
+ *              source, build options, library version, platform, device and
+ *              driver versions, so a binary from another build or driver is
+ *              never loaded; a damaged entry is rebuilt from source and
+ *              replaced. Deleting the folder (or its fmm_rows-*.bin files)
+ *              clears the cache; it is refilled on the next build.
+ *   library:   the OpenCL ICD loader to dlopen. NULL: $MESHFMM_OPENCL_LIBRARY,
+ *              else "libOpenCL.so.1". */
+typedef struct mfmm_opencl_options {
+    size_t struct_size;      /* sizeof(mfmm_opencl_options), set by the _init function */
+    const char *device;
+    const char *cache_dir;
+    const char *library;
+} mfmm_opencl_options;
+
+/* Fills `options` with the defaults (all NULL: the environment, then the
+ * built-in defaults). */
+MFMM_API void mfmm_opencl_options_init(mfmm_opencl_options *options);
+
+/* Loads OpenCL, selects the device and builds the program (from the disk
+ * cache when it holds a valid binary for this exact build and driver).
+ *   options: NULL for defaults (see mfmm_opencl_options).
+ *   out:     receives the context; NULL on failure.
+ * MFMM_ERR_NO_OPENCL when the loader cannot be opened, no device matches or
+ * works, or meshfmm was built without the OpenCL headers; MFMM_ERR_OPENCL_BUILD
+ * when the program does not build. The mfmm_error says which. */
+MFMM_API mfmm_status mfmm_opencl_context_create(const mfmm_opencl_options *options,
+                                                mfmm_opencl_context **out, mfmm_error *err);
 
 /* Frees a context; NULL is a no-op. No call may be using it. */
 MFMM_API void mfmm_opencl_context_destroy(mfmm_opencl_context *context);
@@ -304,6 +356,7 @@ typedef int (*mfmm_rows_callback)(void *user, int32_t first_row, int32_t n_rows,
                                   const void *rows);
 
 typedef struct mfmm_matrix_options {
+    size_t struct_size;              /* sizeof(mfmm_matrix_options), set by the _init function */
     mfmm_backend backend;            /* default MFMM_BACKEND_AUTO */
     mfmm_dtype dtype;                /* output type; arithmetic is always float64. Default float32 */
     const double *cost;              /* as in mfmm_solve_options */
@@ -319,6 +372,11 @@ typedef struct mfmm_matrix_options {
     mfmm_backend backend_used;       /* out: the backend that ran */
     mfmm_opencl_context *opencl;     /* for the OpenCL backend: a context to reuse, or
                                         NULL to make one for this call */
+    const mfmm_opencl_options *opencl_options; /* how to make the call's context when
+                                        opencl is NULL; NULL: defaults */
+    char fallback_reason[256];       /* out: with backend AUTO, why threads ran instead of
+                                        OpenCL (the OpenCL error, or that OpenCL could not
+                                        keep every core busy); "" when OpenCL ran */
 } mfmm_matrix_options;
 
 MFMM_API void mfmm_matrix_options_init(mfmm_matrix_options *options);
@@ -327,14 +385,16 @@ MFMM_API void mfmm_matrix_options_init(mfmm_matrix_options *options);
  * every vertex (equal to mfmm_solve's). sources NULL: all vertices, in order
  * (n_sources must then be nv). Rows go to options->out, to options->on_rows,
  * or both; the library holds only the blocks in flight, never n_sources x nv.
- * With backend AUTO, an OpenCL failure falls back to threads (from the first
- * row not yet delivered); options->backend_used tells which ran.
- * OpenCL: the device is $MESHFMM_OPENCL_DEVICE (an index over all platforms'
- * devices, or a substring of a device name), default the first CPU device;
- * the program binary is cached in $MESHFMM_CACHE_DIR, else
- * $XDG_CACHE_HOME/meshfmm, else ~/.cache/meshfmm (best effort). Float64
- * rows equal mfmm_solve's bit for bit (OpenCL: built without contraction or
- * relaxed math; tested on PoCL). */
+ * With backend AUTO, threads run instead of OpenCL when OpenCL fails (from the
+ * first row not yet delivered), and when OpenCL could not keep every compute
+ * unit busy (a batch of rows smaller than the device's compute units within
+ * memory_limit); options->backend_used tells which ran and
+ * options->fallback_reason why. OpenCL: the device and program cache are
+ * options->opencl's, else options->opencl_options' (see
+ * mfmm_opencl_options). A batch holds at least one row per compute unit
+ * (each row needs about 37 bytes per vertex for float32 output) unless
+ * memory_limit is set and smaller. Float64 rows equal mfmm_solve's bit for bit
+ * (OpenCL: built without contraction or relaxed math; tested on PoCL). */
 MFMM_API mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
                                           int32_t n_sources, mfmm_matrix_options *options,
                                           mfmm_error *err);

@@ -1,12 +1,20 @@
 #!/usr/bin/env bash
 # Installs everything meshfmm needs on Debian (as root), builds the C library,
 # command line, tests and benchmarks into build/, and installs the Python
-# package into .venv/. Safe to run again: it only does what is missing.
+# package into .venv/. Safe to run again: it only does what is missing or
+# changed (stamps in .venv/: the requirements' hash, the package sources' hash),
+# so a second run with nothing changed takes about a second.
+#   setup.sh [--deps-only]   --deps-only: Debian packages and .venv's
+#                            requirements, no build/ and no package install
+#                            (scripts/test.sh builds in a clean clone instead)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+deps_only=0
+[ "${1:-}" = "--deps-only" ] && deps_only=1
 
 packages=(build-essential cmake pkg-config python3 python3-venv python3-dev
-          pocl-opencl-icd ocl-icd-opencl-dev opencl-headers clinfo libcmocka-dev)
+          pocl-opencl-icd ocl-icd-libopencl1 opencl-headers clinfo libcmocka-dev
+          git clang locales)
 if command -v apt-get >/dev/null 2>&1; then
     missing=()
     for p in "${packages[@]}"; do
@@ -26,13 +34,37 @@ if [ ! -x .venv/bin/python ]; then
     echo "setup: creating .venv"
     python3 -m venv .venv
 fi
-.venv/bin/python -m pip install -q --upgrade pip >/dev/null
-.venv/bin/python -m pip install -q -r requirements-dev.txt
+# pip only when requirements-dev.txt (or the Python) changed
+req_hash=$( { cat requirements-dev.txt; .venv/bin/python -VV; } | sha256sum | cut -d' ' -f1)
+req_stamp=.venv/.meshfmm-requirements.sha256
+if [ "$(cat "$req_stamp" 2>/dev/null)" != "$req_hash" ]; then
+    .venv/bin/python -m pip install -q --upgrade pip >/dev/null
+    .venv/bin/python -m pip install -q -r requirements-dev.txt
+    echo "$req_hash" > "$req_stamp"
+else
+    echo "setup: .venv has requirements-dev.txt's packages (unchanged)"
+fi
+
+[ "$deps_only" = 1 ] && exit 0
 
 jobs=$(nproc 2>/dev/null || echo 2)
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+# configure once; later builds are incremental (cmake --build re-configures
+# when a CMakeLists.txt changed)
+[ -f build/CMakeCache.txt ] || cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$jobs" >/dev/null
 echo "setup: built build/ (library, meshfmm command, tests, benchmarks)"
 
-.venv/bin/python -m pip install -q . >/dev/null
-echo "setup: installed the meshfmm Python package into .venv"
+# the package again only when what goes into it changed: a hash of every file
+# under these paths (committed or not), and of the requirements
+pkg_hash=$( { echo "$req_hash"
+              find src include kernels bindings cmake CMakeLists.txt pyproject.toml -type f \
+                   ! -name '*.pyc' ! -path '*/__pycache__/*' -print0 | sort -z | xargs -0 sha256sum; } \
+            | sha256sum | cut -d' ' -f1)
+pkg_stamp=.venv/.meshfmm-package.sha256
+if [ "$(cat "$pkg_stamp" 2>/dev/null)" != "$pkg_hash" ] || ! .venv/bin/python -c 'import meshfmm' 2>/dev/null; then
+    .venv/bin/python -m pip install -q . >/dev/null
+    echo "$pkg_hash" > "$pkg_stamp"
+    echo "setup: installed the meshfmm Python package into .venv"
+else
+    echo "setup: the meshfmm Python package in .venv is up to date"
+fi

@@ -1,13 +1,34 @@
 #!/usr/bin/env bash
-# Sets everything up (scripts/setup.sh), then runs every test: the C tests
-# (ctest), the C tests again under AddressSanitizer and
-# UndefinedBehaviorSanitizer, and the Python tests (pytest).
+# Sets up the dependencies (scripts/setup.sh --deps-only: Debian packages and
+# .venv), then runs every test in a fresh `git clone` of HEAD in a temporary
+# folder with nothing beside it, so that a test depending on a file outside
+# the repository (or not committed) fails here: the C tests (ctest: cmocka,
+# command line, consumer), the C tests again under AddressSanitizer and
+# UndefinedBehaviorSanitizer, and the Python tests (pytest) against the
+# clone's library. The clone's builds are the only builds (no duplicate in
+# place). Outside a git checkout it runs in place.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup.sh
+repo=$PWD
+bash scripts/setup.sh --deps-only
 jobs=$(nproc 2>/dev/null || echo 2)
 
+if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
+    if [ -n "$(git status --porcelain --untracked-files=no)" ]; then
+        echo "test: note: uncommitted changes are not tested (the clone has HEAD only)" >&2
+    fi
+    tmp=$(mktemp -d)
+    trap 'rm -rf "$tmp"' EXIT
+    git clone -q --no-local "$repo" "$tmp/meshfmm"
+    # the environment, not sources: the venv setup.sh made
+    ln -s "$repo/.venv" "$tmp/meshfmm/.venv"
+    cd "$tmp/meshfmm"
+    echo "== testing a clean clone of $(git rev-parse --short HEAD) in $PWD"
+fi
+
 echo "== C tests (ctest, Release)"
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMESHFMM_BUILD_BENCH=OFF >/dev/null
+cmake --build build -j"$jobs" >/dev/null
 ctest --test-dir build --output-on-failure -j"$jobs"
 
 echo "== C tests under AddressSanitizer + UndefinedBehaviorSanitizer"
@@ -16,5 +37,6 @@ cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Debug -DMESHFMM_SANITIZE=ON \
 cmake --build build-sanitize -j"$jobs" >/dev/null
 ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-sanitize --output-on-failure -j"$jobs"
 
-echo "== Python tests (pytest)"
-MESHFMM_CLI="$PWD/build/meshfmm" .venv/bin/python -m pytest tests/python -q
+echo "== Python tests (pytest, against this tree's build)"
+MESHFMM_LIBRARY="$PWD/build/libmeshfmm.so" PYTHONPATH="$PWD/bindings/python" \
+MESHFMM_CLI="$PWD/build/meshfmm" .venv/bin/python -m pytest tests/python -q -p no:cacheprovider

@@ -256,20 +256,15 @@ int cmd_allpairs(int argc, char **argv)
     s.t0 = s.last = now();
     o.on_rows = on_rows;
     o.user = &s;
-    o.backend = backend == MFMM_BACKEND_AUTO ? MFMM_BACKEND_OPENCL : backend;
+    o.backend = backend;
     mfmm_error err;
+    /* auto: the library runs OpenCL, or threads (from the first row not
+     * delivered) when OpenCL fails or cannot keep every core busy */
     mfmm_status st = mfmm_distance_matrix(mesh, src, (int32_t)n_src, &o, &err);
-    mfmm_backend used = o.backend;
-    if (backend == MFMM_BACKEND_AUTO && !interrupted &&
-        (st == MFMM_ERR_NO_OPENCL || st == MFMM_ERR_OPENCL_BUILD ||
-         st == MFMM_ERR_OPENCL_RUNTIME || st == MFMM_ERR_OUT_OF_MEMORY)) {
-        /* go on with threads from the first row not written */
-        fprintf(stderr, "meshfmm allpairs: OpenCL unavailable (%s); falling back to threads\n",
-                err.message);
-        s.base = s.done;
-        o.backend = used = MFMM_BACKEND_THREADS;
-        st = mfmm_distance_matrix(mesh, src + s.base, (int32_t)(n_src - s.base), &o, &err);
-    }
+    mfmm_backend used = o.backend_used;
+    if (o.fallback_reason[0])
+        fprintf(stderr, "meshfmm allpairs: OpenCL not used (%s); falling back to threads\n",
+                o.fallback_reason);
     if (interrupted) {
         cli_npy_abort(&s.w);
         if (!quiet && s.tty)

@@ -15,8 +15,11 @@
 
 void mfmm_mesh_options_init(mfmm_mesh_options *options)
 {
-    if (options)
-        options->max_unfold_steps = 64;
+    if (!options)
+        return;
+    memset(options, 0, sizeof *options);
+    options->struct_size = sizeof *options;
+    options->max_unfold_steps = 64;
 }
 
 void mfmm_mesh_destroy(mfmm_mesh *mesh)
@@ -392,8 +395,11 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
                          INT32_MAX / 3, (long)nv, (long)nf);
     mfmm_mesh_options opt;
     mfmm_mesh_options_init(&opt);
-    if (options)
+    if (options) {
+        if (mfmm_check_struct_size(options, sizeof opt, "mfmm_mesh_options", err) != MFMM_OK)
+            return MFMM_ERR_BAD_ARGUMENT;
         opt = *options;
+    }
     if (opt.max_unfold_steps < 1)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "max_unfold_steps must be >= 1 (got %ld)",
                          (long)opt.max_unfold_steps);

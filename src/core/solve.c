@@ -2,6 +2,7 @@
  * (src/march.h). */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "mesh.h"
 #include "solve.h"
@@ -53,6 +54,8 @@ void mfmm_solve_options_init(mfmm_solve_options *options)
 {
     if (!options)
         return;
+    memset(options, 0, sizeof *options);
+    options->struct_size = sizeof *options;
     options->cost = NULL;
     options->cost_location = MFMM_COST_NONE;
     options->max_distance = INFINITY;
@@ -214,8 +217,11 @@ mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources, int32_t 
     const mfmm_mesh *mesh = solver->mesh;
     mfmm_solve_options opt;
     mfmm_solve_options_init(&opt);
-    if (options)
+    if (options) {
+        if (mfmm_check_struct_size(options, sizeof opt, "mfmm_solve_options", err) != MFMM_OK)
+            return MFMM_ERR_BAD_ARGUMENT;
         opt = *options;
+    }
     if (!opt.cost)
         opt.cost_location = MFMM_COST_NONE;
     mfmm_status st = mfmm_check_cost(mesh, opt.cost, opt.cost_location, err);

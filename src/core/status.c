@@ -2,6 +2,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "mesh.h"
 
@@ -61,6 +62,19 @@ mfmm_status mfmm_fail(mfmm_error *err, mfmm_status status, int64_t index, const 
         }
     }
     return status;
+}
+
+mfmm_status mfmm_check_struct_size(const void *options, size_t known, const char *type,
+                                   mfmm_error *err)
+{
+    size_t given;
+    memcpy(&given, options, sizeof given);
+    if (given == known)
+        return MFMM_OK;
+    return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                     "%s.struct_size is %zu, but this library (meshfmm %s) knows only %zu: "
+                     "fill it with %s_init (a header of another version?)",
+                     type, given, mfmm_version(), known, type);
 }
 
 void mfmm_ok(mfmm_error *err)

@@ -2,6 +2,7 @@
  * serial core (one thread or many) or on OpenCL (src/opencl_host.c). */
 #include <math.h>
 #include <pthread.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -25,6 +26,7 @@ void mfmm_matrix_options_init(mfmm_matrix_options *options)
     if (!options)
         return;
     memset(options, 0, sizeof *options);
+    options->struct_size = sizeof *options;
     options->backend = MFMM_BACKEND_AUTO;
     options->dtype = MFMM_FLOAT32;
     options->cost = NULL;
@@ -329,7 +331,10 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     if (!options)
         return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "options is NULL");
     mfmm_matrix_options *o = options;
+    if (mfmm_check_struct_size(o, sizeof *o, "mfmm_matrix_options", err) != MFMM_OK)
+        return MFMM_ERR_BAD_ARGUMENT;
     o->backend_used = o->backend;
+    o->fallback_reason[0] = '\0';
     int32_t nv = mesh->nv;
     if (!o->out && !o->on_rows)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
@@ -374,6 +379,7 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
         sources = all;
     }
     mfmm_rows_job job;
+    memset(&job, 0, sizeof job);
     job.mesh = mesh;
     job.sources = sources;
     job.n_sources = n_sources;
@@ -396,15 +402,20 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
         st = mfmm_opencl_rows(&job, 0, &done, err);
         break;
     }
-    default: { /* auto: OpenCL, else threads from the first row not delivered */
+    default: { /* auto: OpenCL when it keeps every compute unit busy, else
+                * threads from the first row not delivered, saying why */
         int32_t done = 0;
+        mfmm_error cl_err;
         o->backend_used = MFMM_BACKEND_OPENCL;
-        st = mfmm_opencl_rows(&job, 0, &done, err);
+        job.full_batches = 1;
+        st = mfmm_opencl_rows(&job, 0, &done, &cl_err);
         if (st == MFMM_ERR_NO_OPENCL || st == MFMM_ERR_OPENCL_BUILD ||
             st == MFMM_ERR_OPENCL_RUNTIME || st == MFMM_ERR_OUT_OF_MEMORY) {
             o->backend_used = MFMM_BACKEND_THREADS;
-            mfmm_ok(err);
+            snprintf(o->fallback_reason, sizeof o->fallback_reason, "%s", cl_err.message);
             st = run_threads(&job, done, err);
+        } else if (st != MFMM_OK && err) {
+            *err = cl_err;
         }
         break;
     }

@@ -1,21 +1,42 @@
-/* The OpenCL backend of mfmm_distance_matrix: device selection, the program
- * (kernels/fmm_rows.cl, embedded at build time) with its binary cached on
- * disk, batches of rows, one work-item per source. Without OpenCL at build
- * time it reports MFMM_ERR_NO_OPENCL. The device and the built program live
- * in an mfmm_opencl_context (the caller's, or one made for the call); a call's
- * queue, kernel and buffers are its own, so a context serves many threads. */
+/* The OpenCL backend of mfmm_distance_matrix: OpenCL loaded at run time
+ * (opencl_loader.c), device selection, the program (kernels/fmm_rows.cl,
+ * embedded at build time) with its binary cached on disk, batches of rows,
+ * one work-item per source. Without the OpenCL headers at build time it
+ * reports MFMM_ERR_NO_OPENCL. The loader's table, the device and the built
+ * program live in an mfmm_opencl_context (the caller's, or one made for the
+ * call); a call's queue, kernel and buffers are its own, so a context serves
+ * many threads. */
+#include <string.h>
+
 #include "rows.h"
+#include "opencl_loader.h"
+
+void mfmm_opencl_options_init(mfmm_opencl_options *options)
+{
+    if (!options)
+        return;
+    memset(options, 0, sizeof *options);
+    options->struct_size = sizeof *options;
+    options->device = NULL;
+    options->cache_dir = NULL;
+    options->library = NULL;
+}
 
 #ifndef MESHFMM_HAVE_OPENCL
 
-mfmm_status mfmm_opencl_context_create(mfmm_opencl_context **out, mfmm_error *err)
+mfmm_status mfmm_opencl_context_create(const mfmm_opencl_options *options,
+                                       mfmm_opencl_context **out, mfmm_error *err)
 {
     mfmm_ok(err);
     if (!out)
         return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "out (the context pointer) is NULL");
     *out = NULL;
+    if (options && mfmm_check_struct_size(options, sizeof *options, "mfmm_opencl_options",
+                                          err) != MFMM_OK)
+        return MFMM_ERR_BAD_ARGUMENT;
     return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1,
-                     "meshfmm was built without OpenCL (MESHFMM_WITH_OPENCL=OFF or not found)");
+                     "meshfmm was built without OpenCL (MESHFMM_WITH_OPENCL=OFF or no "
+                     "OpenCL headers)");
 }
 
 void mfmm_opencl_context_destroy(mfmm_opencl_context *context)
@@ -37,20 +58,20 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
     if (rows_done)
         *rows_done = 0;
     return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1,
-                     "meshfmm was built without OpenCL (MESHFMM_WITH_OPENCL=OFF or not found)");
+                     "meshfmm was built without OpenCL (MESHFMM_WITH_OPENCL=OFF or no "
+                     "OpenCL headers)");
 }
 
 #else
 
 #include <ctype.h>
 #include <errno.h>
+#include <fcntl.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-
-#include <CL/cl.h>
 
 extern const char mfmm_kernel_fmm_rows[];
 extern const size_t mfmm_kernel_fmm_rows_len;
@@ -80,6 +101,7 @@ static const char *cl_error_name(cl_int e)
     case CL_INVALID_VALUE: return "CL_INVALID_VALUE";
     case CL_INVALID_BINARY: return "CL_INVALID_BINARY";
     case CL_INVALID_BUILD_OPTIONS: return "CL_INVALID_BUILD_OPTIONS";
+    case CL_INVALID_KERNEL_NAME: return "CL_INVALID_KERNEL_NAME";
     case CL_INVALID_KERNEL_ARGS: return "CL_INVALID_KERNEL_ARGS";
     case CL_INVALID_WORK_GROUP_SIZE: return "CL_INVALID_WORK_GROUP_SIZE";
     case CL_INVALID_BUFFER_SIZE: return "CL_INVALID_BUFFER_SIZE";
@@ -91,6 +113,7 @@ static const char *cl_error_name(cl_int e)
 /* ---- device selection ---- */
 
 typedef struct ocl {
+    const mfmm_cl_api *api; /* the context's loader table */
     cl_device_id device;
     cl_context context;
     cl_command_queue queue;
@@ -101,10 +124,10 @@ typedef struct ocl {
     cl_uint compute_units;
 } ocl;
 
-static void device_string(cl_device_id d, cl_device_info what, char *buf, size_t n)
+static void device_string(const ocl *cl, cl_device_info what, char *buf, size_t n)
 {
     buf[0] = '\0';
-    if (clGetDeviceInfo(d, what, n, buf, NULL) != CL_SUCCESS)
+    if (cl->api->clGetDeviceInfo(cl->device, what, n, buf, NULL) != CL_SUCCESS)
         buf[0] = '\0';
     buf[n - 1] = '\0';
 }
@@ -123,56 +146,68 @@ static int ci_contains(const char *hay, const char *needle)
     return n == 0;
 }
 
-/* MESHFMM_OPENCL_DEVICE: an index into all devices of all platforms, or a
- * substring of a device's name; default the first CPU device, else the first. */
-static mfmm_status select_device(ocl *cl, mfmm_error *err)
+/* `want` (options, else MESHFMM_OPENCL_DEVICE): an index into all devices of
+ * all platforms, or a substring of a device's name; default the first CPU
+ * device, else the first. */
+static mfmm_status select_device(ocl *cl, const char *want, mfmm_error *err)
 {
+    const mfmm_cl_api *api = cl->api;
+    const char *from = "device option";
+    if (!want) {
+        want = getenv("MESHFMM_OPENCL_DEVICE");
+        from = "MESHFMM_OPENCL_DEVICE";
+    }
     cl_uint np = 0;
-    cl_int e = clGetPlatformIDs(0, NULL, &np);
+    cl_int e = api->clGetPlatformIDs(0, NULL, &np);
     if (e != CL_SUCCESS || np == 0)
         return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1, "no OpenCL platform (clGetPlatformIDs: %s)",
                          e != CL_SUCCESS ? cl_error_name(e) : "0 platforms");
     if (np > 16)
         np = 16;
     cl_platform_id plats[16];
-    if (clGetPlatformIDs(np, plats, NULL) != CL_SUCCESS)
+    if (api->clGetPlatformIDs(np, plats, NULL) != CL_SUCCESS)
         return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1, "clGetPlatformIDs failed");
     cl_device_id devs[64];
     cl_uint nd = 0;
     for (cl_uint p = 0; p < np && nd < 64; p++) {
         cl_uint k = 0;
-        if (clGetDeviceIDs(plats[p], CL_DEVICE_TYPE_ALL, 64 - nd, devs + nd, &k) == CL_SUCCESS)
+        if (api->clGetDeviceIDs(plats[p], CL_DEVICE_TYPE_ALL, 64 - nd, devs + nd, &k) ==
+            CL_SUCCESS)
             nd += k < 64 - nd ? k : 64 - nd;
     }
     if (nd == 0)
         return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1, "no OpenCL device on %u platform(s)",
                          (unsigned)np);
-    const char *want = getenv("MESHFMM_OPENCL_DEVICE");
     int pick = -1;
     char name[256];
     if (want && *want) {
         char *end = NULL;
         long idx = strtol(want, &end, 10);
-        if (end && *end == '\0') {
+        if (end && end != want && *end == '\0') {
             if (idx < 0 || idx >= (long)nd)
                 return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1,
-                                 "MESHFMM_OPENCL_DEVICE=%s, but there are %u device(s)", want,
+                                 "%s is %s, but there are %u OpenCL device(s)", from, want,
                                  (unsigned)nd);
             pick = (int)idx;
         } else {
             for (cl_uint i = 0; i < nd && pick < 0; i++) {
-                device_string(devs[i], CL_DEVICE_NAME, name, sizeof name);
+                name[0] = '\0';
+                if (api->clGetDeviceInfo(devs[i], CL_DEVICE_NAME, sizeof name, name, NULL) !=
+                    CL_SUCCESS)
+                    name[0] = '\0';
+                name[sizeof name - 1] = '\0';
                 if (ci_contains(name, want))
                     pick = (int)i;
             }
             if (pick < 0)
                 return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1,
-                                 "no OpenCL device name contains MESHFMM_OPENCL_DEVICE=%s", want);
+                                 "no OpenCL device name contains '%s' (%s)", want, from);
         }
     } else {
         for (cl_uint i = 0; i < nd && pick < 0; i++) {
             cl_device_type t = 0;
-            if (clGetDeviceInfo(devs[i], CL_DEVICE_TYPE, sizeof t, &t, NULL) == CL_SUCCESS &&
+            if (api->clGetDeviceInfo(devs[i], CL_DEVICE_TYPE, sizeof t, &t, NULL) ==
+                    CL_SUCCESS &&
                 (t & CL_DEVICE_TYPE_CPU))
                 pick = (int)i;
         }
@@ -180,25 +215,25 @@ static mfmm_status select_device(ocl *cl, mfmm_error *err)
             pick = 0;
     }
     cl->device = devs[pick];
-    device_string(cl->device, CL_DEVICE_NAME, cl->name, sizeof cl->name);
+    device_string(cl, CL_DEVICE_NAME, cl->name, sizeof cl->name);
     cl_device_fp_config fp64 = 0;
-    if (clGetDeviceInfo(cl->device, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof fp64, &fp64, NULL) !=
+    if (api->clGetDeviceInfo(cl->device, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof fp64, &fp64, NULL) !=
             CL_SUCCESS ||
         fp64 == 0)
         return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1,
                          "OpenCL device '%s' has no float64 support", cl->name);
     cl_bool ok = CL_FALSE;
-    if (clGetDeviceInfo(cl->device, CL_DEVICE_COMPILER_AVAILABLE, sizeof ok, &ok, NULL) !=
+    if (api->clGetDeviceInfo(cl->device, CL_DEVICE_COMPILER_AVAILABLE, sizeof ok, &ok, NULL) !=
             CL_SUCCESS ||
         !ok)
         return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1, "OpenCL device '%s' has no compiler",
                          cl->name);
-    if (clGetDeviceInfo(cl->device, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof cl->global_mem,
-                        &cl->global_mem, NULL) != CL_SUCCESS ||
-        clGetDeviceInfo(cl->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof cl->max_alloc,
-                        &cl->max_alloc, NULL) != CL_SUCCESS ||
-        clGetDeviceInfo(cl->device, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof cl->compute_units,
-                        &cl->compute_units, NULL) != CL_SUCCESS)
+    if (api->clGetDeviceInfo(cl->device, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof cl->global_mem,
+                             &cl->global_mem, NULL) != CL_SUCCESS ||
+        api->clGetDeviceInfo(cl->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof cl->max_alloc,
+                             &cl->max_alloc, NULL) != CL_SUCCESS ||
+        api->clGetDeviceInfo(cl->device, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof cl->compute_units,
+                             &cl->compute_units, NULL) != CL_SUCCESS)
         return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1, "cannot query OpenCL device '%s'",
                          cl->name);
     if (cl->compute_units < 1)
@@ -206,7 +241,20 @@ static mfmm_status select_device(ocl *cl, mfmm_error *err)
     return MFMM_OK;
 }
 
-/* ---- the program, with its binary cached on disk ---- */
+/* ---- the program, with its binary cached on disk ----
+ * An entry is fmm_rows-<hash>.bin, <hash> the FNV-1a of its key: a text
+ * naming everything the binary depends on (library version, kernel source,
+ * build options, platform, device, driver). The file holds the key itself,
+ * the binary and a checksum; a binary is used only when its key text equals
+ * ours, and only after a self-test on a small mesh against the serial core.
+ * The checksum is keyed with a random secret kept in the folder (file
+ * `secret`, mode 0600): drivers parse binaries without checks (PoCL 3.1
+ * crashes in clCreateProgramWithBinary on a binary with bytes changed inside),
+ * so an entry altered by anything but this library, its plain checksum
+ * recomputed or not, never reaches the driver. Whatever fails (read, checksum,
+ * key, load, build, self-test) makes the program be built from source and the
+ * entry be replaced. Files are written to a temporary file made exclusively
+ * beside them and renamed (the secret: linked) into place. */
 
 static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
 {
@@ -218,40 +266,45 @@ static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
     return h;
 }
 
-static uint64_t fnv_str(uint64_t h, const char *s)
-{
-    return fnv1a(h, s, strlen(s) + 1);
-}
+#define MFMM_FNV_BASIS 14695981039346656037ull
 
-/* Key of a binary: kernel source, device, driver and build options. */
-static uint64_t program_key(const ocl *cl)
+/* The key text of ocl's device; 0 when it does not fit. */
+static int program_key(const ocl *cl, char *key, size_t n)
 {
-    char buf[512];
-    uint64_t h = 14695981039346656037ull;
-    h = fnv1a(h, mfmm_kernel_fmm_rows, mfmm_kernel_fmm_rows_len);
-    h = fnv_str(h, build_options);
-    h = fnv_str(h, cl->name);
-    device_string(cl->device, CL_DEVICE_VERSION, buf, sizeof buf);
-    h = fnv_str(h, buf);
-    device_string(cl->device, CL_DRIVER_VERSION, buf, sizeof buf);
-    h = fnv_str(h, buf);
+    char dev_ver[256], drv_ver[256], plat_name[256], plat_ver[256];
+    device_string(cl, CL_DEVICE_VERSION, dev_ver, sizeof dev_ver);
+    device_string(cl, CL_DRIVER_VERSION, drv_ver, sizeof drv_ver);
+    plat_name[0] = plat_ver[0] = '\0';
     cl_platform_id plat = NULL;
-    if (clGetDeviceInfo(cl->device, CL_DEVICE_PLATFORM, sizeof plat, &plat, NULL) ==
-            CL_SUCCESS &&
-        clGetPlatformInfo(plat, CL_PLATFORM_VERSION, sizeof buf, buf, NULL) == CL_SUCCESS) {
-        buf[sizeof buf - 1] = '\0';
-        h = fnv_str(h, buf);
+    if (cl->api->clGetDeviceInfo(cl->device, CL_DEVICE_PLATFORM, sizeof plat, &plat, NULL) ==
+        CL_SUCCESS) {
+        if (cl->api->clGetPlatformInfo(plat, CL_PLATFORM_NAME, sizeof plat_name, plat_name,
+                                       NULL) != CL_SUCCESS)
+            plat_name[0] = '\0';
+        if (cl->api->clGetPlatformInfo(plat, CL_PLATFORM_VERSION, sizeof plat_ver, plat_ver,
+                                       NULL) != CL_SUCCESS)
+            plat_ver[0] = '\0';
+        plat_name[sizeof plat_name - 1] = plat_ver[sizeof plat_ver - 1] = '\0';
     }
-    return h;
+    uint64_t src = fnv1a(MFMM_FNV_BASIS, mfmm_kernel_fmm_rows, mfmm_kernel_fmm_rows_len);
+    int k = snprintf(key, n,
+                     "meshfmm %s\nkernel fmm_rows.cl %zu bytes fnv1a %016llx\n"
+                     "build options %s\nplatform %s | %s\ndevice %s | %s\ndriver %s\n",
+                     mfmm_version(), mfmm_kernel_fmm_rows_len, (unsigned long long)src,
+                     build_options, plat_name, plat_ver, cl->name, dev_ver, drv_ver);
+    return k > 0 && (size_t)k < n;
 }
 
-/* The cache folder: $MESHFMM_CACHE_DIR, else $XDG_CACHE_HOME/meshfmm, else
- * $HOME/.cache/meshfmm. 0 when none can be named. */
-static int cache_dir(char *out, size_t n)
+/* The cache folder: the option, else $MESHFMM_CACHE_DIR, else
+ * $XDG_CACHE_HOME/meshfmm, else $HOME/.cache/meshfmm. 0 when there is none
+ * (the option is "", or nothing names one). */
+static int cache_dir(const char *option, char *out, size_t n)
 {
-    const char *d = getenv("MESHFMM_CACHE_DIR");
+    const char *d;
     int k;
-    if (d && *d)
+    if (option)
+        k = *option ? snprintf(out, n, "%s", option) : -1;
+    else if ((d = getenv("MESHFMM_CACHE_DIR")) && *d)
         k = snprintf(out, n, "%s", d);
     else if ((d = getenv("XDG_CACHE_HOME")) && *d)
         k = snprintf(out, n, "%s/meshfmm", d);
@@ -273,58 +326,122 @@ static void make_dirs(const char *path)
         if (buf[i] == '/' || buf[i] == '\0') {
             char c = buf[i];
             buf[i] = '\0';
-            mkdir(buf, 0755); /* errors show up when the file is written */
+            mkdir(buf, 0700); /* errors show up when the file is written */
             buf[i] = c;
         }
     }
 }
 
-/* Cache file: magic, key, size, binary, FNV of the binary. */
-static const char cache_magic[8] = {'M', 'F', 'M', 'M', 'C', 'L', 'B', '1'};
+/* The folder's secret (16 bytes), made on first use; 0 when it can be
+ * neither read nor made (no disk cache then). */
+static int cache_secret(const char *dir, unsigned char secret[16])
+{
+    char path[1100], tmp[1200];
+    if (snprintf(path, sizeof path, "%s/secret", dir) >= (int)sizeof path ||
+        snprintf(tmp, sizeof tmp, "%s.XXXXXX", path) >= (int)sizeof tmp)
+        return 0;
+    for (int attempt = 0; attempt < 2; attempt++) {
+        FILE *f = fopen(path, "rb");
+        if (f) {
+            int ok = fread(secret, 1, 16, f) == 16 && fgetc(f) == EOF;
+            fclose(f);
+            return ok;
+        }
+        if (attempt > 0)
+            return 0;
+        make_dirs(dir);
+        FILE *r = fopen("/dev/urandom", "rb");
+        if (!r)
+            return 0;
+        int got = fread(secret, 1, 16, r) == 16;
+        fclose(r);
+        int fd = got ? mkstemp(tmp) : -1; /* mode 0600 */
+        if (fd < 0)
+            return 0;
+        int ok = write(fd, secret, 16) == 16;
+        ok = close(fd) == 0 && ok;
+        /* link, unlike rename, keeps a secret another process made first */
+        if (ok && link(tmp, path) == 0) {
+            unlink(tmp);
+            return 1;
+        }
+        unlink(tmp);
+    }
+    return 0;
+}
 
-static unsigned char *cache_load(const char *path, uint64_t key, size_t *size)
+/* The entry's checksum: FNV-1a over secret, key text, binary, secret. */
+static uint64_t cache_sum(const unsigned char secret[16], const char *key, size_t key_len,
+                          const unsigned char *bin, size_t n)
+{
+    uint64_t h = fnv1a(MFMM_FNV_BASIS, secret, 16);
+    h = fnv1a(h, key, key_len);
+    h = fnv1a(h, bin, n);
+    return fnv1a(h, secret, 16);
+}
+
+/* File: magic, key length, key text, binary length, binary, cache_sum.
+ * All integers uint64 in host order. */
+static const char cache_magic[8] = {'M', 'F', 'M', 'M', 'C', 'L', 'B', '2'};
+#define MFMM_CACHE_MAX_BINARY ((uint64_t)1 << 30)
+
+static unsigned char *cache_load(const char *path, const unsigned char secret[16],
+                                 const char *key, size_t *size)
 {
     FILE *f = fopen(path, "rb");
     if (!f)
         return NULL;
     char magic[8];
-    uint64_t k = 0, n = 0, sum = 0;
+    size_t key_len = strlen(key);
+    uint64_t klen = 0, n = 0, sum = 0;
     unsigned char *bin = NULL;
+    char *k = NULL;
     if (fread(magic, 1, 8, f) != 8 || memcmp(magic, cache_magic, 8) != 0 ||
-        fread(&k, sizeof k, 1, f) != 1 || k != key || fread(&n, sizeof n, 1, f) != 1 ||
-        n == 0 || n > ((uint64_t)1 << 31))
+        fread(&klen, sizeof klen, 1, f) != 1 || klen != key_len)
+        goto bad;
+    k = malloc(key_len + 1);
+    if (!k || fread(k, 1, key_len, f) != key_len || memcmp(k, key, key_len) != 0 ||
+        fread(&n, sizeof n, 1, f) != 1 || n == 0 || n > MFMM_CACHE_MAX_BINARY)
         goto bad;
     bin = malloc((size_t)n);
     if (!bin || fread(bin, 1, (size_t)n, f) != (size_t)n || fread(&sum, sizeof sum, 1, f) != 1 ||
-        sum != fnv1a(14695981039346656037ull, bin, (size_t)n))
+        fgetc(f) != EOF || sum != cache_sum(secret, key, key_len, bin, (size_t)n))
         goto bad;
+    free(k);
     fclose(f);
     *size = (size_t)n;
     return bin;
 bad:
+    free(k);
     free(bin);
     fclose(f);
     return NULL;
 }
 
-/* Best effort: an unwritable cache is not an error. Written to a temporary
- * name and renamed, so readers never see half a file. */
-static void cache_store(const char *dir, const char *path, uint64_t key, const unsigned char *bin,
-                        size_t n)
+/* Best effort: an unwritable cache is not an error. */
+static void cache_store(const char *path, const unsigned char secret[16], const char *key,
+                        const unsigned char *bin, size_t n)
 {
     char tmp[1200];
-    make_dirs(dir);
-    /* pid and a stack address: unique among processes and concurrent calls */
-    if (snprintf(tmp, sizeof tmp, "%s.%ld.%p.tmp", path, (long)getpid(), (void *)tmp) >=
-        (int)sizeof tmp)
+    if (snprintf(tmp, sizeof tmp, "%s.XXXXXX", path) >= (int)sizeof tmp)
         return;
-    FILE *f = fopen(tmp, "wb");
-    if (!f)
+    int fd = mkstemp(tmp); /* a new, unique file (O_CREAT | O_EXCL) */
+    if (fd < 0)
         return;
-    uint64_t k = key, len = n, sum = fnv1a(14695981039346656037ull, bin, n);
-    int ok = fwrite(cache_magic, 1, 8, f) == 8 && fwrite(&k, sizeof k, 1, f) == 1 &&
+    FILE *f = fdopen(fd, "wb");
+    if (!f) {
+        close(fd);
+        remove(tmp);
+        return;
+    }
+    uint64_t klen = strlen(key), len = n;
+    uint64_t sum = cache_sum(secret, key, (size_t)klen, bin, n);
+    int ok = fwrite(cache_magic, 1, 8, f) == 8 && fwrite(&klen, sizeof klen, 1, f) == 1 &&
+             fwrite(key, 1, (size_t)klen, f) == (size_t)klen &&
              fwrite(&len, sizeof len, 1, f) == 1 && fwrite(bin, 1, n, f) == n &&
              fwrite(&sum, sizeof sum, 1, f) == 1;
+    ok = fflush(f) == 0 && ok;
+    ok = fchmod(fd, 0644) == 0 && ok;
     ok = (fclose(f) == 0) && ok;
     if (!ok || rename(tmp, path) != 0)
         remove(tmp);
@@ -334,14 +451,14 @@ static void build_log(const ocl *cl, cl_program prog, char *out, size_t n)
 {
     out[0] = '\0';
     size_t len = 0;
-    if (clGetProgramBuildInfo(prog, cl->device, CL_PROGRAM_BUILD_LOG, 0, NULL, &len) !=
+    if (cl->api->clGetProgramBuildInfo(prog, cl->device, CL_PROGRAM_BUILD_LOG, 0, NULL, &len) !=
             CL_SUCCESS ||
         len == 0)
         return;
     char *log = malloc(len + 1);
     if (!log)
         return;
-    if (clGetProgramBuildInfo(prog, cl->device, CL_PROGRAM_BUILD_LOG, len, log, NULL) ==
+    if (cl->api->clGetProgramBuildInfo(prog, cl->device, CL_PROGRAM_BUILD_LOG, len, log, NULL) ==
         CL_SUCCESS) {
         log[len] = '\0';
         /* first non-blank line */
@@ -357,60 +474,84 @@ static void build_log(const ocl *cl, cl_program prog, char *out, size_t n)
     free(log);
 }
 
-/* Builds from the cached binary when there is a valid one, else from source
- * (then stores the binary). */
-static mfmm_status build_program(ocl *cl, mfmm_error *err)
+static mfmm_status self_test(ocl *cl, mfmm_error *err);
+
+/* A program from a cached binary, built and self-tested; NULL when any step
+ * fails. */
+static cl_program program_from_cache(ocl *cl, const char *path,
+                                     const unsigned char secret[16], const char *key)
 {
-    char dir[1024], path[1100];
-    uint64_t key = program_key(cl);
-    int have_dir = cache_dir(dir, sizeof dir);
+    size_t n = 0;
+    unsigned char *bin = cache_load(path, secret, key, &n);
+    if (!bin)
+        return NULL;
+    const unsigned char *bins[1] = {bin};
+    cl_int bin_status = CL_SUCCESS, e = CL_SUCCESS;
+    cl_program prog =
+        cl->api->clCreateProgramWithBinary(cl->context, 1, &cl->device, &n, bins, &bin_status, &e);
+    free(bin);
+    if (e != CL_SUCCESS || bin_status != CL_SUCCESS || !prog ||
+        cl->api->clBuildProgram(prog, 1, &cl->device, build_options, NULL, NULL) != CL_SUCCESS) {
+        if (prog)
+            cl->api->clReleaseProgram(prog);
+        return NULL;
+    }
+    cl->program = prog;
+    if (self_test(cl, NULL) != MFMM_OK) {
+        cl->program = NULL;
+        cl->api->clReleaseProgram(prog);
+        return NULL;
+    }
+    cl->program = NULL;
+    return prog;
+}
+
+/* Builds from the cached binary when there is a valid one, else from source
+ * (then stores the binary, replacing a bad entry). */
+static mfmm_status build_program(ocl *cl, const char *cache_option, mfmm_error *err)
+{
+    char dir[1024], path[1100], key[2048];
+    unsigned char secret[16];
+    int have_dir = program_key(cl, key, sizeof key) && cache_dir(cache_option, dir, sizeof dir) &&
+                   cache_secret(dir, secret);
     if (have_dir && snprintf(path, sizeof path, "%s/fmm_rows-%016llx.bin", dir,
-                             (unsigned long long)key) >= (int)sizeof path)
+                             (unsigned long long)fnv1a(MFMM_FNV_BASIS, key, strlen(key))) >=
+                        (int)sizeof path)
         have_dir = 0;
-    cl_int e;
     if (have_dir) {
-        size_t n = 0;
-        unsigned char *bin = cache_load(path, key, &n);
-        if (bin) {
-            const unsigned char *bins[1] = {bin};
-            cl_int bin_status = CL_SUCCESS;
-            cl_program prog = clCreateProgramWithBinary(cl->context, 1, &cl->device, &n, bins,
-                                                        &bin_status, &e);
-            free(bin);
-            if (e == CL_SUCCESS && bin_status == CL_SUCCESS &&
-                clBuildProgram(prog, 1, &cl->device, build_options, NULL, NULL) == CL_SUCCESS) {
-                cl->program = prog;
-                return MFMM_OK;
-            }
-            if (prog)
-                clReleaseProgram(prog);
-            remove(path); /* corrupt or stale: rebuilt below */
+        cl_program prog = program_from_cache(cl, path, secret, key);
+        if (prog) {
+            cl->program = prog;
+            return MFMM_OK;
         }
     }
+    cl_int e;
     const char *src = mfmm_kernel_fmm_rows;
     size_t len = mfmm_kernel_fmm_rows_len;
-    cl_program prog = clCreateProgramWithSource(cl->context, 1, &src, &len, &e);
+    cl_program prog = cl->api->clCreateProgramWithSource(cl->context, 1, &src, &len, &e);
     if (e != CL_SUCCESS)
         return mfmm_fail(err, MFMM_ERR_OPENCL_BUILD, -1, "clCreateProgramWithSource: %s",
                          cl_error_name(e));
-    e = clBuildProgram(prog, 1, &cl->device, build_options, NULL, NULL);
+    e = cl->api->clBuildProgram(prog, 1, &cl->device, build_options, NULL, NULL);
     if (e != CL_SUCCESS) {
         char log[160];
         build_log(cl, prog, log, sizeof log);
-        clReleaseProgram(prog);
+        cl->api->clReleaseProgram(prog);
         return mfmm_fail(err, MFMM_ERR_OPENCL_BUILD, -1, "building the kernel for '%s': %s%s%s",
                          cl->name, cl_error_name(e), log[0] ? ": " : "", log);
     }
     cl->program = prog;
-    if (have_dir) {
+    /* only a program that passes the self-test is cached (a cached one must pass it) */
+    if (have_dir && self_test(cl, NULL) == MFMM_OK) {
         size_t n = 0;
-        if (clGetProgramInfo(prog, CL_PROGRAM_BINARY_SIZES, sizeof n, &n, NULL) == CL_SUCCESS &&
-            n > 0) {
+        if (cl->api->clGetProgramInfo(prog, CL_PROGRAM_BINARY_SIZES, sizeof n, &n, NULL) ==
+                CL_SUCCESS &&
+            n > 0 && n <= MFMM_CACHE_MAX_BINARY) {
             unsigned char *bin = malloc(n);
             unsigned char *bins[1] = {bin};
-            if (bin && clGetProgramInfo(prog, CL_PROGRAM_BINARIES, sizeof bins, bins, NULL) ==
-                           CL_SUCCESS)
-                cache_store(dir, path, key, bin, n);
+            if (bin && cl->api->clGetProgramInfo(prog, CL_PROGRAM_BINARIES, sizeof bins, bins,
+                                                 NULL) == CL_SUCCESS)
+                cache_store(path, secret, key, bin, n);
             free(bin);
         }
     }
@@ -421,69 +562,81 @@ static mfmm_status build_program(ocl *cl, mfmm_error *err)
 static void ocl_release_call(ocl *cl)
 {
     if (cl->kernel)
-        clReleaseKernel(cl->kernel);
+        cl->api->clReleaseKernel(cl->kernel);
     if (cl->queue)
-        clReleaseCommandQueue(cl->queue);
+        cl->api->clReleaseCommandQueue(cl->queue);
     cl->kernel = NULL;
     cl->queue = NULL;
 }
 
 static void ocl_release(ocl *cl)
 {
+    if (!cl->api)
+        return;
     ocl_release_call(cl);
     if (cl->program)
-        clReleaseProgram(cl->program);
+        cl->api->clReleaseProgram(cl->program);
     if (cl->context)
-        clReleaseContext(cl->context);
-    memset(cl, 0, sizeof *cl);
+        cl->api->clReleaseContext(cl->context);
+    cl->program = NULL;
+    cl->context = NULL;
 }
 
 /* Device, context and built program. */
-static mfmm_status ocl_open(ocl *cl, mfmm_error *err)
+static mfmm_status ocl_open(ocl *cl, const mfmm_opencl_options *o, mfmm_error *err)
 {
-    memset(cl, 0, sizeof *cl);
-    mfmm_status st = select_device(cl, err);
+    mfmm_status st = select_device(cl, o ? o->device : NULL, err);
     if (st != MFMM_OK)
         return st;
     cl_int e;
-    cl->context = clCreateContext(NULL, 1, &cl->device, NULL, NULL, &e);
+    cl->context = cl->api->clCreateContext(NULL, 1, &cl->device, NULL, NULL, &e);
     if (e != CL_SUCCESS)
         return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1, "clCreateContext on '%s': %s", cl->name,
                          cl_error_name(e));
-    return build_program(cl, err);
+    return build_program(cl, o ? o->cache_dir : NULL, err);
 }
 
 /* A call's own queue and kernel on an open context. */
 static mfmm_status ocl_open_call(ocl *cl, int f64, mfmm_error *err)
 {
     cl_int e;
-    cl->queue = clCreateCommandQueue(cl->context, cl->device, 0, &e);
+    cl->queue = cl->api->clCreateCommandQueue(cl->context, cl->device, 0, &e);
     if (e != CL_SUCCESS)
         return mfmm_fail(err, MFMM_ERR_OPENCL_RUNTIME, -1, "clCreateCommandQueue on '%s': %s",
                          cl->name, cl_error_name(e));
-    cl->kernel = clCreateKernel(cl->program, f64 ? "fmm_rows_f64" : "fmm_rows_f32", &e);
+    cl->kernel = cl->api->clCreateKernel(cl->program, f64 ? "fmm_rows_f64" : "fmm_rows_f32", &e);
     if (e != CL_SUCCESS)
         return mfmm_fail(err, MFMM_ERR_OPENCL_BUILD, -1, "clCreateKernel: %s", cl_error_name(e));
     return MFMM_OK;
 }
 
 struct mfmm_opencl_context {
-    ocl cl; /* device, context, program; no queue or kernel */
+    mfmm_cl_api api; /* the loader's entry points */
+    ocl cl;          /* device, context, program; no queue or kernel */
 };
 
-mfmm_status mfmm_opencl_context_create(mfmm_opencl_context **out, mfmm_error *err)
+mfmm_status mfmm_opencl_context_create(const mfmm_opencl_options *options,
+                                       mfmm_opencl_context **out, mfmm_error *err)
 {
     mfmm_ok(err);
     if (!out)
         return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "out (the context pointer) is NULL");
     *out = NULL;
+    if (options && mfmm_check_struct_size(options, sizeof *options, "mfmm_opencl_options",
+                                          err) != MFMM_OK)
+        return MFMM_ERR_BAD_ARGUMENT;
     mfmm_opencl_context *ctx = calloc(1, sizeof *ctx);
     if (!ctx)
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
-    mfmm_status st = ocl_open(&ctx->cl, err);
+    mfmm_status st = mfmm_cl_api_load(&ctx->api, options ? options->library : NULL, err);
     if (st != MFMM_OK) {
-        ocl_release(&ctx->cl);
         free(ctx);
+        return st;
+    }
+    ctx->cl.api = &ctx->api;
+    st = ocl_open(&ctx->cl, options, err);
+    if (st != MFMM_OK) {
+        mfmm_opencl_context_destroy(ctx);
         return st;
     }
     *out = ctx;
@@ -495,6 +648,7 @@ void mfmm_opencl_context_destroy(mfmm_opencl_context *context)
     if (!context)
         return;
     ocl_release(&context->cl);
+    mfmm_cl_api_unload(&context->api);
     free(context);
 }
 
@@ -521,10 +675,18 @@ static size_t item_bytes(const mfmm_rows_job *job, int direct)
     return b;
 }
 
+/* Rows per batch: as many as the budget holds (at most 4096), in whole
+ * rounds over the compute units. With the default budget (memory_limit 0) a
+ * batch holds at least one row per compute unit, so that every core works
+ * whatever the mesh size (issue 13: 16 MiB held one row of a 227k-vertex
+ * mesh, and OpenCL ran on one core). */
 static int32_t batch_rows(const ocl *cl, const mfmm_rows_job *job, int direct, int32_t rows)
 {
     size_t nv = (size_t)job->mesh->nv;
     size_t budget = job->budget;
+    size_t per_round = (size_t)cl->compute_units * item_bytes(job, direct);
+    if (job->opt->memory_limit == 0 && budget < per_round)
+        budget = per_round;
     if (budget > cl->global_mem / 2)
         budget = (size_t)(cl->global_mem / 2);
     size_t b = budget / item_bytes(job, direct);
@@ -549,8 +711,18 @@ static mfmm_status runtime_fail(mfmm_error *err, const char *what, cl_int e)
                      (int)e);
 }
 
-mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *rows_done,
-                             mfmm_error *err)
+/* OpenCL keeps fewer compute units busy than threads would cores: a batch
+ * smaller than both the compute units and the rows left. */
+static int starved(const ocl *cl, int32_t batch, int32_t rows)
+{
+    int32_t want = (int32_t)(cl->compute_units < (cl_uint)rows ? cl->compute_units : (cl_uint)rows);
+    return batch < want;
+}
+
+/* Rows [start, n_sources) of the job on `shared`'s device and program, with
+ * this call's own queue, kernel and buffers. */
+static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t start,
+                            int32_t *rows_done, mfmm_error *err)
 {
     *rows_done = 0;
     int32_t rows = job->n_sources - start;
@@ -559,18 +731,11 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
     const mfmm_mesh *mesh = job->mesh;
     int f64 = job->elem_size == sizeof(double);
     int direct = job->opt->out != NULL;
-    mfmm_opencl_context *own = NULL, *ctx = job->opt->opencl;
-    if (!ctx) {
-        mfmm_status cs = mfmm_opencl_context_create(&own, err);
-        if (cs != MFMM_OK)
-            return cs;
-        ctx = own;
-    }
-    ocl cl = ctx->cl; /* shared handles, plus this call's queue and kernel */
+    ocl cl = *shared; /* shared handles, plus this call's queue and kernel */
+    const mfmm_cl_api *api = cl.api;
     mfmm_status st = ocl_open_call(&cl, f64, err);
     if (st != MFMM_OK) {
         ocl_release_call(&cl);
-        mfmm_opencl_context_destroy(own);
         return st;
     }
     cl_mem mem[MB_COUNT];
@@ -585,22 +750,22 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
     /* the mesh, read-only, used in place where the driver allows */
     cl_mem_flags ro = CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR;
     size_t n_upd = 2 * (size_t)mesh->update_offset[mesh->nv]; /* (corner, vertex) pairs */
-    mem[MB_OFFSET] = clCreateBuffer(cl.context, ro, (nv + 1) * sizeof(int32_t),
+    mem[MB_OFFSET] = api->clCreateBuffer(cl.context, ro, (nv + 1) * sizeof(int32_t),
                                     mesh->update_offset, &e);
     if (e == CL_SUCCESS)
-        mem[MB_CORNER] = clCreateBuffer(cl.context, ro, (n_upd ? n_upd : 1) * sizeof(int32_t),
+        mem[MB_CORNER] = api->clCreateBuffer(cl.context, ro, (n_upd ? n_upd : 1) * sizeof(int32_t),
                                         n_upd ? (void *)mesh->update_corner : (void *)&one, &e);
     if (e == CL_SUCCESS)
-        mem[MB_CORNERS] = clCreateBuffer(cl.context, ro,
+        mem[MB_CORNERS] = api->clCreateBuffer(cl.context, ro,
                                          (size_t)mesh->nf * 3 * sizeof(mfmm_corner),
                                          mesh->corners, &e);
     if (e == CL_SUCCESS) {
         size_t nc = job->cost_location == 1 ? nv : job->cost_location == 2 ? (size_t)mesh->nf : 1;
-        mem[MB_COST] = clCreateBuffer(cl.context, ro, nc * sizeof(double),
+        mem[MB_COST] = api->clCreateBuffer(cl.context, ro, nc * sizeof(double),
                                       job->cost ? (void *)job->cost : (void *)&one, &e);
     }
     if (e == CL_SUCCESS)
-        mem[MB_SOURCES] = clCreateBuffer(cl.context, ro, (size_t)job->n_sources * sizeof(int32_t),
+        mem[MB_SOURCES] = api->clCreateBuffer(cl.context, ro, (size_t)job->n_sources * sizeof(int32_t),
                                          (void *)job->sources, &e);
     if (e != CL_SUCCESS) {
         st = runtime_fail(err, "uploading the mesh", e);
@@ -610,18 +775,26 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
     /* workspaces for a batch; halved until the device accepts them */
     int32_t batch = batch_rows(&cl, job, direct, rows);
     for (;;) {
+        if (job->full_batches && starved(&cl, batch, rows)) {
+            st = mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1,
+                           "OpenCL would run %d row(s) at a time on %u compute units "
+                           "(memory_limit %zu bytes, %zu per row); threads keep every core busy",
+                           (int)batch, (unsigned)cl.compute_units, job->budget,
+                           item_bytes(job, direct));
+            goto done;
+        }
         size_t b = (size_t)batch;
-        mem[MB_LABEL] = clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv, NULL, &e);
+        mem[MB_LABEL] = api->clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv, NULL, &e);
         if (e == CL_SUCCESS)
-            mem[MB_KEY] = clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv * 8, NULL, &e);
+            mem[MB_KEY] = api->clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv * 8, NULL, &e);
         if (e == CL_SUCCESS)
-            mem[MB_VERT] = clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv * 4, NULL, &e);
+            mem[MB_VERT] = api->clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv * 4, NULL, &e);
         if (e == CL_SUCCESS)
-            mem[MB_POS] = clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv * 4, NULL, &e);
+            mem[MB_POS] = api->clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv * 4, NULL, &e);
         if (e == CL_SUCCESS && !f64)
-            mem[MB_T] = clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv * 8, NULL, &e);
+            mem[MB_T] = api->clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv * 8, NULL, &e);
         if (e == CL_SUCCESS)
-            mem[MB_OUT] = clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * row_bytes, NULL, &e);
+            mem[MB_OUT] = api->clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * row_bytes, NULL, &e);
         if (e == CL_SUCCESS && !direct) {
             host = malloc(2 * b * row_bytes);
             if (!host)
@@ -631,7 +804,7 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
             break;
         for (int i = MB_LABEL; i < MB_COUNT; i++)
             if (mem[i]) {
-                clReleaseMemObject(mem[i]);
+                api->clReleaseMemObject(mem[i]);
                 mem[i] = NULL;
             }
         free(host);
@@ -646,24 +819,24 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
     /* fixed kernel arguments */
     cl_int nvi = (cl_int)nv, cl_loc = job->cost_location, unfold = job->opt->unfolding != 0;
     cl_double maxd = job->opt->max_distance;
-    e = clSetKernelArg(cl.kernel, 0, sizeof nvi, &nvi);
-    e |= clSetKernelArg(cl.kernel, 1, sizeof(cl_mem), &mem[MB_OFFSET]);
-    e |= clSetKernelArg(cl.kernel, 2, sizeof(cl_mem), &mem[MB_CORNER]);
-    e |= clSetKernelArg(cl.kernel, 3, sizeof(cl_mem), &mem[MB_CORNERS]);
-    e |= clSetKernelArg(cl.kernel, 4, sizeof(cl_mem), &mem[MB_COST]);
-    e |= clSetKernelArg(cl.kernel, 5, sizeof cl_loc, &cl_loc);
-    e |= clSetKernelArg(cl.kernel, 6, sizeof maxd, &maxd);
-    e |= clSetKernelArg(cl.kernel, 7, sizeof unfold, &unfold);
-    e |= clSetKernelArg(cl.kernel, 8, sizeof(cl_mem), &mem[MB_SOURCES]);
-    e |= clSetKernelArg(cl.kernel, 11, sizeof(cl_mem), &mem[MB_LABEL]);
-    e |= clSetKernelArg(cl.kernel, 12, sizeof(cl_mem), &mem[MB_KEY]);
-    e |= clSetKernelArg(cl.kernel, 13, sizeof(cl_mem), &mem[MB_VERT]);
-    e |= clSetKernelArg(cl.kernel, 14, sizeof(cl_mem), &mem[MB_POS]);
+    e = api->clSetKernelArg(cl.kernel, 0, sizeof nvi, &nvi);
+    e |= api->clSetKernelArg(cl.kernel, 1, sizeof(cl_mem), &mem[MB_OFFSET]);
+    e |= api->clSetKernelArg(cl.kernel, 2, sizeof(cl_mem), &mem[MB_CORNER]);
+    e |= api->clSetKernelArg(cl.kernel, 3, sizeof(cl_mem), &mem[MB_CORNERS]);
+    e |= api->clSetKernelArg(cl.kernel, 4, sizeof(cl_mem), &mem[MB_COST]);
+    e |= api->clSetKernelArg(cl.kernel, 5, sizeof cl_loc, &cl_loc);
+    e |= api->clSetKernelArg(cl.kernel, 6, sizeof maxd, &maxd);
+    e |= api->clSetKernelArg(cl.kernel, 7, sizeof unfold, &unfold);
+    e |= api->clSetKernelArg(cl.kernel, 8, sizeof(cl_mem), &mem[MB_SOURCES]);
+    e |= api->clSetKernelArg(cl.kernel, 11, sizeof(cl_mem), &mem[MB_LABEL]);
+    e |= api->clSetKernelArg(cl.kernel, 12, sizeof(cl_mem), &mem[MB_KEY]);
+    e |= api->clSetKernelArg(cl.kernel, 13, sizeof(cl_mem), &mem[MB_VERT]);
+    e |= api->clSetKernelArg(cl.kernel, 14, sizeof(cl_mem), &mem[MB_POS]);
     if (f64) {
-        e |= clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_OUT]);
+        e |= api->clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_OUT]);
     } else {
-        e |= clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_T]);
-        e |= clSetKernelArg(cl.kernel, 16, sizeof(cl_mem), &mem[MB_OUT]);
+        e |= api->clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_T]);
+        e |= api->clSetKernelArg(cl.kernel, 16, sizeof(cl_mem), &mem[MB_OUT]);
     }
     if (e != CL_SUCCESS) {
         st = runtime_fail(err, "clSetKernelArg", e);
@@ -678,13 +851,13 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
             cl_int first = start + k * batch;
             cl_int count = job->n_sources - first < batch ? job->n_sources - first : batch;
             size_t global = (size_t)count, local = 1;
-            e = clSetKernelArg(cl.kernel, 9, sizeof first, &first);
-            e |= clSetKernelArg(cl.kernel, 10, sizeof count, &count);
+            e = api->clSetKernelArg(cl.kernel, 9, sizeof first, &first);
+            e |= api->clSetKernelArg(cl.kernel, 10, sizeof count, &count);
             if (e != CL_SUCCESS) {
                 st = runtime_fail(err, "clSetKernelArg", e);
                 goto done;
             }
-            e = clEnqueueNDRangeKernel(cl.queue, cl.kernel, 1, NULL, &global, &local, 0, NULL,
+            e = api->clEnqueueNDRangeKernel(cl.queue, cl.kernel, 1, NULL, &global, &local, 0, NULL,
                                        NULL);
             if (e != CL_SUCCESS) {
                 st = runtime_fail(err, "clEnqueueNDRangeKernel", e);
@@ -692,24 +865,24 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
             }
             void *dst = direct ? (char *)job->opt->out + (size_t)first * row_bytes
                                : host + (size_t)(k & 1) * (size_t)batch * row_bytes;
-            e = clEnqueueReadBuffer(cl.queue, mem[MB_OUT], CL_FALSE, 0,
+            e = api->clEnqueueReadBuffer(cl.queue, mem[MB_OUT], CL_FALSE, 0,
                                     (size_t)count * row_bytes, dst, 0, NULL, &ev[k & 1]);
             if (e != CL_SUCCESS) {
                 st = runtime_fail(err, "clEnqueueReadBuffer", e);
                 goto done;
             }
-            clFlush(cl.queue);
+            api->clFlush(cl.queue);
         }
         if (k > 0) {
             int32_t j = k - 1;
             cl_event wait = ev[j & 1];
             ev[j & 1] = NULL;
-            e = clWaitForEvents(1, &wait);
+            e = api->clWaitForEvents(1, &wait);
             cl_int status = CL_COMPLETE;
             if (e == CL_SUCCESS)
-                e = clGetEventInfo(wait, CL_EVENT_COMMAND_EXECUTION_STATUS, sizeof status,
+                e = api->clGetEventInfo(wait, CL_EVENT_COMMAND_EXECUTION_STATUS, sizeof status,
                                    &status, NULL);
-            clReleaseEvent(wait);
+            api->clReleaseEvent(wait);
             if (e == CL_SUCCESS && status < 0)
                 e = status;
             if (e != CL_SUCCESS) {
@@ -730,16 +903,102 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
     st = MFMM_OK;
 done:
     if (cl.queue)
-        clFinish(cl.queue);
+        api->clFinish(cl.queue);
     for (int i = 0; i < 2; i++)
         if (ev[i])
-            clReleaseEvent(ev[i]);
+            api->clReleaseEvent(ev[i]);
     for (int i = 0; i < MB_COUNT; i++)
         if (mem[i])
-            clReleaseMemObject(mem[i]);
+            api->clReleaseMemObject(mem[i]);
     free(host);
     ocl_release_call(&cl);
+    return st;
+}
+
+mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *rows_done,
+                             mfmm_error *err)
+{
+    *rows_done = 0;
+    if (job->n_sources - start <= 0)
+        return MFMM_OK;
+    mfmm_opencl_context *own = NULL, *ctx = job->opt->opencl;
+    if (!ctx) {
+        mfmm_status cs = mfmm_opencl_context_create(job->opt->opencl_options, &own, err);
+        if (cs != MFMM_OK)
+            return cs;
+        ctx = own;
+    }
+    mfmm_status st = run_rows(&ctx->cl, job, start, rows_done, err);
     mfmm_opencl_context_destroy(own);
+    return st;
+}
+
+/* ---- the self-test of a program before it goes to or comes from the cache ----
+ * All rows of a small mesh with obtuse corners (a sheared 5 x 4 grid), in
+ * float64 and float32, against mfmm_solve, bit for bit. A cached binary that
+ * fails to make a kernel, to run or to give exactly these rows is not used. */
+static mfmm_status self_test(ocl *cl, mfmm_error *err)
+{
+    enum { NX = 5, NY = 4, NV = NX * NY, NF = 2 * (NX - 1) * (NY - 1) };
+    double xyz[NV * 3];
+    int32_t faces[NF * 3];
+    for (int j = 0; j < NY; j++)
+        for (int i = 0; i < NX; i++) {
+            double *p = xyz + 3 * (j * NX + i);
+            p[0] = i + 0.7 * j;
+            p[1] = 0.4 * j;
+            p[2] = 0.1 * ((i * 7 + j * 3) % 5);
+        }
+    int32_t *f = faces;
+    for (int j = 0; j + 1 < NY; j++)
+        for (int i = 0; i + 1 < NX; i++) {
+            int32_t a = j * NX + i, b = a + 1, c = a + NX, d = c + 1;
+            f[0] = a, f[1] = b, f[2] = d, f[3] = a, f[4] = d, f[5] = c;
+            f += 6;
+        }
+    mfmm_mesh *mesh = NULL;
+    mfmm_solver *solver = NULL;
+    double ref[NV * NV];
+    union {
+        double d[NV * NV];
+        float f[NV * NV];
+    } got;
+    int32_t sources[NV];
+    mfmm_status st = mfmm_mesh_create(xyz, NV, faces, NF, NULL, &mesh, err);
+    if (st == MFMM_OK)
+        st = mfmm_solver_create(mesh, &solver);
+    for (int32_t s = 0; st == MFMM_OK && s < NV; s++) {
+        mfmm_source src;
+        memset(&src, 0, sizeof src);
+        src.vertex = sources[s] = s;
+        src.face = -1;
+        st = mfmm_solve(solver, &src, 1, NULL, ref + (size_t)s * NV, err);
+    }
+    for (int f64 = 1; st == MFMM_OK && f64 >= 0; f64--) {
+        mfmm_matrix_options o;
+        mfmm_matrix_options_init(&o);
+        o.out = &got;
+        mfmm_rows_job job;
+        memset(&job, 0, sizeof job);
+        job.mesh = mesh;
+        job.sources = sources;
+        job.n_sources = NV;
+        job.opt = &o;
+        job.elem_size = f64 ? sizeof(double) : sizeof(float);
+        job.budget = MFMM_DEFAULT_BUDGET;
+        int32_t done = 0;
+        st = run_rows(cl, &job, 0, &done, err);
+        for (int i = 0; st == MFMM_OK && i < NV * NV; i++) {
+            double r = f64 ? got.d[i] : (double)got.f[i];
+            double want = f64 ? ref[i] : (double)(float)ref[i];
+            if (memcmp(&r, &want, sizeof r) != 0)
+                st = mfmm_fail(err, MFMM_ERR_OPENCL_RUNTIME, i,
+                               "OpenCL self-test: row %d vertex %d is %.17g, not %.17g",
+                               i / NV, i % NV, r, want);
+        }
+    }
+    mfmm_solver_destroy(solver);
+    mfmm_mesh_destroy(mesh);
     return st;
 }
 

@@ -658,6 +658,7 @@ void mfmm_path_options_init(mfmm_path_options *options)
     if (!options)
         return;
     memset(options, 0, sizeof *options);
+    options->struct_size = sizeof *options;
     options->max_points = 100000;
     options->cost_location = MFMM_COST_NONE;
     options->straighten = 1;
@@ -685,6 +686,9 @@ mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
         return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "target is NULL");
     if (!n_points)
         return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "n_points is NULL");
+    if (options && mfmm_check_struct_size(options, sizeof *options, "mfmm_path_options", err) !=
+                       MFMM_OK)
+        return MFMM_ERR_BAD_ARGUMENT;
     if (capacity < 0)
         return mfmm_fail(err, MFMM_ERR_BAD_COUNT, capacity, "capacity %d is negative",
                          (int)capacity);

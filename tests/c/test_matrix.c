@@ -168,7 +168,7 @@ static void test_no_opencl_fallback(void **state)
     assert_int_equal(err.status, MFMM_ERR_NO_OPENCL);
     assert_true(strlen(err.message) > 0);
     mfmm_opencl_context *ctx = (mfmm_opencl_context *)&o;
-    assert_int_equal(mfmm_opencl_context_create(&ctx, &err), MFMM_ERR_NO_OPENCL);
+    assert_int_equal(mfmm_opencl_context_create(NULL, &ctx, &err), MFMM_ERR_NO_OPENCL);
     assert_null(ctx);
     assert_true(strlen(err.message) > 0);
     free(out);
@@ -318,6 +318,123 @@ static void test_names_and_defaults(void **state)
     assert_null(o.cost);
 }
 
+/* No OpenCL loader at all (a loader name that does not exist, through the
+ * options and through MESHFMM_OPENCL_LIBRARY): single solves never need
+ * OpenCL, the opencl backend says why it cannot run, and auto runs threads
+ * with that reason in fallback_reason. */
+static void test_no_opencl_loader(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh g = mfmm_gen_icosphere(2);
+    mfmm_mesh *mesh = tm_make(&g);
+    mfmm_solver *solver = NULL;
+    assert_int_equal(mfmm_solver_create(mesh, &solver), MFMM_OK);
+    double *d = malloc((size_t)g.nv * sizeof *d);
+    assert_non_null(d);
+    mfmm_source s = tm_vertex_source(3);
+    mfmm_error err;
+    assert_int_equal(mfmm_solve(solver, &s, 1, NULL, d, &err), MFMM_OK);
+    free(d);
+    mfmm_solver_destroy(solver);
+
+    mfmm_opencl_options co;
+    mfmm_opencl_options_init(&co);
+    co.library = "libmeshfmm-no-such-opencl.so.1";
+    mfmm_opencl_context *ctx = (mfmm_opencl_context *)&co;
+    assert_int_equal(mfmm_opencl_context_create(&co, &ctx, &err), MFMM_ERR_NO_OPENCL);
+    assert_null(ctx);
+#ifdef MESHFMM_TEST_HAVE_CL
+    assert_non_null(strstr(err.message, "libmeshfmm-no-such-opencl.so.1"));
+#endif
+
+    double *ref = tm_reference_rows(mesh, some_sources, N_SOME, NULL);
+    size_t total = (size_t)N_SOME * (size_t)g.nv;
+    double *out = malloc(total * sizeof *out);
+    assert_non_null(out);
+    mfmm_matrix_options o;
+    mfmm_matrix_options_init(&o);
+    o.dtype = MFMM_FLOAT64;
+    o.out = out;
+    o.opencl_options = &co;
+    o.backend = MFMM_BACKEND_OPENCL;
+    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &err),
+                     MFMM_ERR_NO_OPENCL);
+    o.backend = MFMM_BACKEND_AUTO;
+    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &err), MFMM_OK);
+    assert_int_equal(o.backend_used, MFMM_BACKEND_THREADS);
+    assert_memory_equal(out, ref, total * sizeof *out);
+#ifdef MESHFMM_TEST_HAVE_CL
+    assert_non_null(strstr(o.fallback_reason, "cannot load the OpenCL library"));
+#else
+    assert_true(strlen(o.fallback_reason) > 0);
+#endif
+    /* the environment names the loader when the options do not */
+    setenv("MESHFMM_OPENCL_LIBRARY", "libmeshfmm-no-such-opencl.so.1", 1);
+    o.opencl_options = NULL;
+    memset(out, 0, total * sizeof *out);
+    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &err), MFMM_OK);
+    assert_int_equal(o.backend_used, MFMM_BACKEND_THREADS);
+    assert_memory_equal(out, ref, total * sizeof *out);
+    unsetenv("MESHFMM_OPENCL_LIBRARY");
+    free(out);
+    free(ref);
+    mfmm_mesh_destroy(mesh);
+    mfmm_gen_free(&g);
+}
+
+/* Option structs carry their size: _init sets it, a wrong one is refused
+ * with a message naming the struct. */
+static void test_struct_size(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh g = mfmm_gen_icosphere(1);
+    mfmm_mesh *mesh = tm_make(&g);
+    mfmm_error err;
+    mfmm_matrix_options o;
+    mfmm_matrix_options_init(&o);
+    assert_int_equal(o.struct_size, sizeof o);
+    double *out = malloc((size_t)g.nv * sizeof *out);
+    assert_non_null(out);
+    o.out = out;
+    o.dtype = MFMM_FLOAT64;
+    o.backend = MFMM_BACKEND_SERIAL;
+    int32_t src = 0;
+    o.struct_size = sizeof o + 8;
+    assert_int_equal(mfmm_distance_matrix(mesh, &src, 1, &o, &err), MFMM_ERR_BAD_ARGUMENT);
+    assert_non_null(strstr(err.message, "mfmm_matrix_options.struct_size"));
+    o.struct_size = 0;
+    assert_int_equal(mfmm_distance_matrix(mesh, &src, 1, &o, &err), MFMM_ERR_BAD_ARGUMENT);
+    o.struct_size = sizeof o;
+    assert_int_equal(mfmm_distance_matrix(mesh, &src, 1, &o, &err), MFMM_OK);
+
+    mfmm_solve_options so;
+    mfmm_solve_options_init(&so);
+    assert_int_equal(so.struct_size, sizeof so);
+    so.struct_size = 4;
+    mfmm_solver *solver = NULL;
+    assert_int_equal(mfmm_solver_create(mesh, &solver), MFMM_OK);
+    mfmm_source s = tm_vertex_source(0);
+    assert_int_equal(mfmm_solve(solver, &s, 1, &so, out, &err), MFMM_ERR_BAD_ARGUMENT);
+    assert_non_null(strstr(err.message, "mfmm_solve_options.struct_size"));
+    mfmm_solver_destroy(solver);
+
+    mfmm_path_options po;
+    mfmm_path_options_init(&po);
+    assert_int_equal(po.struct_size, sizeof po);
+    mfmm_mesh_options mo;
+    mfmm_mesh_options_init(&mo);
+    assert_int_equal(mo.struct_size, sizeof mo);
+    mo.struct_size = sizeof mo - 1;
+    mfmm_mesh *m2 = NULL;
+    assert_int_equal(mfmm_mesh_create(g.V, g.nv, g.F, g.nf, &mo, &m2, &err),
+                     MFMM_ERR_BAD_ARGUMENT);
+    assert_non_null(strstr(err.message, "mfmm_mesh_options.struct_size"));
+    assert_null(m2);
+    free(out);
+    mfmm_mesh_destroy(mesh);
+    mfmm_gen_free(&g);
+}
+
 int main(void)
 {
     /* an empty vendors folder: no OpenCL platform in this process */
@@ -332,6 +449,8 @@ int main(void)
         cmocka_unit_test(test_all_vertices_costs_and_limit),
         cmocka_unit_test(test_no_opencl_fallback),
         cmocka_unit_test(test_cancel),
+        cmocka_unit_test(test_no_opencl_loader),
+        cmocka_unit_test(test_struct_size),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     rmdir(dir);

@@ -13,6 +13,12 @@
 #include <string.h>
 #include <unistd.h>
 #include <cmocka.h>
+#ifdef MESHFMM_TEST_HAVE_CL
+#include <dlfcn.h>
+#include <sys/stat.h>
+#define CL_TARGET_OPENCL_VERSION 120
+#include <CL/cl.h>
+#endif
 
 #include "testutil.h"
 
@@ -225,6 +231,360 @@ static void test_cache_corrupt_and_unwritable(void **state)
     mfmm_gen_free(&g);
 }
 
+#ifdef MESHFMM_TEST_HAVE_CL
+/* The cache file format of opencl_host.c: magic, key length, key, binary
+ * length, binary, checksum: FNV-1a of the folder's secret, key, binary and
+ * secret (uint64 in host order). */
+static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < n; i++) {
+        h ^= p[i];
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+/* Reads the only entry of cache_dir: its path, key and binary. */
+static void read_entry(char *path, size_t path_n, char **key, uint64_t *klen,
+                       unsigned char **bin, uint64_t *n)
+{
+    DIR *d = opendir(cache_dir);
+    assert_non_null(d);
+    struct dirent *e;
+    path[0] = '\0';
+    while ((e = readdir(d)) != NULL)
+        if (strstr(e->d_name, ".bin"))
+            snprintf(path, path_n, "%s/%s", cache_dir, e->d_name);
+    closedir(d);
+    assert_true(path[0] != '\0');
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    char magic[8];
+    assert_int_equal(fread(magic, 1, 8, f), 8);
+    assert_int_equal(fread(klen, 8, 1, f), 1);
+    *key = malloc(*klen);
+    assert_non_null(*key);
+    assert_int_equal(fread(*key, 1, *klen, f), *klen);
+    assert_int_equal(fread(n, 8, 1, f), 1);
+    *bin = malloc(*n);
+    assert_non_null(*bin);
+    assert_int_equal(fread(*bin, 1, *n, f), *n);
+    fclose(f);
+}
+
+/* Writes an entry with `bin` under the key, the checksum recomputed: with
+ * the folder's secret (keyed), or as a plain FNV-1a of key and binary. */
+static void write_entry(const char *path, const char *key, uint64_t klen,
+                        const unsigned char *bin, uint64_t n, int keyed)
+{
+    uint64_t sum = fnv1a(fnv1a(14695981039346656037ull, key, klen), bin, n);
+    if (keyed) {
+        char sp[512];
+        unsigned char secret[16];
+        snprintf(sp, sizeof sp, "%s/secret", cache_dir);
+        FILE *s = fopen(sp, "rb");
+        assert_non_null(s);
+        assert_int_equal(fread(secret, 1, 16, s), 16);
+        fclose(s);
+        sum = fnv1a(fnv1a(fnv1a(fnv1a(14695981039346656037ull, secret, 16), key, klen), bin, n),
+                    secret, 16);
+    }
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fwrite("MFMMCLB2", 1, 8, f);
+    fwrite(&klen, 8, 1, f);
+    fwrite(key, 1, klen, f);
+    fwrite(&n, 8, 1, f);
+    fwrite(bin, 1, n, f);
+    fwrite(&sum, 8, 1, f);
+    assert_int_equal(fclose(f), 0);
+}
+
+extern const char mfmm_kernel_fmm_rows[];
+extern const size_t mfmm_kernel_fmm_rows_len;
+
+/* A program binary for the first CPU device (else the first device), built
+ * from `src` with `options`, through the system's OpenCL loader. NULL (with
+ * *n = 0) when it cannot be built here. */
+static unsigned char *other_binary(const char *src, size_t src_len, const char *options,
+                                   size_t *n)
+{
+    *n = 0;
+    void *h = dlopen("libOpenCL.so.1", RTLD_NOW | RTLD_LOCAL);
+    if (!h)
+        return NULL;
+#define SYM(name) name##_fn name##_p; { void *p_ = dlsym(h, #name); assert_non_null(p_); memcpy(&name##_p, &p_, sizeof p_); }
+    typedef cl_int (*clGetPlatformIDs_fn)(cl_uint, cl_platform_id *, cl_uint *);
+    typedef cl_int (*clGetDeviceIDs_fn)(cl_platform_id, cl_device_type, cl_uint, cl_device_id *, cl_uint *);
+    typedef cl_context (*clCreateContext_fn)(const cl_context_properties *, cl_uint, const cl_device_id *, void *, void *, cl_int *);
+    typedef cl_program (*clCreateProgramWithSource_fn)(cl_context, cl_uint, const char **, const size_t *, cl_int *);
+    typedef cl_int (*clBuildProgram_fn)(cl_program, cl_uint, const cl_device_id *, const char *, void *, void *);
+    typedef cl_int (*clGetProgramInfo_fn)(cl_program, cl_program_info, size_t, void *, size_t *);
+    typedef cl_int (*clReleaseProgram_fn)(cl_program);
+    typedef cl_int (*clReleaseContext_fn)(cl_context);
+    SYM(clGetPlatformIDs) SYM(clGetDeviceIDs) SYM(clCreateContext) SYM(clCreateProgramWithSource)
+    SYM(clBuildProgram) SYM(clGetProgramInfo) SYM(clReleaseProgram) SYM(clReleaseContext)
+#undef SYM
+    cl_platform_id plat[8];
+    cl_uint np = 0;
+    cl_device_id dev = NULL;
+    if (clGetPlatformIDs_p(8, plat, &np) == CL_SUCCESS)
+        for (cl_uint p = 0; p < np && p < 8 && !dev; p++)
+            if (clGetDeviceIDs_p(plat[p], CL_DEVICE_TYPE_CPU, 1, &dev, NULL) != CL_SUCCESS)
+                dev = NULL;
+    unsigned char *bin = NULL;
+    cl_int e;
+    cl_context ctx = dev ? clCreateContext_p(NULL, 1, &dev, NULL, NULL, &e) : NULL;
+    cl_program prog = ctx ? clCreateProgramWithSource_p(ctx, 1, &src, &src_len, &e) : NULL;
+    if (prog && clBuildProgram_p(prog, 1, &dev, options, NULL, NULL) == CL_SUCCESS &&
+        clGetProgramInfo_p(prog, CL_PROGRAM_BINARY_SIZES, sizeof *n, n, NULL) == CL_SUCCESS &&
+        *n > 0) {
+        bin = malloc(*n);
+        assert_non_null(bin);
+        unsigned char *bins[1] = {bin};
+        assert_int_equal(clGetProgramInfo_p(prog, CL_PROGRAM_BINARIES, sizeof bins, bins, NULL),
+                         CL_SUCCESS);
+    }
+    if (prog)
+        clReleaseProgram_p(prog);
+    if (ctx)
+        clReleaseContext_p(ctx);
+    dlclose(h);
+    if (!bin)
+        *n = 0;
+    return bin;
+}
+
+/* Issue 9 point 11: an altered cache entry (checksum recomputed) crashed
+ * every OpenCL and auto run until deleted. Each altered entry here must give
+ * rows equal to the serial core's, and be replaced by a good one. */
+static void test_cache_altered_entries(void **state)
+{
+    (void)state;
+    if (have_device == 0)
+        skip();
+    mfmm_gen_mesh g = mfmm_gen_lattice(9, 3.0);
+    mfmm_mesh *mesh = tm_make(&g);
+    int32_t src[6] = {0, 5, 17, 33, 50, 80};
+    double *ref = tm_reference_rows(mesh, src, 6, NULL);
+    assert_true(check_opencl(mesh, src, 6, ref, MFMM_FLOAT64, 0, 0, NULL)); /* fills the cache */
+    char path[512];
+    char *key;
+    unsigned char *good;
+    uint64_t klen, n;
+    read_entry(path, sizeof path, &key, &klen, &good, &n);
+
+    /* the kernel with other build options (another heap arity, relaxed math),
+     * and another program whose kernels have the same names */
+    static const char dummy[] =
+        "__kernel void fmm_rows_f64(__global double *out) { out[get_global_id(0)] = 1.0; }\n"
+        "__kernel void fmm_rows_f32(__global float *out) { out[get_global_id(0)] = 1.0f; }\n";
+    size_t n_other = 0, n_dummy = 0;
+    unsigned char *other = other_binary(mfmm_kernel_fmm_rows, mfmm_kernel_fmm_rows_len,
+                                        "-cl-std=CL1.2 -DMFMM_HEAP_ARITY=2 -cl-fast-relaxed-math "
+                                        "-cl-mad-enable", &n_other);
+    unsigned char *dummy_bin = other_binary(dummy, sizeof dummy - 1, "-cl-std=CL1.2", &n_dummy);
+    unsigned char *noise = malloc(n);
+    assert_non_null(noise);
+    uint64_t x = 88172645463325252ull;
+    for (uint64_t i = 0; i < n; i++) {
+        x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+        noise[i] = (unsigned char)x;
+    }
+    unsigned char *flipped = malloc(n);
+    assert_non_null(flipped);
+    memcpy(flipped, good, n);
+    for (uint64_t i = n / 3; i < n; i += 61)
+        flipped[i] ^= 0x5a;
+
+    for (int k = 0; k < 7; k++) {
+        switch (k) {
+        case 0: /* truncated */
+            assert_int_equal(truncate(path, (off_t)(klen + n / 2)), 0);
+            break;
+        case 1: /* random bytes, the plain checksum recomputed */
+            write_entry(path, key, klen, noise, n, 0);
+            break;
+        case 2: /* the good binary with bytes changed after its first third, the
+                 * plain checksum recomputed: PoCL 3.1 crashes on it in
+                 * clCreateProgramWithBinary, the keyed checksum keeps it out */
+            write_entry(path, key, klen, flipped, n, 0);
+            break;
+        case 3: /* random bytes with a valid (keyed) checksum: the driver refuses them */
+            write_entry(path, key, klen, noise, n, 1);
+            break;
+        case 4: /* the kernel built with other options, valid checksum */
+            if (!other)
+                continue;
+            write_entry(path, key, klen, other, n_other, 1);
+            break;
+        case 5: /* another program with kernels of the same names, valid checksum */
+            if (!dummy_bin)
+                continue;
+            write_entry(path, key, klen, dummy_bin, n_dummy, 1);
+            break;
+        case 6: /* a good binary under the key of another driver, valid checksum */
+            key[klen - 2] ^= 1;
+            write_entry(path, key, klen, good, n, 1);
+            key[klen - 2] ^= 1;
+            break;
+        }
+        assert_true(check_opencl(mesh, src, 6, ref, MFMM_FLOAT64, 0, 0, NULL));
+        assert_true(check_opencl(mesh, src, 6, ref, MFMM_FLOAT32, 0, 0, NULL));
+        /* the entry was replaced by a working one */
+        char path2[512];
+        char *key2;
+        unsigned char *bin2;
+        uint64_t klen2, n2;
+        read_entry(path2, sizeof path2, &key2, &klen2, &bin2, &n2);
+        assert_string_equal(path2, path);
+        assert_true(klen2 == klen && memcmp(key2, key, klen) == 0);
+        assert_int_equal(count_files(cache_dir), 1);
+        free(key2);
+        free(bin2);
+    }
+    /* auto runs OpenCL on an altered entry too */
+    write_entry(path, key, klen, flipped, n, 0);
+    double *out = malloc(6 * (size_t)g.nv * sizeof *out);
+    assert_non_null(out);
+    mfmm_matrix_options o;
+    mfmm_matrix_options_init(&o);
+    o.dtype = MFMM_FLOAT64;
+    o.out = out;
+    mfmm_error err;
+    assert_int_equal(mfmm_distance_matrix(mesh, src, 6, &o, &err), MFMM_OK);
+    assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL);
+    assert_memory_equal(out, ref, 6 * (size_t)g.nv * sizeof *out);
+    free(out);
+    free(noise);
+    free(flipped);
+    free(other);
+    free(dummy_bin);
+    free(good);
+    free(key);
+    free(ref);
+    mfmm_mesh_destroy(mesh);
+    mfmm_gen_free(&g);
+}
+#endif
+
+static int batch_first_n = 0;
+static int first_batch(void *user, int32_t first, int32_t n, const void *rows)
+{
+    (void)user;
+    (void)rows;
+    if (first == 0)
+        batch_first_n = n;
+    return 0;
+}
+
+/* Issue 13: with the default memory budget (16 MiB) a batch held one row of a
+ * mesh above ~227k vertices (37 bytes per vertex and row), and OpenCL ran on
+ * one core. A batch now holds a row per compute unit (this machine's cores,
+ * on PoCL); and auto runs threads, saying why, when memory_limit keeps
+ * OpenCL from filling every compute unit. */
+static void test_batches_fill_compute_units(void **state)
+{
+    (void)state;
+    if (have_device == 0)
+        skip();
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    if (cores < 2)
+        skip();
+    mfmm_gen_mesh g = mfmm_gen_grid(500); /* 251001 vertices */
+    mfmm_mesh *mesh = tm_make(&g);
+    int32_t src[4] = {0, 1000, 125000, 250000};
+    mfmm_matrix_options o;
+    mfmm_matrix_options_init(&o);
+    o.backend = MFMM_BACKEND_OPENCL;
+    o.max_distance = 1e-9; /* each row stops at its source: the batch size is what counts */
+    o.on_rows = first_batch;
+    mfmm_error err;
+    if (mfmm_distance_matrix(mesh, src, 4, &o, &err) != MFMM_OK)
+        fail_msg("%s", err.message);
+    assert_true(batch_first_n >= 2);
+    mfmm_mesh_destroy(mesh);
+    mfmm_gen_free(&g);
+
+    g = mfmm_gen_grid(20);
+    mesh = tm_make(&g);
+    int32_t nv = g.nv;
+    src[1] = 200;
+    double *ref = tm_reference_rows(mesh, src, 2, NULL);
+    double *out = malloc(2 * (size_t)nv * sizeof *out);
+    assert_non_null(out);
+    mfmm_matrix_options_init(&o);
+    o.dtype = MFMM_FLOAT64;
+    o.out = out;
+    o.memory_limit = (size_t)nv * 40; /* one row at a time */
+    assert_int_equal(mfmm_distance_matrix(mesh, src, 2, &o, &err), MFMM_OK);
+    assert_int_equal(o.backend_used, MFMM_BACKEND_THREADS);
+    assert_non_null(strstr(o.fallback_reason, "compute units"));
+    assert_memory_equal(out, ref, 2 * (size_t)nv * sizeof *out);
+    o.memory_limit = 0; /* the default: OpenCL, no reason */
+    assert_int_equal(mfmm_distance_matrix(mesh, src, 2, &o, &err), MFMM_OK);
+    assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL);
+    assert_string_equal(o.fallback_reason, "");
+    assert_memory_equal(out, ref, 2 * (size_t)nv * sizeof *out);
+    free(out);
+    free(ref);
+    mfmm_mesh_destroy(mesh);
+    mfmm_gen_free(&g);
+}
+
+/* The device and cache folder through mfmm_opencl_options (they win over the
+ * environment); a wrong struct_size is refused. */
+static void test_opencl_options(void **state)
+{
+    (void)state;
+    if (have_device == 0)
+        skip();
+    char dir[64] = "/tmp/mfmm_clopt_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char sub[128];
+    snprintf(sub, sizeof sub, "%s/a/b", dir);
+    mfmm_opencl_options co;
+    mfmm_opencl_options_init(&co);
+    assert_int_equal(co.struct_size, sizeof co);
+    co.cache_dir = sub;
+    co.device = "0";
+    setenv("MESHFMM_OPENCL_DEVICE", "no-such-device-name", 1);
+    mfmm_opencl_context *ctx = NULL;
+    mfmm_error err;
+    if (mfmm_opencl_context_create(&co, &ctx, &err) != MFMM_OK)
+        fail_msg("%s", err.message);
+    unsetenv("MESHFMM_OPENCL_DEVICE");
+    mfmm_opencl_context_destroy(ctx);
+    char entry[512];
+    DIR *d = opendir(sub);
+    assert_non_null(d);
+    int bins = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        if (e->d_name[0] == '.')
+            continue;
+        bins += strstr(e->d_name, ".bin") != NULL;
+        snprintf(entry, sizeof entry, "%s/%s", sub, e->d_name);
+        remove(entry);
+    }
+    closedir(d);
+    assert_int_equal(bins, 1);
+    rmdir(sub);
+    snprintf(sub, sizeof sub, "%s/a", dir);
+    rmdir(sub);
+    rmdir(dir);
+
+    co.device = "no-such-device-name";
+    assert_int_equal(mfmm_opencl_context_create(&co, &ctx, &err), MFMM_ERR_NO_OPENCL);
+    assert_non_null(strstr(err.message, "no-such-device-name"));
+    co.device = NULL;
+    co.struct_size = sizeof co - 8;
+    assert_int_equal(mfmm_opencl_context_create(&co, &ctx, &err), MFMM_ERR_BAD_ARGUMENT);
+    assert_non_null(strstr(err.message, "struct_size"));
+    assert_null(ctx);
+}
+
 /* MESHFMM_OPENCL_DEVICE: an index or a name substring; a wrong one is
  * MFMM_ERR_NO_OPENCL (auto then falls back to threads). */
 static void test_device_selection_and_cancel(void **state)
@@ -295,7 +655,7 @@ static void test_reused_context(void **state)
     (void)state;
     mfmm_opencl_context *ctx = NULL;
     mfmm_error err;
-    mfmm_status st = mfmm_opencl_context_create(&ctx, &err);
+    mfmm_status st = mfmm_opencl_context_create(NULL, &ctx, &err);
     if (st == MFMM_ERR_NO_OPENCL) {
         assert_null(ctx);
         skip();
@@ -328,7 +688,7 @@ static void test_reused_context(void **state)
     mfmm_gen_free(&g);
     mfmm_opencl_context_destroy(ctx);
     mfmm_opencl_context_destroy(NULL);
-    assert_int_equal(mfmm_opencl_context_create(NULL, &err), MFMM_ERR_NULL_POINTER);
+    assert_int_equal(mfmm_opencl_context_create(NULL, NULL, &err), MFMM_ERR_NULL_POINTER);
 }
 
 int main(void)
@@ -342,8 +702,13 @@ int main(void)
         cmocka_unit_test(test_generated_meshes),
         cmocka_unit_test(test_shared_meshes),
         cmocka_unit_test(test_cache_corrupt_and_unwritable),
+#ifdef MESHFMM_TEST_HAVE_CL
+        cmocka_unit_test(test_cache_altered_entries),
+#endif
         cmocka_unit_test(test_device_selection_and_cancel),
         cmocka_unit_test(test_reused_context),
+        cmocka_unit_test(test_batches_fill_compute_units),
+        cmocka_unit_test(test_opencl_options),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     remove_cache();

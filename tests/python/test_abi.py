@@ -23,6 +23,7 @@ STRUCTS = {
     "mfmm_surface_point": _lib.mfmm_surface_point,
     "mfmm_path_options": _lib.mfmm_path_options,
     "mfmm_matrix_options": _lib.mfmm_matrix_options,
+    "mfmm_opencl_options": _lib.mfmm_opencl_options,
 }
 ENUMS = ["mfmm_status", "mfmm_cost_location", "mfmm_backend", "mfmm_dtype"]
 

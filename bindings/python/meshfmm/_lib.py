@@ -120,8 +120,10 @@ class mfmm_error(Structure):
     ]
 
 
+# Option structs start with struct_size (set by their C _init function, which
+# the package always calls before setting fields).
 class mfmm_mesh_options(Structure):
-    _fields_ = [("max_unfold_steps", c_int32)]
+    _fields_ = [("struct_size", c_size_t), ("max_unfold_steps", c_int32)]
 
 
 class mfmm_mesh_info(Structure):
@@ -155,6 +157,7 @@ class mfmm_source(Structure):
 
 class mfmm_solve_options(Structure):
     _fields_ = [
+        ("struct_size", c_size_t),
         ("cost", c_void_p),  # const double *
         ("cost_location", c_enum),
         ("max_distance", c_double),
@@ -174,6 +177,7 @@ class mfmm_surface_point(Structure):
 
 class mfmm_path_options(Structure):
     _fields_ = [
+        ("struct_size", c_size_t),
         ("max_points", c_int32),
         ("sources", c_void_p),  # const mfmm_source *
         ("n_sources", c_int32),
@@ -189,8 +193,18 @@ class mfmm_path_options(Structure):
 mfmm_rows_callback = CFUNCTYPE(c_int, c_void_p, c_int32, c_int32, c_void_p)
 
 
+class mfmm_opencl_options(Structure):
+    _fields_ = [
+        ("struct_size", c_size_t),
+        ("device", c_char_p),
+        ("cache_dir", c_char_p),
+        ("library", c_char_p),
+    ]
+
+
 class mfmm_matrix_options(Structure):
     _fields_ = [
+        ("struct_size", c_size_t),
         ("backend", c_enum),
         ("dtype", c_enum),
         ("cost", c_void_p),  # const double *
@@ -204,6 +218,8 @@ class mfmm_matrix_options(Structure):
         ("user", c_void_p),
         ("backend_used", c_enum),
         ("opencl", c_void_p),  # mfmm_opencl_context *
+        ("opencl_options", c_void_p),  # const mfmm_opencl_options *
+        ("fallback_reason", c_char * 256),  # out: why AUTO ran threads
     ]
 
 
@@ -356,8 +372,12 @@ mfmm_distance_matrix = _proto(
     [c_void_p, c_void_p, c_int32, P(mfmm_matrix_options), P(mfmm_error)],
 )
 # I/O
+mfmm_opencl_options_init = _proto("mfmm_opencl_options_init", None, [P(mfmm_opencl_options)])
 mfmm_opencl_context_create = _proto(
-    "mfmm_opencl_context_create", c_enum, [P(c_void_p), P(mfmm_error)]
+    "mfmm_opencl_context_create",
+    c_enum,
+    # options (NULL: defaults), out, err
+    [P(mfmm_opencl_options), P(c_void_p), P(mfmm_error)],
 )
 mfmm_opencl_context_destroy = _proto("mfmm_opencl_context_destroy", None, [c_void_p])
 mfmm_opencl_context_device_name = _proto("mfmm_opencl_context_device_name", c_char_p, [c_void_p])

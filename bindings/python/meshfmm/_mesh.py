@@ -298,6 +298,9 @@ class Mesh:
         #: Name of the backend that ran the last :meth:`distance_matrix` call
         #: ("serial", "threads" or "opencl"), None before the first.
         self.backend_used: Optional[str] = None
+        #: Why the last "auto" call ran threads instead of OpenCL ("" when it
+        #: did not fall back), from the library's fallback_reason.
+        self.fallback_reason: str = ""
 
         Va = np.asarray(V)
         if Va.dtype.kind not in "iuf":
@@ -734,6 +737,7 @@ class Mesh:
         _lib.check(status, err)
         name = _lib.mfmm_backend_name(opts.backend_used)
         self.backend_used = name.decode("ascii") if name else None
+        self.fallback_reason = opts.fallback_reason.decode("utf-8", "replace")
         return out
 
 
@@ -786,7 +790,7 @@ def _shared_opencl_context() -> Optional[ctypes.c_void_p]:
         if _opencl_context is None:
             ptr = ctypes.c_void_p()
             err = _lib.mfmm_error()
-            if _lib.mfmm_opencl_context_create(byref(ptr), byref(err)) != 0 or not ptr:
+            if _lib.mfmm_opencl_context_create(None, byref(ptr), byref(err)) != 0 or not ptr:
                 return None
             _opencl_context = ptr
             atexit.register(_lib.mfmm_opencl_context_destroy, ptr)
