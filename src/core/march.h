@@ -20,6 +20,9 @@ typedef struct mfmm_march_mesh {
      * skipped without touching their corner records */
     MFMM_GLOBAL const mfmm_i32 *update_corner;
     MFMM_GLOBAL const mfmm_corner *corners; /* (3 nf,) grouped by vertex C */
+    /* the strip of faces each virtual edge crosses: strip[r] .. strip[r + 1]
+     * (r a corner record) index pairs (face, its far vertex) in strip itself */
+    MFMM_GLOBAL const mfmm_i32 *strip;
 } mfmm_march_mesh;
 
 /* A march's workspace, and the options it runs with. */
@@ -140,6 +143,34 @@ MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, MFMM_GLOBAL const 
     return 1.0;
 }
 
+/* Whether the virtual edge of corner record r (vertex c) may be used under
+ * the march's cost. Its virtual triangles charge the corner's own F over the
+ * whole unfolded strip between C and V, which only holds where F is the same
+ * over the strip: every face of it (per face), or every vertex of its faces
+ * (per vertex). Elsewhere the corner takes the plain stencil, as with
+ * unfolding off (issue 9: a cost-1 face's virtual edge through cost-100 faces
+ * made T 50x too low). */
+MFMM_INLINE int mfmm_march_virt_ok(const mfmm_march_state *s, const mfmm_march_mesh *m,
+                                   MFMM_GLOBAL const mfmm_corner *cr, mfmm_i32 r, mfmm_i32 c)
+{
+    MFMM_GLOBAL const double *F = s->cost;
+    mfmm_i32 end = m->strip[r + 1];
+    if (s->cost_location == 2) {
+        double f = F[cr->face];
+        for (mfmm_i32 i = m->strip[r]; i < end; i += 2)
+            if (F[m->strip[i]] != f)
+                return 0;
+    } else if (s->cost_location == 1) {
+        double f = F[c];
+        if (F[cr->a] != f || F[cr->b] != f)
+            return 0;
+        for (mfmm_i32 i = m->strip[r]; i < end; i += 2)
+            if (F[m->strip[i + 1]] != f)
+                return 0;
+    }
+    return 1;
+}
+
 /* Section 2's loop: settle the Close vertex of least T, recompute its
  * neighbours from settled values, until the heap is empty, T passes
  * max_distance, or every target is settled. Vertices not settled are set
@@ -172,9 +203,12 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
             mfmm_u8 st = s->label[c] & MFMM_STATE_MASK;
             if (st == MFMM_ALIVE)
                 continue;
-            MFMM_GLOBAL const mfmm_corner *cr = m->corners + m->update_corner[2 * j];
-            double t = mfmm_corner_update(cr, s->T, s->label, mfmm_march_cost(s, cr, c),
-                                          s->unfolding);
+            mfmm_i32 r = m->update_corner[2 * j];
+            MFMM_GLOBAL const mfmm_corner *cr = m->corners + r;
+            int unfold = s->unfolding;
+            if (unfold && s->cost_location != 0 && cr->virt >= 0)
+                unfold = mfmm_march_virt_ok(s, m, cr, r, c);
+            double t = mfmm_corner_update(cr, s->T, s->label, mfmm_march_cost(s, cr, c), unfold);
             if (t < s->T[c]) {
                 /* c joins the front: its own update list is read when it settles */
                 if (st == MFMM_FAR)

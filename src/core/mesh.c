@@ -33,6 +33,9 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh->corners);
     free(mesh->update_offset);
     free(mesh->update_corner);
+    free(mesh->virt_offset);
+    free(mesh->virt_steps);
+    free(mesh->strip);
     free(mesh);
 }
 
@@ -297,14 +300,34 @@ static mfmm_status build_update_lists(mfmm_mesh *m)
         free(grouped);
         return st;
     }
-    size_t j = 0;
+    /* the strips in record order: offsets (nc + 1) then (face, far) pairs */
+    size_t n_steps = (size_t)m->virt_offset[nc];
+    int32_t *strip = n_steps <= (INT32_MAX - nc - 1) / 2
+                         ? malloc((nc + 1 + 2 * n_steps) * sizeof *strip)
+                         : NULL;
+    if (!strip) {
+        free(off);
+        free(order);
+        free(record_vertex);
+        free(grouped);
+        return n_steps <= (INT32_MAX - nc - 1) / 2 ? MFMM_ERR_OUT_OF_MEMORY : MFMM_ERR_BAD_COUNT;
+    }
+    size_t j = 0, at = nc + 1;
     for (int32_t i = 0; i < m->nv; i++) {
         int32_t c = order[i];
         for (int32_t t = m->vertex_face_offset[c]; t < m->vertex_face_offset[c + 1]; t++) {
+            int32_t fc = m->vertex_face_corner[t];
             record_vertex[j] = c;
-            grouped[j++] = m->corners[m->vertex_face_corner[t]];
+            strip[j] = (int32_t)at;
+            for (int32_t k = m->virt_offset[fc]; k < m->virt_offset[fc + 1]; k++) {
+                strip[at++] = m->virt_steps[k].face;
+                strip[at++] = m->virt_steps[k].far;
+            }
+            grouped[j++] = m->corners[fc];
         }
     }
+    strip[nc] = (int32_t)at;
+    m->strip = strip;
     free(order);
     free(m->corners);
     m->corners = grouped;
@@ -430,9 +453,10 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
         st = build_components(m);
     if (st == MFMM_OK) {
         build_corners(m);
-        mfmm_mesh_unfold_obtuse(m, opt.max_unfold_steps);
-        st = build_update_lists(m);
+        st = mfmm_mesh_unfold_obtuse(m, opt.max_unfold_steps);
     }
+    if (st == MFMM_OK)
+        st = build_update_lists(m);
     if (st != MFMM_OK) {
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, st, -1, NULL);

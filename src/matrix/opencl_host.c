@@ -505,7 +505,7 @@ const char *mfmm_opencl_context_device_name(const mfmm_opencl_context *context)
 
 /* ---- rows ---- */
 
-enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_LABEL, MB_KEY, MB_VERT,
+enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_LABEL, MB_KEY, MB_VERT,
        MB_POS, MB_T, MB_OUT, MB_COUNT };
 
 /* Bytes per work-item on the device (workspace and output row), and on the
@@ -602,6 +602,10 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
     if (e == CL_SUCCESS)
         mem[MB_SOURCES] = clCreateBuffer(cl.context, ro, (size_t)job->n_sources * sizeof(int32_t),
                                          (void *)job->sources, &e);
+    if (e == CL_SUCCESS) /* virtual edges' strips (march.h), offsets then pairs */
+        mem[MB_STRIP] = clCreateBuffer(cl.context, ro,
+                                       (size_t)mesh->strip[3 * (size_t)mesh->nf] * sizeof(int32_t),
+                                       mesh->strip, &e);
     if (e != CL_SUCCESS) {
         st = runtime_fail(err, "uploading the mesh", e);
         goto done;
@@ -661,9 +665,11 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
     e |= clSetKernelArg(cl.kernel, 14, sizeof(cl_mem), &mem[MB_POS]);
     if (f64) {
         e |= clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_OUT]);
+        e |= clSetKernelArg(cl.kernel, 16, sizeof(cl_mem), &mem[MB_STRIP]);
     } else {
         e |= clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_T]);
         e |= clSetKernelArg(cl.kernel, 16, sizeof(cl_mem), &mem[MB_OUT]);
+        e |= clSetKernelArg(cl.kernel, 17, sizeof(cl_mem), &mem[MB_STRIP]);
     }
     if (e != CL_SUCCESS) {
         st = runtime_fail(err, "clSetKernelArg", e);
