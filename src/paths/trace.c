@@ -423,7 +423,64 @@ static int32_t face_source(tracer *t, const frame *fr, const double b[3], double
     return bi;
 }
 
-/* 1 when no edge neighbour of v has a smaller T. */
+/* Barycentric coordinates in face f of the point (1 - s) x_u + s x_w on its
+ * edge (u, w). */
+static void edge_bary(const mfmm_mesh *m, int32_t f, int32_t u, int32_t w, double s, double b[3])
+{
+    for (int k = 0; k < 3; k++) {
+        int32_t x = m->faces[3 * (size_t)f + k];
+        b[k] = x == u ? 1.0 - s : x == w ? s : 0.0;
+    }
+}
+
+/* Where corner c's virtual edge crosses the edge of its strip's step k. */
+static void virt_crossing(const mfmm_mesh *m, const mfmm_virt_step *st, double x[3])
+{
+    const double *x1 = m->xyz + 3 * (size_t)st->e1, *x2 = m->xyz + 3 * (size_t)st->e2;
+    for (int d = 0; d < 3; d++)
+        x[d] = (1.0 - st->t) * x1[d] + st->t * x2[d];
+}
+
+/* Length on the surface of corner c's virtual edge C -> V (section 4.2): its
+ * pieces between the edges it crosses, each inside one face of the strip. */
+static double virt_length(const mfmm_mesh *m, int32_t c)
+{
+    double prev[3], x[3], len = 0.0;
+    memcpy(prev, m->xyz + 3 * (size_t)m->faces[c], sizeof prev);
+    for (int32_t k = m->virt_offset[c]; k < m->virt_offset[c + 1]; k++) {
+        virt_crossing(m, m->virt_steps + k, x);
+        len += mfmm_dist3(prev, x);
+        memcpy(prev, x, sizeof x);
+    }
+    int32_t V = m->virt_steps[m->virt_offset[c + 1] - 1].far;
+    return len + mfmm_dist3(prev, m->xyz + 3 * (size_t)V);
+}
+
+/* The corner at v whose virtual edge descends most steeply (T(V) < T(v)), or
+ * -1. A march value T(C) = T(V) + F |CV| can leave C below all its edge
+ * neighbours: the way down from there is the virtual edge itself. */
+static int32_t virt_descent(const tracer *t, int32_t v)
+{
+    const mfmm_mesh *m = t->m;
+    double Tv = t->T[v], best = 0.0;
+    int32_t bc = -1;
+    for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
+        int32_t c = m->vertex_face_corner[i];
+        if (m->virt_offset[c] == m->virt_offset[c + 1])
+            continue;
+        double TV = t->T[m->virt_steps[m->virt_offset[c + 1] - 1].far];
+        if (!(TV < Tv))
+            continue;
+        double L = virt_length(m, c), slope = L > 0.0 ? (Tv - TV) / L : INFINITY;
+        if (bc < 0 || slope > best) {
+            best = slope;
+            bc = c;
+        }
+    }
+    return bc;
+}
+
+/* 1 when no edge or virtual-edge neighbour of v has a smaller T. */
 static int local_min(const tracer *t, int32_t v)
 {
     const mfmm_mesh *m = t->m;
@@ -433,7 +490,7 @@ static int local_min(const tracer *t, int32_t v)
         if (t->T[m->faces[3 * f + (k + 1) % 3]] < Tv || t->T[m->faces[3 * f + (k + 2) % 3]] < Tv)
             return 0;
     }
-    return 1;
+    return virt_descent(t, v) < 0;
 }
 
 /* Ends the path inside face f from the point at b when f holds the end: a
@@ -446,9 +503,12 @@ static int try_finish(tracer *t, const frame *fr, const double b[3], double Tx)
         if (face_source(t, fr, b, Tx, eb) < 0)
             return 0;
     } else {
+        /* without sources, the path ends only where T reaches 0 at a local
+         * minimum (a vertex source); else it is not at a source */
         int best = -1;
         for (int k = 0; k < 3; k++)
-            if (fr->T[k] <= Tx && local_min(t, fr->v[k]) && (best < 0 || fr->T[k] < fr->T[best]))
+            if (fr->T[k] <= Tx && fr->T[k] <= 0.0 && local_min(t, fr->v[k]) &&
+                (best < 0 || fr->T[k] < fr->T[best]))
                 best = k;
         if (best < 0)
             return 0;
@@ -605,11 +665,14 @@ static int slide(tracer *t, pos *p, const frame *fr, int k, const double d[2], d
     double ex = fr->P[k2][0] - fr->P[k1][0], ey = fr->P[k2][1] - fr->P[k1][1];
     double L = sqrt(ex * ex + ey * ey);
     double s = (d[0] * ex + d[1] * ey) / L;
+    /* T along an edge is linear in its ends: down is toward the lower end
+     * (d's tangential part, from the quadratic, can point up the edge, and
+     * the two faces of a valley then send the path back and forth) */
     int toward;
-    if (fabs(s) > 1e-6)
-        toward = s > 0.0 ? k2 : k1;
-    else if (fr->T[k1] != fr->T[k2])
+    if (fr->T[k1] != fr->T[k2])
         toward = fr->T[k1] < fr->T[k2] ? k1 : k2;
+    else if (fabs(s) > 1e-6)
+        toward = s > 0.0 ? k2 : k1;
     else
         return 0;
     int other = toward == k1 ? k2 : k1;
@@ -625,6 +688,98 @@ static int slide(tracer *t, pos *p, const frame *fr, int k, const double d[2], d
     p->b[k] = 0.0;
     p->from = -1;
     return 1;
+}
+
+/* Follows corner c's virtual edge from its vertex C straight through its
+ * strip to V (a point on each edge crossed), and stands at V. 1, or -1. */
+static int follow_virt(tracer *t, pos *p, int32_t c)
+{
+    const mfmm_mesh *m = t->m;
+    int32_t f = c / 3;
+    for (int32_t k = m->virt_offset[c]; k < m->virt_offset[c + 1]; k++) {
+        const mfmm_virt_step *st = m->virt_steps + k;
+        double b[3];
+        edge_bary(m, f, st->e1, st->e2, st->t, b);
+        if (!emit(t, f, b)) /* the piece to it ran through f */
+            return -1;
+        f = st->face;
+    }
+    set_vertex(p, m, f, m->virt_steps[m->virt_offset[c + 1] - 1].far);
+    return emit(t, f, p->b) ? 1 : -1;
+}
+
+/* F on the way to v from a face source across an edge, as solve.c seeds it. */
+static int seed_F(tracer *t, int32_t face, int32_t v, double *out)
+{
+    if (!t->cost) {
+        *out = 1.0;
+        return 1;
+    }
+    return read_cost(t, t->cost_loc == MFMM_COST_PER_FACE ? face : v, out);
+}
+
+/* At vertex v, which T does not descend from: a face source in the face f
+ * across the edge opposite v of an incident face g, reached by a straight
+ * segment through that edge (the far vertices solve.c seeds from a point
+ * source), when that segment's cost is T(v). Ends the path there: the edge
+ * crossing, then the source. 1: ended; 0: none; -1: error. */
+static int finish_across(tracer *t, int32_t v)
+{
+    const mfmm_mesh *m = t->m;
+    double Tv = t->T[v], best = INFINITY, bt = 0.0;
+    int32_t bg = -1, bs = -1, be1 = -1, be2 = -1;
+    const double *xv = m->xyz + 3 * (size_t)v;
+    for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
+        int32_t c = m->vertex_face_corner[i], g = c / 3, k = c % 3;
+        int32_t f = m->face_neighbor[c];
+        if (f < 0)
+            continue;
+        int32_t e1 = m->faces[3 * (size_t)g + (k + 1) % 3], e2 = m->faces[3 * (size_t)g + (k + 2) % 3];
+        const double *x1 = m->xyz + 3 * (size_t)e1, *x2 = m->xyz + 3 * (size_t)e2;
+        double len = mfmm_dist3(x1, x2);
+        if (!(len > 0.0))
+            continue;
+        double ex[3] = {(x2[0] - x1[0]) / len, (x2[1] - x1[1]) / len, (x2[2] - x1[2]) / len};
+        double r1 = mfmm_dist3(x1, xv), r2 = mfmm_dist3(x2, xv);
+        double vx = (len * len + r1 * r1 - r2 * r2) / (2.0 * len);
+        double h2 = r1 * r1 - vx * vx, vy = h2 > 0.0 ? sqrt(h2) : 0.0; /* v at (vx, -vy) */
+        for (int32_t j = lower_bound(t->fkeys, t->n_fkeys, f); j < t->n_fkeys && t->fkeys[j].key == f;
+             j++) {
+            const mfmm_source *s = &t->src[t->fkeys[j].idx];
+            double xs[3], w[3];
+            mfmm_bary_to_xyz(m, f, s->bary, xs);
+            for (int d = 0; d < 3; d++)
+                w[d] = xs[d] - x1[d];
+            double sx = mfmm_dot3(w, ex), sy2 = mfmm_dot3(w, w) - sx * sx;
+            double sy = sy2 > 0.0 ? sqrt(sy2) : 0.0; /* the source at (sx, sy) */
+            if (!(sy + vy > 0.0))
+                continue;
+            double xc = sx + (vx - sx) * sy / (sy + vy), tc = xc / len;
+            if (!(tc >= 0.0 && tc <= 1.0))
+                continue;
+            double first = sqrt((xc - sx) * (xc - sx) + sy * sy);
+            double second = sqrt((vx - xc) * (vx - xc) + vy * vy);
+            double Ff, Fg;
+            if (!seed_F(t, f, v, &Ff) || !seed_F(t, g, v, &Fg))
+                return -1;
+            double val = s->value + first * Ff + second * Fg;
+            if (val < best) {
+                best = val;
+                bg = g;
+                bs = t->fkeys[j].idx;
+                be1 = e1;
+                be2 = e2;
+                bt = tc;
+            }
+        }
+    }
+    if (bs < 0 || !(best <= Tv + 1e-9 * (fabs(Tv) + fabs(best))))
+        return 0;
+    double b[3];
+    edge_bary(m, bg, be1, be2, bt, b);
+    if (!emit(t, bg, b))
+        return -1;
+    return emit(t, t->src[bs].face, t->src[bs].bary) ? 1 : -1;
 }
 
 static int validate_point(const mfmm_mesh *m, const mfmm_source *s, const char *what, int64_t idx,
@@ -878,9 +1033,23 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
             int r = leave_vertex(t, &p, &fr, d);
             if (r < 0)
                 return t->st;
+            if (r == 0) {
+                /* no way down over faces and edges: a virtual edge, or a
+                 * face source seeded across an edge */
+                int32_t c = virt_descent(t, v);
+                if (c >= 0)
+                    r = follow_virt(t, &p, c);
+                else if ((r = finish_across(t, v)) > 0)
+                    return MFMM_OK;
+                if (r < 0)
+                    return t->st;
+            }
             if (r == 0)
                 return mfmm_fail(t->err, MFMM_ERR_PATH_STALLED, v,
-                                 "T has a local minimum %.17g at vertex %d, not at a source",
+                                 t->n_src > 0 ? "T has a local minimum %.17g at vertex %d, not at a source"
+                                              : "T has a local minimum %.17g at vertex %d, not 0 "
+                                                "(pass the sources to end at a point source or "
+                                                "one with a value)",
                                  Tcur, (int)v);
             if (p.vertex >= 0) { /* went down an edge to another vertex */
                 have_frame = 0;
