@@ -20,8 +20,8 @@ typedef struct mfmm_march_mesh {
      * skipped without touching their corner records */
     MFMM_GLOBAL const mfmm_i32 *update_corner;
     MFMM_GLOBAL const mfmm_corner *corners; /* (3 nf,) grouped by vertex C */
-    /* the strip of faces each virtual edge crosses: strip[r] .. strip[r + 1]
-     * (r a corner record) index pairs (face, its far vertex) in strip itself */
+    /* the footprint of each virtual stencil: strip[r] .. strip[r + 1] (r a
+     * corner record) index [n faces, faces, their vertices] in strip itself */
     MFMM_GLOBAL const mfmm_i32 *strip;
 } mfmm_march_mesh;
 
@@ -143,29 +143,29 @@ MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, MFMM_GLOBAL const 
     return 1.0;
 }
 
-/* Whether the virtual edge of corner record r (vertex c) may be used under
- * the march's cost. Its virtual triangles charge the corner's own F over the
- * whole unfolded strip between C and V, which only holds where F is the same
- * over the strip: every face of it (per face), or every vertex of its faces
- * (per vertex). Elsewhere the corner takes the plain stencil, as with
- * unfolding off (issue 9: a cost-1 face's virtual edge through cost-100 faces
- * made T 50x too low). */
+/* Whether the virtual stencil of corner record r (vertex c) may be used
+ * under the march's cost. Its virtual edge and triangles charge the corner's
+ * own F over the unfolded strip between C and V and over the virtual
+ * triangles A-C-V, V-C-B, which lie over faces other than the corner's: it
+ * holds only where F is the same over that footprint (the corner's face and
+ * every face around the strip's vertices: per face, each face's F; per
+ * vertex, F at each of their vertices). Elsewhere the corner takes the plain
+ * stencil, as with unfolding off (issue 9.1: a cost-1 face's virtual edge
+ * through cost-100 faces made T 50x too low). */
 MFMM_INLINE int mfmm_march_virt_ok(const mfmm_march_state *s, const mfmm_march_mesh *m,
                                    MFMM_GLOBAL const mfmm_corner *cr, mfmm_i32 r, mfmm_i32 c)
 {
     MFMM_GLOBAL const double *F = s->cost;
-    mfmm_i32 end = m->strip[r + 1];
+    mfmm_i32 at = m->strip[r], end = m->strip[r + 1], faces_end = at + 1 + m->strip[at];
     if (s->cost_location == 2) {
         double f = F[cr->face];
-        for (mfmm_i32 i = m->strip[r]; i < end; i += 2)
+        for (mfmm_i32 i = at + 1; i < faces_end; i++)
             if (F[m->strip[i]] != f)
                 return 0;
     } else if (s->cost_location == 1) {
         double f = F[c];
-        if (F[cr->a] != f || F[cr->b] != f)
-            return 0;
-        for (mfmm_i32 i = m->strip[r]; i < end; i += 2)
-            if (F[m->strip[i + 1]] != f)
+        for (mfmm_i32 i = faces_end; i < end; i++)
+            if (F[m->strip[i]] != f)
                 return 0;
     }
     return 1;

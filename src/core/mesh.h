@@ -30,8 +30,8 @@ struct mfmm_mesh {
     int32_t *virt_offset;      /* (3 nf + 1,) CSR by corner 3f+k into virt_steps: the
                                   strip of an obtuse corner's virtual edge */
     mfmm_virt_step *virt_steps;
-    int32_t *strip;            /* the strips for the march, by corner record (see
-                                  mfmm_march_mesh.strip) */
+    int32_t *strip;            /* the virtual stencils' footprints for the march, by
+                                  corner record (see mfmm_march_mesh.strip) */
     mfmm_mesh_info info;
 };
 

@@ -602,7 +602,7 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
     if (e == CL_SUCCESS)
         mem[MB_SOURCES] = clCreateBuffer(cl.context, ro, (size_t)job->n_sources * sizeof(int32_t),
                                          (void *)job->sources, &e);
-    if (e == CL_SUCCESS) /* virtual edges' strips (march.h), offsets then pairs */
+    if (e == CL_SUCCESS) /* virtual stencils' footprints (march.h) */
         mem[MB_STRIP] = clCreateBuffer(cl.context, ro,
                                        (size_t)mesh->strip[3 * (size_t)mesh->nf] * sizeof(int32_t),
                                        mesh->strip, &e);
