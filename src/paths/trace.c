@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/start.h"
 #include "surface.h"
 #include "straighten.h"
 
@@ -708,78 +709,79 @@ static int follow_virt(tracer *t, pos *p, int32_t c)
     return emit(t, f, p->b) ? 1 : -1;
 }
 
-/* F on the way to v from a face source across an edge, as solve.c seeds it. */
-static int seed_F(tracer *t, int32_t face, int32_t v, double *out)
+/* The best straight way from a point source to one vertex (start.c). */
+typedef struct walk_find {
+    int32_t target;
+    double value, best;
+    int32_t depth;
+    int32_t a[MFMM_START_DEPTH], b[MFMM_START_DEPTH], face[MFMM_START_DEPTH + 1];
+    double t[MFMM_START_DEPTH];
+} walk_find;
+
+static int walk_find_hit(void *user, const mfmm_start_hit *h)
 {
-    if (!t->cost) {
-        *out = 1.0;
-        return 1;
-    }
-    return read_cost(t, t->cost_loc == MFMM_COST_PER_FACE ? face : v, out);
+    walk_find *w = user;
+    if (h->vertex != w->target || !(w->value + h->cost_length < w->best))
+        return 0;
+    w->best = w->value + h->cost_length;
+    w->depth = h->depth;
+    memcpy(w->face, h->face, (size_t)(h->depth + 1) * sizeof *w->face);
+    memcpy(w->a, h->a, (size_t)h->depth * sizeof *w->a);
+    memcpy(w->b, h->b, (size_t)h->depth * sizeof *w->b);
+    memcpy(w->t, h->t, (size_t)h->depth * sizeof *w->t);
+    return 0;
 }
 
-/* At vertex v, which T does not descend from: a face source in the face f
- * across the edge opposite v of an incident face g, reached by a straight
- * segment through that edge (the far vertices solve.c seeds from a point
- * source), when that segment's cost is T(v). Ends the path there: the edge
- * crossing, then the source. 1: ended; 0: none; -1: error. */
-static int finish_across(tracer *t, int32_t v)
+/* At vertex v, which T does not descend from: a face source that seeded v
+ * by a straight segment (solve.c starts a point source's march so, through
+ * the faces near it), when that segment's cost is T(v). Ends the path along
+ * it: a point on each edge crossed, then the source. 1: ended; 0: none;
+ * -1: error. */
+static int finish_straight(tracer *t, int32_t v)
 {
     const mfmm_mesh *m = t->m;
-    double Tv = t->T[v], best = INFINITY, bt = 0.0;
-    int32_t bg = -1, bs = -1, be1 = -1, be2 = -1;
-    const double *xv = m->xyz + 3 * (size_t)v;
-    for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
-        int32_t c = m->vertex_face_corner[i], g = c / 3, k = c % 3;
-        int32_t f = m->face_neighbor[c];
-        if (f < 0)
-            continue;
-        int32_t e1 = m->faces[3 * (size_t)g + (k + 1) % 3], e2 = m->faces[3 * (size_t)g + (k + 2) % 3];
-        const double *x1 = m->xyz + 3 * (size_t)e1, *x2 = m->xyz + 3 * (size_t)e2;
-        double len = mfmm_dist3(x1, x2);
-        if (!(len > 0.0))
-            continue;
-        double ex[3] = {(x2[0] - x1[0]) / len, (x2[1] - x1[1]) / len, (x2[2] - x1[2]) / len};
-        double r1 = mfmm_dist3(x1, xv), r2 = mfmm_dist3(x2, xv);
-        double vx = (len * len + r1 * r1 - r2 * r2) / (2.0 * len);
-        double h2 = r1 * r1 - vx * vx, vy = h2 > 0.0 ? sqrt(h2) : 0.0; /* v at (vx, -vy) */
-        for (int32_t j = lower_bound(t->fkeys, t->n_fkeys, f); j < t->n_fkeys && t->fkeys[j].key == f;
-             j++) {
-            const mfmm_source *s = &t->src[t->fkeys[j].idx];
-            double xs[3], w[3];
-            mfmm_bary_to_xyz(m, f, s->bary, xs);
-            for (int d = 0; d < 3; d++)
-                w[d] = xs[d] - x1[d];
-            double sx = mfmm_dot3(w, ex), sy2 = mfmm_dot3(w, w) - sx * sx;
-            double sy = sy2 > 0.0 ? sqrt(sy2) : 0.0; /* the source at (sx, sy) */
-            if (!(sy + vy > 0.0))
-                continue;
-            double xc = sx + (vx - sx) * sy / (sy + vy), tc = xc / len;
-            if (!(tc >= 0.0 && tc <= 1.0))
-                continue;
-            double first = sqrt((xc - sx) * (xc - sx) + sy * sy);
-            double second = sqrt((vx - xc) * (vx - xc) + vy * vy);
-            double Ff, Fg;
-            if (!seed_F(t, f, v, &Ff) || !seed_F(t, g, v, &Fg))
-                return -1;
-            double val = s->value + first * Ff + second * Fg;
-            if (val < best) {
-                best = val;
-                bg = g;
-                bs = t->fkeys[j].idx;
-                be1 = e1;
-                be2 = e2;
-                bt = tc;
-            }
+    double Tv = t->T[v];
+    walk_find best;
+    best.best = INFINITY;
+    int32_t bs = -1;
+    for (int32_t j = 0; j < t->n_fkeys; j++) {
+        const mfmm_source *s = &t->src[t->fkeys[j].idx];
+        walk_find w;
+        w.target = v;
+        w.value = s->value;
+        w.best = INFINITY;
+        w.depth = -1;
+        mfmm_start_walk(m, s, t->cost, (int)t->cost_loc, walk_find_hit, &w);
+        if (w.depth >= 0 && w.best < best.best) {
+            best = w;
+            bs = t->fkeys[j].idx;
         }
     }
-    if (bs < 0 || !(best <= Tv + 1e-9 * (fabs(Tv) + fabs(best))))
+    if (bs < 0 || !(best.best <= Tv + 1e-9 * (fabs(Tv) + fabs(best.best))))
         return 0;
+    for (int32_t i = best.depth - 1; i >= 0; i--) {
+        double b[3];
+        edge_bary(m, best.face[i + 1], best.a[i], best.b[i], best.t[i], b);
+        if (!emit(t, best.face[i + 1], b)) /* the piece to it ran through face[i + 1] */
+            return -1;
+    }
+    /* the source, named in the start face the segment left */
+    const mfmm_source *s = &t->src[bs];
+    int32_t f0 = best.face[0];
     double b[3];
-    edge_bary(m, bg, be1, be2, bt, b);
-    if (!emit(t, bg, b))
-        return -1;
-    return emit(t, t->src[bs].face, t->src[bs].bary) ? 1 : -1;
+    for (int k = 0; k < 3; k++) {
+        int32_t x = m->faces[3 * (size_t)f0 + k];
+        b[k] = 0.0;
+        for (int j = 0; j < 3; j++)
+            if (m->faces[3 * (size_t)s->face + j] == x)
+                b[k] = s->bary[j] > 0.0 ? s->bary[j] : 0.0;
+    }
+    double sum = b[0] + b[1] + b[2];
+    if (!(sum > 0.0)) /* at a vertex of f0 that the source face does not share: cannot be */
+        return 0;
+    for (int k = 0; k < 3; k++)
+        b[k] /= sum;
+    return emit(t, f0, b) ? 1 : -1;
 }
 
 static int validate_point(const mfmm_mesh *m, const mfmm_source *s, const char *what, int64_t idx,
@@ -1039,7 +1041,7 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
                 int32_t c = virt_descent(t, v);
                 if (c >= 0)
                     r = follow_virt(t, &p, c);
-                else if ((r = finish_across(t, v)) > 0)
+                else if ((r = finish_straight(t, v)) > 0)
                     return MFMM_OK;
                 if (r < 0)
                     return t->st;
