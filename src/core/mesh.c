@@ -278,94 +278,30 @@ static mfmm_status bfs_order(const mfmm_mesh *m, int32_t *order)
     return MFMM_OK;
 }
 
-/* Appends x to the growing list (*buf, *n, *cap); 0 when out of memory. */
-static int push_i32(int32_t **buf, size_t *n, size_t *cap, int32_t x)
-{
-    if (*n == *cap) {
-        size_t c = *cap ? 2 * *cap : 4096;
-        if (c > (size_t)INT32_MAX)
-            return 0;
-        int32_t *b = realloc(*buf, c * sizeof *b);
-        if (!b)
-            return 0;
-        *buf = b;
-        *cap = c;
-    }
-    (*buf)[(*n)++] = x;
-    return 1;
-}
-
-/* The footprint of each obtuse corner's virtual stencil (section 4.2), by
- * corner record (the order build_update_lists groups them in): its virtual
- * triangles A-C-V and V-C-B lie over the corner's face and the faces around
- * the strip's vertices A, B and those unfolded up to V. *out: offsets
- * (3 nf + 1) into *out itself, then per corner [n faces, the faces, the
- * vertices of those faces]; empty for corners without a virtual edge. */
+/* The strip vertices of each obtuse corner's virtual stencil (section 4.2),
+ * by corner record (the order build_update_lists groups them in): the
+ * vertices unfolded up to V (A and B are in the record). *out: offsets
+ * (3 nf + 1) into *out itself, then the vertices; an empty run for corners
+ * without a virtual edge. */
 static mfmm_status build_footprints(const mfmm_mesh *m, const int32_t *order, int32_t **out)
 {
-    size_t nc = 3 * (size_t)m->nf, n = 0, cap = 0;
-    int32_t *buf = NULL;
-    int32_t *face_mark = malloc((size_t)m->nf * sizeof *face_mark);
-    int32_t *vert_mark = malloc((size_t)m->nv * sizeof *vert_mark);
-    int32_t *verts = NULL;
-    size_t n_verts = 0, cap_verts = 0;
-    int ok = face_mark && vert_mark;
-    for (size_t i = 0; ok && i < nc + 1; i++)
-        ok = push_i32(&buf, &n, &cap, 0);
-    if (ok) {
-        memset(face_mark, 0xff, (size_t)m->nf * sizeof *face_mark);
-        memset(vert_mark, 0xff, (size_t)m->nv * sizeof *vert_mark);
-    }
-    size_t r = 0;
-    for (int32_t i = 0; ok && i < m->nv; i++) {
+    size_t nc = 3 * (size_t)m->nf, n_steps = (size_t)m->virt_offset[nc];
+    if (n_steps > (size_t)INT32_MAX - nc - 1)
+        return MFMM_ERR_BAD_COUNT;
+    int32_t *buf = malloc((nc + 1 + n_steps) * sizeof *buf);
+    if (!buf)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    size_t r = 0, at = nc + 1;
+    for (int32_t i = 0; i < m->nv; i++) {
         int32_t v = order[i];
-        for (int32_t t = m->vertex_face_offset[v]; ok && t < m->vertex_face_offset[v + 1]; t++, r++) {
-            int32_t fc = m->vertex_face_corner[t], f = fc / 3;
-            buf[r] = (int32_t)n;
-            if (m->virt_offset[fc] == m->virt_offset[fc + 1])
-                continue;
-            /* the strip's vertices: A, B and each step's far vertex */
-            n_verts = 0;
-            ok = push_i32(&verts, &n_verts, &cap_verts, m->faces[3 * (size_t)f + (fc % 3 + 1) % 3]) &&
-                 push_i32(&verts, &n_verts, &cap_verts, m->faces[3 * (size_t)f + (fc % 3 + 2) % 3]);
-            for (int32_t k = m->virt_offset[fc]; ok && k < m->virt_offset[fc + 1]; k++)
-                ok = push_i32(&verts, &n_verts, &cap_verts, m->virt_steps[k].far);
-            size_t count_at = n, first_face = n + 1;
-            ok = ok && push_i32(&buf, &n, &cap, 0) && push_i32(&buf, &n, &cap, f);
-            face_mark[f] = (int32_t)r;
-            for (size_t a = 0; ok && a < n_verts; a++) {
-                int32_t w = verts[a];
-                for (int32_t u = m->vertex_face_offset[w]; ok && u < m->vertex_face_offset[w + 1]; u++) {
-                    int32_t g = m->vertex_face_corner[u] / 3;
-                    if (face_mark[g] != (int32_t)r) {
-                        face_mark[g] = (int32_t)r;
-                        ok = push_i32(&buf, &n, &cap, g);
-                    }
-                }
-            }
-            if (!ok)
-                break;
-            size_t last_face = n;
-            buf[count_at] = (int32_t)(last_face - first_face);
-            for (size_t a = first_face; ok && a < last_face; a++)
-                for (int k = 0; ok && k < 3; k++) {
-                    int32_t w = m->faces[3 * (size_t)buf[a] + k];
-                    if (vert_mark[w] != (int32_t)r) {
-                        vert_mark[w] = (int32_t)r;
-                        ok = push_i32(&buf, &n, &cap, w);
-                    }
-                }
+        for (int32_t t = m->vertex_face_offset[v]; t < m->vertex_face_offset[v + 1]; t++, r++) {
+            int32_t fc = m->vertex_face_corner[t];
+            buf[r] = (int32_t)at;
+            for (int32_t k = m->virt_offset[fc]; k < m->virt_offset[fc + 1]; k++)
+                buf[at++] = m->virt_steps[k].far;
         }
     }
-    if (ok)
-        buf[nc] = (int32_t)n;
-    free(face_mark);
-    free(vert_mark);
-    free(verts);
-    if (!ok) {
-        free(buf);
-        return n >= (size_t)INT32_MAX ? MFMM_ERR_BAD_COUNT : MFMM_ERR_OUT_OF_MEMORY;
-    }
+    buf[nc] = (int32_t)at;
     *out = buf;
     return MFMM_OK;
 }
@@ -392,7 +328,7 @@ static mfmm_status build_update_lists(mfmm_mesh *m)
         free(grouped);
         return st;
     }
-    /* the footprints of the virtual stencils in record order (march.h) */
+    /* the strips' vertices in record order (march.h) */
     int32_t *strip = NULL;
     st = build_footprints(m, order, &strip);
     if (st != MFMM_OK) {
@@ -585,4 +521,26 @@ int32_t mfmm_mesh_vertex_count(const mfmm_mesh *mesh)
 int32_t mfmm_mesh_face_count(const mfmm_mesh *mesh)
 {
     return mesh ? mesh->nf : 0;
+}
+
+void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_location,
+                       double *uniform)
+{
+    for (int32_t v = 0; v < mesh->nv; v++)
+        uniform[v] = 0.0;
+    for (int32_t f = 0; f < mesh->nf; f++) {
+        const int32_t *fv = mesh->faces + 3 * (size_t)f;
+        double x;
+        if (cost_location == 2) {
+            x = cost[f];
+        } else { /* the face's corners all alike, or -1 */
+            x = cost[fv[0]];
+            if (cost[fv[1]] != x || cost[fv[2]] != x)
+                x = -1.0;
+        }
+        for (int k = 0; k < 3; k++) {
+            double *u = uniform + fv[k];
+            *u = *u == 0.0 || *u == x ? x : -1.0;
+        }
+    }
 }

@@ -30,8 +30,8 @@ struct mfmm_mesh {
     int32_t *virt_offset;      /* (3 nf + 1,) CSR by corner 3f+k into virt_steps: the
                                   strip of an obtuse corner's virtual edge */
     mfmm_virt_step *virt_steps;
-    int32_t *strip;            /* the virtual stencils' footprints for the march, by
-                                  corner record (see mfmm_march_mesh.strip) */
+    int32_t *strip;            /* the strips' vertices for the march, by corner
+                                  record (see mfmm_march_mesh.strip) */
     mfmm_mesh_info info;
 };
 
@@ -54,6 +54,13 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
  * corners still in face order (corner 3f+k), as mesh creation has them then.
  * MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
 mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *mesh, int32_t max_steps);
+
+/* For the march's virtual stencils under a cost (march.h): uniform[v] = the
+ * cost every face around v has (per face), or that v and every neighbour
+ * has (per vertex); -1 where they differ; 0 for vertices in no face.
+ * cost_location 1 per vertex, 2 per face. */
+void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_location,
+                       double *uniform);
 
 /* Fills err (if any) and returns status. */
 mfmm_status mfmm_fail(mfmm_error *err, mfmm_status status, int64_t index, const char *fmt, ...)

@@ -13,6 +13,7 @@ struct mfmm_solver {
     int32_t *heap_vertex;
     int32_t *heap_pos;
     uint8_t *label;
+    double *uniform; /* for the virtual stencils under a cost (march.h) */
 };
 
 mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out)
@@ -31,7 +32,8 @@ mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out)
     s->heap_vertex = malloc(n * sizeof *s->heap_vertex);
     s->heap_pos = malloc(n * sizeof *s->heap_pos);
     s->label = malloc(n * sizeof *s->label);
-    if (!s->heap_key || !s->heap_vertex || !s->heap_pos || !s->label) {
+    s->uniform = malloc(n * sizeof *s->uniform);
+    if (!s->heap_key || !s->heap_vertex || !s->heap_pos || !s->label || !s->uniform) {
         mfmm_solver_destroy(s);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
@@ -47,6 +49,7 @@ void mfmm_solver_destroy(mfmm_solver *solver)
     free(solver->heap_vertex);
     free(solver->heap_pos);
     free(solver->label);
+    free(solver->uniform);
     free(solver);
 }
 
@@ -196,6 +199,11 @@ void mfmm_solve_checked(mfmm_solver *solver, const mfmm_source *sources, int32_t
     s.cost_location = (int)opt.cost_location;
     s.max_distance = opt.max_distance;
     s.unfolding = opt.unfolding != 0;
+    s.uniform = NULL;
+    if (s.cost && s.unfolding) {
+        mfmm_uniform_cost(mesh, s.cost, s.cost_location, solver->uniform);
+        s.uniform = solver->uniform;
+    }
     mfmm_march_reset(&s, mesh->nv);
     for (int32_t i = 0; i < opt.n_targets; i++) {
         uint8_t *l = s.label + opt.targets[i];

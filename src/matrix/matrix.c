@@ -365,9 +365,10 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
         own_sources[i] = sources ? sources[i] : i;
     for (int32_t i = 0; i < n_sources; i++)
         if (own_sources[i] < 0 || own_sources[i] >= nv) {
+            int32_t bad = own_sources[i];
             free(own_sources);
             return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, i, "source %d is vertex %d, outside [0, %d)",
-                             (int)i, (int)own_sources[i], (int)nv);
+                             (int)i, (int)bad, (int)nv);
         }
     sources = own_sources;
     int cost_location = o->cost ? (int)o->cost_location : 0;
