@@ -4,7 +4,12 @@
  * moves off the edge. Here the faces holding the point are all start faces,
  * and the walk goes on through edges while they are near: the set of
  * vertices reached, and their values, are the limits of those of nearby
- * points. */
+ * points on either side of an edge (hand: a 1e-9 move changes T by at most
+ * the move). At a corner the limit depends on the direction the point comes
+ * from; where the corner's angle sum exceeds 2 pi, the start from the corner
+ * reaches vertices behind it (through it) that a point beside it does not,
+ * and T jumps by the march's own error there (hand: 16 % of sampled corner
+ * approaches, up to 0.6 % of the diagonal). */
 #include <math.h>
 #include <string.h>
 
