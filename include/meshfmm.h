@@ -162,7 +162,11 @@ MFMM_API int32_t mfmm_mesh_face_count(const mfmm_mesh *mesh);
 /* A source: a vertex (face == -1), or a point inside a face given by
  * barycentric coordinates (w0, w1, w2) of the face's corners (>= 0, summing
  * to 1 within 1e-9). `value` is T at the source (usually 0): the result is
- * T(x) = min over sources of (value + cost-weighted distance). */
+ * T(x) = min over sources of (value + cost-weighted distance). A point source
+ * starts the march from straight-segment distances to the vertices near it
+ * (through the faces within about two mean edge lengths); a point on an edge
+ * or at a corner is a point of every face holding it, so T does not depend
+ * on which face names it, and moves continuously with the point. */
 typedef struct mfmm_source {
     int32_t vertex;     /* vertex id when face == -1; ignored otherwise */
     int32_t face;       /* face id, or -1 for a vertex source */
@@ -192,7 +196,8 @@ typedef struct mfmm_solve_options {
     size_t struct_size;              /* sizeof(mfmm_solve_options), set by the _init function */
     const double *cost;              /* NULL: F = 1 */
     mfmm_cost_location cost_location;/* ignored when cost is NULL */
-    double max_distance;             /* stop past it; vertices beyond are +inf. Default +inf */
+    double max_distance;             /* stop past it; vertices beyond are +inf. Default +inf;
+                                        NaN or < 0: MFMM_ERR_BAD_ARGUMENT */
     const int32_t *targets;          /* stop once all these vertices are settled; NULL: none */
     int32_t n_targets;
     int32_t unfolding;               /* 1 (default): obtuse corners update through their
@@ -227,8 +232,11 @@ typedef struct mfmm_path_options {
     int32_t max_points;   /* most points a path may have; default 100000 */
     /* Sources the distances came from (as given to mfmm_solve): the path ends
      * exactly at the one the target's distance came from (a vertex source at
-     * its vertex, a face source at its point once the path enters its face).
-     * NULL: it ends at the vertex where T stops decreasing. */
+     * its vertex, a face source at its point, straight from the faces near
+     * it). NULL: it ends at a vertex where T is 0 and no neighbour (over an
+     * edge or a virtual edge) is lower; where T stops decreasing above 0 (a
+     * face source, a source value > 0) the call fails rather than end
+     * there. */
     const mfmm_source *sources;
     int32_t n_sources;
     const double *cost;               /* the cost the distances were solved with, or NULL */
@@ -266,9 +274,12 @@ MFMM_API void mfmm_path_options_init(mfmm_path_options *options);
  *   n_points:  receives the count (the status is MFMM_ERR_BAD_COUNT when
  *              capacity is too small, with *n_points the count needed).
  *   length:    receives the polyline's Euclidean length (may be NULL).
+ * Where T has no descent over faces and edges at a vertex (its value came
+ * through a virtual edge, section 4.2, or straight from a point source), the
+ * path follows that straight segment through the faces it crosses.
  * MFMM_ERR_UNREACHED: T(target) is +inf. MFMM_ERR_PATH_STALLED: T stopped
- * decreasing before a source (or a local minimum without sources), or the
- * path needed more than max_points points. */
+ * decreasing before a source (without sources: above 0), or the path needed
+ * more than max_points points; never a path that ends elsewhere. */
 MFMM_API mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
                                      const mfmm_source *target,
                                      const mfmm_path_options *options,
@@ -361,7 +372,7 @@ typedef struct mfmm_matrix_options {
     mfmm_dtype dtype;                /* output type; arithmetic is always float64. Default float32 */
     const double *cost;              /* as in mfmm_solve_options */
     mfmm_cost_location cost_location;
-    double max_distance;             /* default +inf */
+    double max_distance;             /* default +inf; NaN or < 0: MFMM_ERR_BAD_ARGUMENT */
     int32_t unfolding;               /* default 1 */
     int32_t n_threads;               /* threads backend; 0: all cores */
     size_t memory_limit;             /* bytes the library may use for workspaces and

@@ -16,13 +16,15 @@ inline void mfmm_row_march(int nv, __global const int *update_offset,
                            int cost_location, double max_distance, int unfolding,
                            int source, __global double *T_row, __global uchar *label,
                            __global double *heap_key, __global int *heap_vertex,
-                           __global int *heap_pos)
+                           __global int *heap_pos, __global const int *strip,
+                           __global const double *uniform)
 {
     mfmm_march_mesh m;
     m.nv = nv;
     m.update_offset = update_offset;
     m.update_corner = update_corner;
     m.corners = corners;
+    m.strip = strip;
     mfmm_march_state s;
     s.T = T_row;
     s.label = label;
@@ -35,6 +37,7 @@ inline void mfmm_row_march(int nv, __global const int *update_offset,
     s.max_distance = max_distance;
     s.unfolding = unfolding;
     s.targets_left = 0;
+    s.uniform = uniform;
     mfmm_march_reset(&s, nv);
     mfmm_march_seed(&s, source, 0.0);
     mfmm_march_run(&s, &m);
@@ -47,7 +50,8 @@ __kernel void fmm_rows_f64(int nv, __global const int *update_offset,
                            int cost_location, double max_distance, int unfolding,
                            __global const int *sources, int first, int count,
                            __global uchar *label_ws, __global double *key_ws,
-                           __global int *vert_ws, __global int *pos_ws, __global double *out)
+                           __global int *vert_ws, __global int *pos_ws, __global double *out,
+                           __global const int *strip, __global const double *uniform)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
@@ -55,7 +59,7 @@ __kernel void fmm_rows_f64(int nv, __global const int *update_offset,
     ulong o = (ulong)i * (ulong)nv;
     mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
                    max_distance, unfolding, sources[first + i], out + o, label_ws + o,
-                   key_ws + o, vert_ws + o, pos_ws + o);
+                   key_ws + o, vert_ws + o, pos_ws + o, strip, uniform);
 }
 
 /* float32 rows: T in a workspace slice, converted (round to nearest). */
@@ -66,7 +70,8 @@ __kernel void fmm_rows_f32(int nv, __global const int *update_offset,
                            __global const int *sources, int first, int count,
                            __global uchar *label_ws, __global double *key_ws,
                            __global int *vert_ws, __global int *pos_ws,
-                           __global double *T_ws, __global float *out)
+                           __global double *T_ws, __global float *out,
+                           __global const int *strip, __global const double *uniform)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
@@ -75,7 +80,7 @@ __kernel void fmm_rows_f32(int nv, __global const int *update_offset,
     __global double *T = T_ws + o;
     mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
-                   key_ws + o, vert_ws + o, pos_ws + o);
+                   key_ws + o, vert_ws + o, pos_ws + o, strip, uniform);
     __global float *row = out + o;
     for (int v = 0; v < nv; v++)
         row[v] = (float)T[v];

@@ -20,6 +20,9 @@ typedef struct mfmm_march_mesh {
      * skipped without touching their corner records */
     MFMM_GLOBAL const mfmm_i32 *update_corner;
     MFMM_GLOBAL const mfmm_corner *corners; /* (3 nf,) grouped by vertex C */
+    /* the vertices each virtual edge's strip unfolds up to V (A and B aside):
+     * strip[strip[r]] .. strip[strip[r + 1] - 1] for corner record r */
+    MFMM_GLOBAL const mfmm_i32 *strip;
 } mfmm_march_mesh;
 
 /* A march's workspace, and the options it runs with. */
@@ -35,6 +38,9 @@ typedef struct mfmm_march_state {
     double max_distance;
     int unfolding;
     mfmm_i32 targets_left;          /* early stop when it reaches 0 (if > 0 at start) */
+    /* with a cost and unfolding: per vertex, the cost all around it, or -1
+     * (mfmm_uniform_cost); read by mfmm_march_virt_ok */
+    MFMM_GLOBAL const double *uniform;
 } mfmm_march_state;
 
 /* ---- indexed d-ary min-heap with decrease-key: a node's 8 children are
@@ -140,6 +146,27 @@ MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, MFMM_GLOBAL const 
     return 1.0;
 }
 
+/* Whether the virtual stencil of corner record r (vertex c) may be used
+ * under the march's cost. Its virtual edge and triangles charge the corner's
+ * own F over the unfolded strip between C and V and over the virtual
+ * triangles A-C-V, V-C-B, which lie over faces other than the corner's: it
+ * holds only where F is the same over that footprint, the faces around the
+ * strip's vertices A, B and those up to V (per face: their F; per vertex: F
+ * at each of their vertices), read from s->uniform. Elsewhere the corner
+ * takes the plain stencil, as with unfolding off (issue 9.1: a cost-1 face's
+ * virtual edge through cost-100 faces made T 50x too low). */
+MFMM_INLINE int mfmm_march_virt_ok(const mfmm_march_state *s, const mfmm_march_mesh *m,
+                                   MFMM_GLOBAL const mfmm_corner *cr, mfmm_i32 r, double f)
+{
+    MFMM_GLOBAL const double *U = s->uniform;
+    if (U[cr->a] != f || U[cr->b] != f)
+        return 0;
+    for (mfmm_i32 i = m->strip[r]; i < m->strip[r + 1]; i++)
+        if (U[m->strip[i]] != f)
+            return 0;
+    return 1;
+}
+
 /* Section 2's loop: settle the Close vertex of least T, recompute its
  * neighbours from settled values, until the heap is empty, T passes
  * max_distance, or every target is settled. Vertices not settled are set
@@ -172,9 +199,17 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
             mfmm_u8 st = s->label[c] & MFMM_STATE_MASK;
             if (st == MFMM_ALIVE)
                 continue;
-            MFMM_GLOBAL const mfmm_corner *cr = m->corners + m->update_corner[2 * j];
-            double t = mfmm_corner_update(cr, s->T, s->label, mfmm_march_cost(s, cr, c),
-                                          s->unfolding);
+            mfmm_i32 r = m->update_corner[2 * j];
+            MFMM_GLOBAL const mfmm_corner *cr = m->corners + r;
+            int unfold = s->unfolding;
+            double f = mfmm_march_cost(s, cr, c);
+            /* (the footprint matters once V, or both A and B, have settled) */
+            if (unfold && s->cost_location != 0 && cr->virt >= 0 &&
+                ((s->label[cr->virt] & MFMM_STATE_MASK) == MFMM_ALIVE ||
+                 ((s->label[cr->a] & MFMM_STATE_MASK) == MFMM_ALIVE &&
+                  (s->label[cr->b] & MFMM_STATE_MASK) == MFMM_ALIVE)))
+                unfold = mfmm_march_virt_ok(s, m, cr, r, f);
+            double t = mfmm_corner_update(cr, s->T, s->label, f, unfold);
             if (t < s->T[c]) {
                 /* c joins the front: its own update list is read when it settles */
                 if (st == MFMM_FAR)

@@ -36,6 +36,9 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh->corners);
     free(mesh->update_offset);
     free(mesh->update_corner);
+    free(mesh->virt_offset);
+    free(mesh->virt_steps);
+    free(mesh->strip);
     free(mesh);
 }
 
@@ -278,6 +281,34 @@ static mfmm_status bfs_order(const mfmm_mesh *m, int32_t *order)
     return MFMM_OK;
 }
 
+/* The strip vertices of each obtuse corner's virtual stencil (section 4.2),
+ * by corner record (the order build_update_lists groups them in): the
+ * vertices unfolded up to V (A and B are in the record). *out: offsets
+ * (3 nf + 1) into *out itself, then the vertices; an empty run for corners
+ * without a virtual edge. */
+static mfmm_status build_footprints(const mfmm_mesh *m, const int32_t *order, int32_t **out)
+{
+    size_t nc = 3 * (size_t)m->nf, n_steps = (size_t)m->virt_offset[nc];
+    if (n_steps > (size_t)INT32_MAX - nc - 1)
+        return MFMM_ERR_BAD_COUNT;
+    int32_t *buf = malloc((nc + 1 + n_steps) * sizeof *buf);
+    if (!buf)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    size_t r = 0, at = nc + 1;
+    for (int32_t i = 0; i < m->nv; i++) {
+        int32_t v = order[i];
+        for (int32_t t = m->vertex_face_offset[v]; t < m->vertex_face_offset[v + 1]; t++, r++) {
+            int32_t fc = m->vertex_face_corner[t];
+            buf[r] = (int32_t)at;
+            for (int32_t k = m->virt_offset[fc]; k < m->virt_offset[fc + 1]; k++)
+                buf[at++] = m->virt_steps[k].far;
+        }
+    }
+    buf[nc] = (int32_t)at;
+    *out = buf;
+    return MFMM_OK;
+}
+
 /* Stores the corner records grouped by vertex, the groups in breadth-first
  * order, so that the corners a settling vertex touches share cache lines
  * (measured: the march is bound by misses on these records), and builds the
@@ -300,6 +331,16 @@ static mfmm_status build_update_lists(mfmm_mesh *m)
         free(grouped);
         return st;
     }
+    /* the strips' vertices in record order (march.h) */
+    int32_t *strip = NULL;
+    st = build_footprints(m, order, &strip);
+    if (st != MFMM_OK) {
+        free(off);
+        free(order);
+        free(record_vertex);
+        free(grouped);
+        return st;
+    }
     size_t j = 0;
     for (int32_t i = 0; i < m->nv; i++) {
         int32_t c = order[i];
@@ -308,6 +349,7 @@ static mfmm_status build_update_lists(mfmm_mesh *m)
             grouped[j++] = m->corners[m->vertex_face_corner[t]];
         }
     }
+    m->strip = strip;
     free(order);
     free(m->corners);
     m->corners = grouped;
@@ -436,9 +478,10 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
         st = build_components(m);
     if (st == MFMM_OK) {
         build_corners(m);
-        mfmm_mesh_unfold_obtuse(m, opt.max_unfold_steps);
-        st = build_update_lists(m);
+        st = mfmm_mesh_unfold_obtuse(m, opt.max_unfold_steps);
     }
+    if (st == MFMM_OK)
+        st = build_update_lists(m);
     if (st != MFMM_OK) {
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, st, -1, NULL);
@@ -484,4 +527,26 @@ int32_t mfmm_mesh_vertex_count(const mfmm_mesh *mesh)
 int32_t mfmm_mesh_face_count(const mfmm_mesh *mesh)
 {
     return mesh ? mesh->nf : 0;
+}
+
+void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_location,
+                       double *uniform)
+{
+    for (int32_t v = 0; v < mesh->nv; v++)
+        uniform[v] = 0.0;
+    for (int32_t f = 0; f < mesh->nf; f++) {
+        const int32_t *fv = mesh->faces + 3 * (size_t)f;
+        double x;
+        if (cost_location == 2) {
+            x = cost[f];
+        } else { /* the face's corners all alike, or -1 */
+            x = cost[fv[0]];
+            if (cost[fv[1]] != x || cost[fv[2]] != x)
+                x = -1.0;
+        }
+        for (int k = 0; k < 3; k++) {
+            double *u = uniform + fv[k];
+            *u = *u == 0.0 || *u == x ? x : -1.0;
+        }
+    }
 }

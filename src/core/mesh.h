@@ -5,6 +5,14 @@
 #include "meshfmm.h"
 #include "march.h"
 
+/* One face of the strip that a virtual edge C -> V crosses (section 4.2). */
+typedef struct mfmm_virt_step {
+    int32_t face;   /* the face entered */
+    int32_t far;    /* its vertex off the edge crossed (the last step's is V) */
+    int32_t e1, e2; /* the edge crossed */
+    double t;       /* CV crosses it at e1 + t (e2 - e1) */
+} mfmm_virt_step;
+
 struct mfmm_mesh {
     int32_t nv, nf;
     double *xyz;               /* (nv, 3) */
@@ -19,6 +27,11 @@ struct mfmm_mesh {
                                   groups in breadth-first order (see mesh.c) */
     int32_t *update_offset;    /* (nv+1,) CSR: corners to recompute when a vertex settles */
     int32_t *update_corner;    /* pairs (index into corners, its vertex C) */
+    int32_t *virt_offset;      /* (3 nf + 1,) CSR by corner 3f+k into virt_steps: the
+                                  strip of an obtuse corner's virtual edge */
+    mfmm_virt_step *virt_steps;
+    int32_t *strip;            /* the strips' vertices for the march, by corner
+                                  record (see mfmm_march_mesh.strip) */
     mfmm_mesh_info info;
 };
 
@@ -30,14 +43,24 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
     m.update_offset = mesh->update_offset;
     m.update_corner = mesh->update_corner;
     m.corners = mesh->corners;
+    m.strip = mesh->strip;
     return m;
 }
 
 /* Finds the virtual edge of every obtuse corner by unfolding (section 4.2);
- * fills corners[].virt, virt_len, virt_cos_a, virt_cos_b and the counts.
+ * fills corners[].virt, virt_len, virt_cos_a, virt_cos_b, the strips
+ * (virt_offset, virt_steps) and the counts.
  * Needs faces, xyz, face_neighbor, corners' lengths and cosines, with the
- * corners still in face order (corner 3f+k), as mesh creation has them then. */
-void mfmm_mesh_unfold_obtuse(mfmm_mesh *mesh, int32_t max_steps);
+ * corners still in face order (corner 3f+k), as mesh creation has them then.
+ * MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
+mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *mesh, int32_t max_steps);
+
+/* For the march's virtual stencils under a cost (march.h): uniform[v] = the
+ * cost every face around v has (per face), or that v and every neighbour
+ * has (per vertex); -1 where they differ; 0 for vertices in no face.
+ * cost_location 1 per vertex, 2 per face. */
+void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_location,
+                       double *uniform);
 
 /* Fills err (if any) and returns status. */
 mfmm_status mfmm_fail(mfmm_error *err, mfmm_status status, int64_t index, const char *fmt, ...)

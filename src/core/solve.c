@@ -6,6 +6,7 @@
 
 #include "mesh.h"
 #include "solve.h"
+#include "start.h"
 
 struct mfmm_solver {
     const mfmm_mesh *mesh;
@@ -13,6 +14,7 @@ struct mfmm_solver {
     int32_t *heap_vertex;
     int32_t *heap_pos;
     uint8_t *label;
+    double *uniform; /* for the virtual stencils under a cost (march.h) */
 };
 
 mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out)
@@ -31,7 +33,8 @@ mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out)
     s->heap_vertex = malloc(n * sizeof *s->heap_vertex);
     s->heap_pos = malloc(n * sizeof *s->heap_pos);
     s->label = malloc(n * sizeof *s->label);
-    if (!s->heap_key || !s->heap_vertex || !s->heap_pos || !s->label) {
+    s->uniform = malloc(n * sizeof *s->uniform);
+    if (!s->heap_key || !s->heap_vertex || !s->heap_pos || !s->label || !s->uniform) {
         mfmm_solver_destroy(s);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
@@ -47,6 +50,7 @@ void mfmm_solver_destroy(mfmm_solver *solver)
     free(solver->heap_vertex);
     free(solver->heap_pos);
     free(solver->label);
+    free(solver->uniform);
     free(solver);
 }
 
@@ -115,70 +119,16 @@ mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int
     return MFMM_OK;
 }
 
-static double dist3(const double *p, const double *q)
-{
-    return sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
-                (p[2] - q[2]) * (p[2] - q[2]));
-}
+typedef struct seed_ctx {
+    mfmm_march_state *st;
+    double value;
+} seed_ctx;
 
-static double seed_cost(const mfmm_march_state *st, int32_t face, int32_t vertex)
+static int seed_point_hit(void *user, const mfmm_start_hit *h)
 {
-    if (st->cost_location == MFMM_COST_PER_VERTEX)
-        return st->cost[vertex];
-    if (st->cost_location == MFMM_COST_PER_FACE)
-        return st->cost[face];
-    return 1.0;
-}
-
-/* The far vertex q of the face g across edge (e1, e2) of the source face,
- * unfolded into the source face's plane: if the straight segment from p to it
- * crosses that edge, it is a path on the surface, and q starts at its cost. */
-static void seed_across_edge(const mfmm_mesh *mesh, mfmm_march_state *st, const mfmm_source *src,
-                             const double *p, int k)
-{
-    int32_t f = src->face, g = mesh->face_neighbor[3 * (size_t)f + k];
-    if (g < 0 || mesh->degenerate[g])
-        return;
-    const int32_t *fv = mesh->faces + 3 * (size_t)f;
-    int32_t e1 = fv[(k + 1) % 3], e2 = fv[(k + 2) % 3], q = -1;
-    for (int j = 0; j < 3; j++) {
-        int32_t w = mesh->faces[3 * (size_t)g + j];
-        if (w != e1 && w != e2)
-            q = w;
-    }
-    const double *x1 = mesh->xyz + 3 * (size_t)e1, *x2 = mesh->xyz + 3 * (size_t)e2;
-    const double *xc = mesh->xyz + 3 * (size_t)fv[k], *xq = mesh->xyz + 3 * (size_t)q;
-    double len = dist3(x1, x2), r1 = dist3(x1, xq), r2 = dist3(x2, xq);
-    double e[3], w[3], n[3];
-    for (int d = 0; d < 3; d++) {
-        e[d] = (x2[d] - x1[d]) / len;
-        w[d] = xc[d] - x1[d];
-    }
-    /* n: in the face's plane, normal to the edge, away from the face */
-    double we = w[0] * e[0] + w[1] * e[1] + w[2] * e[2];
-    for (int d = 0; d < 3; d++)
-        n[d] = -(w[d] - we * e[d]);
-    double nn = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (!(nn > 0.0))
-        return;
-    double s = (len * len + r1 * r1 - r2 * r2) / (2.0 * len);
-    double h2 = r1 * r1 - s * s, h = h2 > 0.0 ? sqrt(h2) : 0.0;
-    /* p's offset from the edge line (towards the face: negative along n) */
-    double pe = 0.0, pn = 0.0;
-    for (int d = 0; d < 3; d++) {
-        pe += (p[d] - x1[d]) * e[d];
-        pn += (p[d] - x1[d]) * n[d] / nn;
-    }
-    if (!(pn < 0.0) || !(h > 0.0))
-        return;
-    double tcross = -pn / (h - pn); /* fraction of the way from p to q' */
-    double ecross = pe + tcross * (s - pe);
-    if (!(ecross > 0.0 && ecross < len))
-        return;
-    double first = sqrt((ecross - pe) * (ecross - pe) + pn * pn);
-    double second = sqrt((s - ecross) * (s - ecross) + h * h);
-    double cost = first * seed_cost(st, f, q) + second * seed_cost(st, g, q);
-    mfmm_march_seed(st, q, src->value + cost);
+    seed_ctx *c = user;
+    mfmm_march_seed(c->st, h->vertex, c->value + h->cost_length);
+    return 0;
 }
 
 void mfmm_seed_source(const mfmm_mesh *mesh, mfmm_march_state *st, const mfmm_source *src)
@@ -187,21 +137,10 @@ void mfmm_seed_source(const mfmm_mesh *mesh, mfmm_march_state *st, const mfmm_so
         mfmm_march_seed(st, src->vertex, src->value);
         return;
     }
-    /* a point inside a face: its corners start at the in-plane distance times
-     * F, and so do the far vertices of the three neighbouring faces that a
-     * straight segment reaches through the shared edge (as a vertex source's
-     * first ring is reached by its edges). */
-    const int32_t *fv = mesh->faces + 3 * (size_t)src->face;
-    double p[3] = {0.0, 0.0, 0.0};
-    for (int k = 0; k < 3; k++)
-        for (int d = 0; d < 3; d++)
-            p[d] += src->bary[k] * mesh->xyz[3 * (size_t)fv[k] + d];
-    for (int k = 0; k < 3; k++) {
-        double dist = dist3(mesh->xyz + 3 * (size_t)fv[k], p);
-        mfmm_march_seed(st, fv[k], src->value + dist * seed_cost(st, src->face, fv[k]));
-    }
-    for (int k = 0; k < 3; k++)
-        seed_across_edge(mesh, st, src, p, k);
+    /* a point on the surface: every vertex a straight segment reaches near
+     * it starts at that segment's cost (start.c) */
+    seed_ctx c = {st, src->value};
+    mfmm_start_walk(mesh, src, st->cost, st->cost_location, seed_point_hit, &c);
 }
 
 mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
@@ -229,6 +168,9 @@ mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources, int32_t 
         return st;
     if (isnan(opt.max_distance))
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "max_distance is NaN");
+    if (opt.max_distance < 0.0)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "max_distance is %g; it must be >= 0 (+inf: no limit)", opt.max_distance);
     if (opt.n_targets < 0 || (opt.n_targets > 0 && !opt.targets))
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
                          "n_targets is %ld but targets is %s", (long)opt.n_targets,
@@ -263,6 +205,11 @@ void mfmm_solve_checked(mfmm_solver *solver, const mfmm_source *sources, int32_t
     s.cost_location = (int)opt.cost_location;
     s.max_distance = opt.max_distance;
     s.unfolding = opt.unfolding != 0;
+    s.uniform = NULL;
+    if (s.cost && s.unfolding) {
+        mfmm_uniform_cost(mesh, s.cost, s.cost_location, solver->uniform);
+        s.uniform = solver->uniform;
+    }
     mfmm_march_reset(&s, mesh->nv);
     for (int32_t i = 0; i < opt.n_targets; i++) {
         uint8_t *l = s.label + opt.targets[i];

@@ -345,6 +345,9 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "unknown dtype %d", (int)o->dtype);
     if (isnan(o->max_distance))
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "max_distance is NaN");
+    if (o->max_distance < 0.0)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "max_distance is %g; it must be >= 0 (+inf: no limit)", o->max_distance);
     if (o->n_threads < 0)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "n_threads is %d, must be >= 0",
                          (int)o->n_threads);
@@ -355,28 +358,41 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     if (n_sources < 1)
         return mfmm_fail(err, MFMM_ERR_BAD_COUNT, n_sources,
                          "n_sources is %d, must be >= 1", (int)n_sources);
-    if (sources) {
-        for (int32_t i = 0; i < n_sources; i++)
-            if (sources[i] < 0 || sources[i] >= nv)
-                return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, i,
-                                 "source %d is vertex %d, outside [0, %d)", (int)i,
-                                 (int)sources[i], (int)nv);
+    /* Rows re-read the sources and the cost while out fills up: the job works
+     * on its own copies, taken before any row is written and checked there,
+     * so an out buffer (or a callback) that overwrites the caller's arrays
+     * cannot change later rows (issue 9.6). */
+    int32_t *own_sources = malloc((size_t)n_sources * sizeof *own_sources);
+    if (!own_sources)
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for %d source ids",
+                         (int)n_sources);
+    for (int32_t i = 0; i < n_sources; i++)
+        own_sources[i] = sources ? sources[i] : i;
+    for (int32_t i = 0; i < n_sources; i++)
+        if (own_sources[i] < 0 || own_sources[i] >= nv) {
+            int32_t bad = own_sources[i];
+            free(own_sources);
+            return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, i, "source %d is vertex %d, outside [0, %d)",
+                             (int)i, (int)bad, (int)nv);
+        }
+    sources = own_sources;
+    int cost_location = o->cost ? (int)o->cost_location : 0;
+    double *own_cost = NULL;
+    if (o->cost && (o->cost_location == MFMM_COST_PER_VERTEX || o->cost_location == MFMM_COST_PER_FACE)) {
+        size_t n = o->cost_location == MFMM_COST_PER_VERTEX ? (size_t)nv : (size_t)mesh->nf;
+        own_cost = malloc(n * sizeof *own_cost);
+        if (!own_cost) {
+            free(own_sources);
+            return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the cost");
+        }
+        memcpy(own_cost, o->cost, n * sizeof *own_cost);
     }
-    const double *cost = o->cost;
-    int cost_location = cost ? (int)o->cost_location : 0;
+    const double *cost = own_cost ? own_cost : o->cost;
     mfmm_status cst = mfmm_check_cost(mesh, cost, o->cost_location, err);
-    if (cst != MFMM_OK)
+    if (cst != MFMM_OK) {
+        free(own_sources);
+        free(own_cost);
         return cst;
-
-    int32_t *all = NULL;
-    if (!sources) {
-        all = malloc((size_t)nv * sizeof *all);
-        if (!all)
-            return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for %d source ids",
-                             (int)nv);
-        for (int32_t i = 0; i < nv; i++)
-            all[i] = i;
-        sources = all;
     }
     mfmm_rows_job job;
     memset(&job, 0, sizeof job);
@@ -422,6 +438,7 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     }
     if (st == MFMM_OK)
         mfmm_ok(err);
-    free(all);
+    free(own_sources);
+    free(own_cost);
     return st;
 }

@@ -659,7 +659,7 @@ const char *mfmm_opencl_context_device_name(const mfmm_opencl_context *context)
 
 /* ---- rows ---- */
 
-enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_LABEL, MB_KEY, MB_VERT,
+enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_LABEL, MB_KEY, MB_VERT,
        MB_POS, MB_T, MB_OUT, MB_COUNT };
 
 /* Bytes per work-item on the device (workspace and output row), and on the
@@ -741,6 +741,7 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     cl_mem mem[MB_COUNT];
     memset(mem, 0, sizeof mem);
     char *host = NULL;
+    double *uniform = NULL;
     cl_event ev[2] = {NULL, NULL};
     cl_int e = CL_SUCCESS;
     size_t nv = (size_t)mesh->nv;
@@ -767,6 +768,23 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     if (e == CL_SUCCESS)
         mem[MB_SOURCES] = api->clCreateBuffer(cl.context, ro, (size_t)job->n_sources * sizeof(int32_t),
                                          (void *)job->sources, &e);
+    if (e == CL_SUCCESS) /* virtual edges' strips (march.h) */
+        mem[MB_STRIP] = api->clCreateBuffer(cl.context, ro,
+                                       (size_t)mesh->strip[3 * (size_t)mesh->nf] * sizeof(int32_t),
+                                       mesh->strip, &e);
+    /* with a cost: the cost around each vertex, for the virtual stencils
+     * (march.h), once for the job */
+    if (e == CL_SUCCESS && job->cost && job->opt->unfolding) {
+        uniform = malloc(nv * sizeof *uniform);
+        if (!uniform) {
+            st = mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for %d costs", (int)nv);
+            goto done;
+        }
+        mfmm_uniform_cost(mesh, job->cost, job->cost_location, uniform);
+    }
+    if (e == CL_SUCCESS)
+        mem[MB_UNIFORM] = api->clCreateBuffer(cl.context, ro, (uniform ? nv : 1) * sizeof(double),
+                                         uniform ? (void *)uniform : (void *)&one, &e);
     if (e != CL_SUCCESS) {
         st = runtime_fail(err, "uploading the mesh", e);
         goto done;
@@ -834,9 +852,13 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     e |= api->clSetKernelArg(cl.kernel, 14, sizeof(cl_mem), &mem[MB_POS]);
     if (f64) {
         e |= api->clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_OUT]);
+        e |= api->clSetKernelArg(cl.kernel, 16, sizeof(cl_mem), &mem[MB_STRIP]);
+        e |= api->clSetKernelArg(cl.kernel, 17, sizeof(cl_mem), &mem[MB_UNIFORM]);
     } else {
         e |= api->clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_T]);
         e |= api->clSetKernelArg(cl.kernel, 16, sizeof(cl_mem), &mem[MB_OUT]);
+        e |= api->clSetKernelArg(cl.kernel, 17, sizeof(cl_mem), &mem[MB_STRIP]);
+        e |= api->clSetKernelArg(cl.kernel, 18, sizeof(cl_mem), &mem[MB_UNIFORM]);
     }
     if (e != CL_SUCCESS) {
         st = runtime_fail(err, "clSetKernelArg", e);
@@ -911,6 +933,7 @@ done:
         if (mem[i])
             api->clReleaseMemObject(mem[i]);
     free(host);
+    free(uniform);
     ocl_release_call(&cl);
     return st;
 }

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/start.h"
 #include "surface.h"
 #include "straighten.h"
 
@@ -423,7 +424,64 @@ static int32_t face_source(tracer *t, const frame *fr, const double b[3], double
     return bi;
 }
 
-/* 1 when no edge neighbour of v has a smaller T. */
+/* Barycentric coordinates in face f of the point (1 - s) x_u + s x_w on its
+ * edge (u, w). */
+static void edge_bary(const mfmm_mesh *m, int32_t f, int32_t u, int32_t w, double s, double b[3])
+{
+    for (int k = 0; k < 3; k++) {
+        int32_t x = m->faces[3 * (size_t)f + k];
+        b[k] = x == u ? 1.0 - s : x == w ? s : 0.0;
+    }
+}
+
+/* Where corner c's virtual edge crosses the edge of its strip's step k. */
+static void virt_crossing(const mfmm_mesh *m, const mfmm_virt_step *st, double x[3])
+{
+    const double *x1 = m->xyz + 3 * (size_t)st->e1, *x2 = m->xyz + 3 * (size_t)st->e2;
+    for (int d = 0; d < 3; d++)
+        x[d] = (1.0 - st->t) * x1[d] + st->t * x2[d];
+}
+
+/* Length on the surface of corner c's virtual edge C -> V (section 4.2): its
+ * pieces between the edges it crosses, each inside one face of the strip. */
+static double virt_length(const mfmm_mesh *m, int32_t c)
+{
+    double prev[3], x[3], len = 0.0;
+    memcpy(prev, m->xyz + 3 * (size_t)m->faces[c], sizeof prev);
+    for (int32_t k = m->virt_offset[c]; k < m->virt_offset[c + 1]; k++) {
+        virt_crossing(m, m->virt_steps + k, x);
+        len += mfmm_dist3(prev, x);
+        memcpy(prev, x, sizeof x);
+    }
+    int32_t V = m->virt_steps[m->virt_offset[c + 1] - 1].far;
+    return len + mfmm_dist3(prev, m->xyz + 3 * (size_t)V);
+}
+
+/* The corner at v whose virtual edge descends most steeply (T(V) < T(v)), or
+ * -1. A march value T(C) = T(V) + F |CV| can leave C below all its edge
+ * neighbours: the way down from there is the virtual edge itself. */
+static int32_t virt_descent(const tracer *t, int32_t v)
+{
+    const mfmm_mesh *m = t->m;
+    double Tv = t->T[v], best = 0.0;
+    int32_t bc = -1;
+    for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
+        int32_t c = m->vertex_face_corner[i];
+        if (m->virt_offset[c] == m->virt_offset[c + 1])
+            continue;
+        double TV = t->T[m->virt_steps[m->virt_offset[c + 1] - 1].far];
+        if (!(TV < Tv))
+            continue;
+        double L = virt_length(m, c), slope = L > 0.0 ? (Tv - TV) / L : INFINITY;
+        if (bc < 0 || slope > best) {
+            best = slope;
+            bc = c;
+        }
+    }
+    return bc;
+}
+
+/* 1 when no edge or virtual-edge neighbour of v has a smaller T. */
 static int local_min(const tracer *t, int32_t v)
 {
     const mfmm_mesh *m = t->m;
@@ -433,7 +491,7 @@ static int local_min(const tracer *t, int32_t v)
         if (t->T[m->faces[3 * f + (k + 1) % 3]] < Tv || t->T[m->faces[3 * f + (k + 2) % 3]] < Tv)
             return 0;
     }
-    return 1;
+    return virt_descent(t, v) < 0;
 }
 
 /* Ends the path inside face f from the point at b when f holds the end: a
@@ -446,9 +504,12 @@ static int try_finish(tracer *t, const frame *fr, const double b[3], double Tx)
         if (face_source(t, fr, b, Tx, eb) < 0)
             return 0;
     } else {
+        /* without sources, the path ends only where T reaches 0 at a local
+         * minimum (a vertex source); else it is not at a source */
         int best = -1;
         for (int k = 0; k < 3; k++)
-            if (fr->T[k] <= Tx && local_min(t, fr->v[k]) && (best < 0 || fr->T[k] < fr->T[best]))
+            if (fr->T[k] <= Tx && fr->T[k] <= 0.0 && local_min(t, fr->v[k]) &&
+                (best < 0 || fr->T[k] < fr->T[best]))
                 best = k;
         if (best < 0)
             return 0;
@@ -605,11 +666,14 @@ static int slide(tracer *t, pos *p, const frame *fr, int k, const double d[2], d
     double ex = fr->P[k2][0] - fr->P[k1][0], ey = fr->P[k2][1] - fr->P[k1][1];
     double L = sqrt(ex * ex + ey * ey);
     double s = (d[0] * ex + d[1] * ey) / L;
+    /* T along an edge is linear in its ends: down is toward the lower end
+     * (d's tangential part, from the quadratic, can point up the edge, and
+     * the two faces of a valley then send the path back and forth) */
     int toward;
-    if (fabs(s) > 1e-6)
-        toward = s > 0.0 ? k2 : k1;
-    else if (fr->T[k1] != fr->T[k2])
+    if (fr->T[k1] != fr->T[k2])
         toward = fr->T[k1] < fr->T[k2] ? k1 : k2;
+    else if (fabs(s) > 1e-6)
+        toward = s > 0.0 ? k2 : k1;
     else
         return 0;
     int other = toward == k1 ? k2 : k1;
@@ -625,6 +689,99 @@ static int slide(tracer *t, pos *p, const frame *fr, int k, const double d[2], d
     p->b[k] = 0.0;
     p->from = -1;
     return 1;
+}
+
+/* Follows corner c's virtual edge from its vertex C straight through its
+ * strip to V (a point on each edge crossed), and stands at V. 1, or -1. */
+static int follow_virt(tracer *t, pos *p, int32_t c)
+{
+    const mfmm_mesh *m = t->m;
+    int32_t f = c / 3;
+    for (int32_t k = m->virt_offset[c]; k < m->virt_offset[c + 1]; k++) {
+        const mfmm_virt_step *st = m->virt_steps + k;
+        double b[3];
+        edge_bary(m, f, st->e1, st->e2, st->t, b);
+        if (!emit(t, f, b)) /* the piece to it ran through f */
+            return -1;
+        f = st->face;
+    }
+    set_vertex(p, m, f, m->virt_steps[m->virt_offset[c + 1] - 1].far);
+    return emit(t, f, p->b) ? 1 : -1;
+}
+
+/* The best straight way from a point source to one vertex (start.c). */
+typedef struct walk_find {
+    int32_t target;
+    double value, best;
+    int32_t depth;
+    int32_t a[MFMM_START_DEPTH], b[MFMM_START_DEPTH], face[MFMM_START_DEPTH + 1];
+    double t[MFMM_START_DEPTH];
+} walk_find;
+
+static int walk_find_hit(void *user, const mfmm_start_hit *h)
+{
+    walk_find *w = user;
+    if (h->vertex != w->target || !(w->value + h->cost_length < w->best))
+        return 0;
+    w->best = w->value + h->cost_length;
+    w->depth = h->depth;
+    memcpy(w->face, h->face, (size_t)(h->depth + 1) * sizeof *w->face);
+    memcpy(w->a, h->a, (size_t)h->depth * sizeof *w->a);
+    memcpy(w->b, h->b, (size_t)h->depth * sizeof *w->b);
+    memcpy(w->t, h->t, (size_t)h->depth * sizeof *w->t);
+    return 0;
+}
+
+/* At vertex v, which T does not descend from: a face source that seeded v
+ * by a straight segment (solve.c starts a point source's march so, through
+ * the faces near it), when that segment's cost is T(v). Ends the path along
+ * it: a point on each edge crossed, then the source. 1: ended; 0: none;
+ * -1: error. */
+static int finish_straight(tracer *t, int32_t v)
+{
+    const mfmm_mesh *m = t->m;
+    double Tv = t->T[v];
+    walk_find best;
+    best.best = INFINITY;
+    int32_t bs = -1;
+    for (int32_t j = 0; j < t->n_fkeys; j++) {
+        const mfmm_source *s = &t->src[t->fkeys[j].idx];
+        walk_find w;
+        w.target = v;
+        w.value = s->value;
+        w.best = INFINITY;
+        w.depth = -1;
+        mfmm_start_walk(m, s, t->cost, (int)t->cost_loc, walk_find_hit, &w);
+        if (w.depth >= 0 && w.best < best.best) {
+            best = w;
+            bs = t->fkeys[j].idx;
+        }
+    }
+    if (bs < 0 || !(best.best <= Tv + 1e-9 * (fabs(Tv) + fabs(best.best))))
+        return 0;
+    for (int32_t i = best.depth - 1; i >= 0; i--) {
+        double b[3];
+        edge_bary(m, best.face[i + 1], best.a[i], best.b[i], best.t[i], b);
+        if (!emit(t, best.face[i + 1], b)) /* the piece to it ran through face[i + 1] */
+            return -1;
+    }
+    /* the source, named in the start face the segment left */
+    const mfmm_source *s = &t->src[bs];
+    int32_t f0 = best.face[0];
+    double b[3];
+    for (int k = 0; k < 3; k++) {
+        int32_t x = m->faces[3 * (size_t)f0 + k];
+        b[k] = 0.0;
+        for (int j = 0; j < 3; j++)
+            if (m->faces[3 * (size_t)s->face + j] == x)
+                b[k] = s->bary[j] > 0.0 ? s->bary[j] : 0.0;
+    }
+    double sum = b[0] + b[1] + b[2];
+    if (!(sum > 0.0)) /* at a vertex of f0 that the source face does not share: cannot be */
+        return 0;
+    for (int k = 0; k < 3; k++)
+        b[k] /= sum;
+    return emit(t, f0, b) ? 1 : -1;
 }
 
 static int validate_point(const mfmm_mesh *m, const mfmm_source *s, const char *what, int64_t idx,
@@ -882,9 +1039,23 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
             int r = leave_vertex(t, &p, &fr, d);
             if (r < 0)
                 return t->st;
+            if (r == 0) {
+                /* no way down over faces and edges: a virtual edge, or a
+                 * face source seeded across an edge */
+                int32_t c = virt_descent(t, v);
+                if (c >= 0)
+                    r = follow_virt(t, &p, c);
+                else if ((r = finish_straight(t, v)) > 0)
+                    return MFMM_OK;
+                if (r < 0)
+                    return t->st;
+            }
             if (r == 0)
                 return mfmm_fail(t->err, MFMM_ERR_PATH_STALLED, v,
-                                 "T has a local minimum %.17g at vertex %d, not at a source",
+                                 t->n_src > 0 ? "T has a local minimum %.17g at vertex %d, not at a source"
+                                              : "T has a local minimum %.17g at vertex %d, not 0 "
+                                                "(pass the sources to end at a point source or "
+                                                "one with a value)",
                                  Tcur, (int)v);
             if (p.vertex >= 0) { /* went down an edge to another vertex */
                 have_frame = 0;

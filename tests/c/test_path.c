@@ -590,6 +590,119 @@ static void test_errors(void **state)
     tm_fixture_free(&fx);
 }
 
+/* Issue 9.2 and 9.3a on the shared meshes: the path ends at the source or
+ * fails, never elsewhere. wingnut from vertex 2593 to 128: T(2793) comes
+ * through a virtual edge and is below all its edge neighbours; the default
+ * call (no sources) ended there silently (length 1.08 for T(128) = 1.56),
+ * with the sources it failed ("local minimum"). spot, face source
+ * (5007, (0.42, 0.14, 0.44)) to (4898, (0.05, 0.73, 0.22)): the far vertex
+ * 597 seeded across an edge of the source face stalled the path. */
+static int32_t trace_data(const mfmm_mesh *mesh, const double *d, const mfmm_source *target,
+                          const mfmm_source *src, int32_t n_src, mfmm_surface_point *pts,
+                          double *len, mfmm_status *st)
+{
+    mfmm_path_options po;
+    mfmm_path_options_init(&po);
+    po.sources = src;
+    po.n_sources = n_src;
+    int32_t n = 0;
+    mfmm_error err;
+    *st = mfmm_trace_path(mesh, d, target, &po, pts, CAP, &n, len, &err);
+    return n;
+}
+
+/* xyz of a vertex or face source, from the mesh file's vertices V */
+static void source_xyz(const double *V, const int32_t *F, const mfmm_source *s, double x[3])
+{
+    for (int c = 0; c < 3; c++) {
+        x[c] = 0.0;
+        if (s->face < 0)
+            x[c] = V[3 * (size_t)s->vertex + c];
+        else
+            for (int k = 0; k < 3; k++)
+                x[c] += s->bary[k] * V[3 * (size_t)F[3 * (size_t)s->face + k] + c];
+    }
+}
+
+/* tests/data/<relative>'s vertices and faces (free with mfmm_free) */
+static void load_arrays(const char *relative, double **V, int32_t **F)
+{
+    char path[1024];
+    int32_t nv = 0, nf = 0;
+    tm_data_path(path, sizeof path, relative);
+    assert_int_equal(mfmm_load_mesh(path, V, &nv, F, &nf, NULL), MFMM_OK);
+}
+
+static void test_shared_mesh_reproducers(void **state)
+{
+    (void)state;
+    mfmm_surface_point *pts = malloc(CAP * sizeof *pts);
+    assert_non_null(pts);
+    mfmm_status st;
+    double len;
+    mfmm_error err;
+    {
+        int32_t nv = 0;
+        mfmm_mesh *mesh = tm_load_data("meshes/wingnut.obj", &nv, NULL, NULL);
+        mfmm_solver *solver = NULL;
+        assert_int_equal(mfmm_solver_create(mesh, &solver), MFMM_OK);
+        double *d = malloc((size_t)nv * sizeof *d);
+        assert_non_null(d);
+        mfmm_source s = tm_vertex_source(2593), t = tm_vertex_source(128);
+        assert_int_equal(mfmm_solve(solver, &s, 1, NULL, d, &err), MFMM_OK);
+        for (int with = 0; with < 2; with++) {
+            int32_t n = trace_data(mesh, d, &t, with ? &s : NULL, with, pts, &len, &st);
+            assert_int_equal(st, MFMM_OK);
+            assert_true(n >= 2);
+            /* the source vertex: barycentric 1 at 2593 in the last face */
+            double x[3], y[3], *V = NULL;
+            int32_t *F = NULL;
+            load_arrays("meshes/wingnut.obj", &V, &F);
+            source_xyz(V, F, &s, x);
+            mfmm_free(V);
+            mfmm_free(F);
+            memcpy(y, pts[n - 1].xyz, sizeof y);
+            tm_assert_close(x[0], y[0], 1e-12);
+            tm_assert_close(x[1], y[1], 1e-12);
+            tm_assert_close(x[2], y[2], 1e-12);
+            print_message("wingnut 2593 -> 128 (%s sources): length %.4f, T(128) = %.4f\n",
+                          with ? "with" : "without", len, d[128]);
+            assert_true(len >= 0.95 * d[128] && len <= 1.05 * d[128]);
+        }
+        free(d);
+        mfmm_solver_destroy(solver);
+        mfmm_mesh_destroy(mesh);
+    }
+    {
+        int32_t nv = 0;
+        mfmm_mesh *mesh = tm_load_data("meshes/spot.obj", &nv, NULL, NULL);
+        mfmm_solver *solver = NULL;
+        assert_int_equal(mfmm_solver_create(mesh, &solver), MFMM_OK);
+        double *d = malloc((size_t)nv * sizeof *d);
+        assert_non_null(d);
+        mfmm_source s = {0, 5007, {0.42, 0.14, 0.44}, 0.0}, t = {0, 4898, {0.05, 0.73, 0.22}, 0.0};
+        assert_int_equal(mfmm_solve(solver, &s, 1, NULL, d, &err), MFMM_OK);
+        int32_t n = trace_data(mesh, d, &t, &s, 1, pts, &len, &st);
+        assert_int_equal(st, MFMM_OK);
+        double x[3], *V = NULL;
+        int32_t *F = NULL;
+        load_arrays("meshes/spot.obj", &V, &F);
+        source_xyz(V, F, &s, x);
+        mfmm_free(V);
+        mfmm_free(F);
+        for (int c = 0; c < 3; c++)
+            tm_assert_close(pts[n - 1].xyz[c], x[c], 1e-12);
+        /* without the sources it cannot end at the point (T > 0 at every
+         * vertex): it fails, and says so */
+        trace_data(mesh, d, &t, NULL, 0, pts, &len, &st);
+        assert_int_equal(st, MFMM_ERR_PATH_STALLED);
+        free(d);
+        mfmm_solver_destroy(solver);
+        mfmm_mesh_destroy(mesh);
+    }
+    free(pts);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -599,6 +712,7 @@ int main(void)
         cmocka_unit_test(test_torus_sides),
         cmocka_unit_test(test_ends),
         cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_shared_mesh_reproducers),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -423,6 +423,125 @@ static void test_bad_solves(void **state)
     tm_fixture_free(&fx);
 }
 
+/* Issue 9.3b: a point on an edge or at a vertex is a point of every face
+ * holding it: the same T (bit for bit) whichever face names it, and T moves
+ * continuously with the point. Before the fix a hand edge midpoint was not
+ * seeded across its edge: naming it by the other face changed T by up to 3 %
+ * of the diagonal, and so did a move of 1e-9 off the edge. A move of d
+ * changes the exact distance by at most d: allowed here 10 d. */
+static void solve_point(mfmm_solver *solver, int32_t face, const double bary[3], double *d)
+{
+    mfmm_source s = {0, face, {bary[0], bary[1], bary[2]}, 0.0};
+    mfmm_error err;
+    if (mfmm_solve(solver, &s, 1, NULL, d, &err) != MFMM_OK)
+        fail_msg("mfmm_solve: %s", err.message);
+}
+
+static void test_points_on_edges_and_vertices(void **state)
+{
+    (void)state;
+    int32_t nv = 0, nf = 0, *F = NULL;
+    mfmm_mesh *mesh = tm_load_data("meshes/hand_lowres.obj", &nv, &nf, &F);
+    char path[1024];
+    tm_data_path(path, sizeof path, "meshes/hand_lowres.obj");
+    double *V = NULL;
+    int32_t *F2 = NULL, nv2 = 0, nf2 = 0;
+    assert_int_equal(mfmm_load_mesh(path, &V, &nv2, &F2, &nf2, NULL), MFMM_OK);
+    mfmm_solver *solver = NULL;
+    assert_int_equal(mfmm_solver_create(mesh, &solver), MFMM_OK);
+    double *d0 = malloc((size_t)nv * sizeof *d0), *d1 = malloc((size_t)nv * sizeof *d1);
+    assert_true(d0 && d1);
+    double worst_move = 0.0;
+    int n_edges = 0;
+    for (int32_t f = 0; f < nf && n_edges < 24; f += 37) {
+        for (int k = 0; k < 3; k++) {
+            /* the edge opposite corner k, and the face g across it */
+            int32_t a = F[3 * f + (k + 1) % 3], b = F[3 * f + (k + 2) % 3], g = -1, kg = -1;
+            for (int32_t h = 0; h < nf && g < 0; h++) {
+                if (h == f)
+                    continue;
+                int has_a = -1, has_b = -1, other = -1;
+                for (int j = 0; j < 3; j++) {
+                    if (F[3 * h + j] == a)
+                        has_a = j;
+                    else if (F[3 * h + j] == b)
+                        has_b = j;
+                    else
+                        other = j;
+                }
+                if (has_a >= 0 && has_b >= 0) {
+                    g = h;
+                    kg = other;
+                }
+            }
+            if (g < 0)
+                continue;
+            n_edges++;
+            double bf[3] = {0, 0, 0}, bg[3] = {0, 0, 0};
+            bf[(k + 1) % 3] = bf[(k + 2) % 3] = 0.5;
+            for (int j = 0; j < 3; j++)
+                if (j != kg)
+                    bg[j] = 0.5;
+            solve_point(solver, f, bf, d0);
+            solve_point(solver, g, bg, d1);
+            for (int32_t v = 0; v < nv; v++)
+                if (!(d0[v] == d1[v]))
+                    fail_msg("edge (%d, %d): T(%d) = %.17g named by face %d, %.17g by face %d",
+                             (int)a, (int)b, (int)v, d0[v], (int)f, d1[v], (int)g);
+            /* 1e-9 off the edge, into f and into g */
+            for (int side = 0; side < 2; side++) {
+                int32_t face = side ? g : f;
+                int kk = side ? kg : k;
+                double bm[3];
+                for (int j = 0; j < 3; j++)
+                    bm[j] = j == kk ? 1e-9 : 0.5 - 0.5e-9;
+                const double *xk = V + 3 * (size_t)F[3 * face + kk];
+                double mid[3], move = 0.0;
+                for (int c = 0; c < 3; c++) {
+                    mid[c] = 0.5 * (V[3 * (size_t)a + c] + V[3 * (size_t)b + c]);
+                    move += (xk[c] - mid[c]) * (xk[c] - mid[c]);
+                }
+                move = 1e-9 * sqrt(move);
+                solve_point(solver, face, bm, d1);
+                for (int32_t v = 0; v < nv; v++) {
+                    double dv = fabs(d1[v] - d0[v]);
+                    worst_move = fmax(worst_move, dv / move);
+                    if (!(dv <= 10.0 * move))
+                        fail_msg("edge (%d, %d) moved %.3g into face %d: T(%d) moves %.3g", (int)a,
+                                 (int)b, move, (int)face, (int)v, dv);
+                }
+            }
+        }
+    }
+    assert_true(n_edges >= 20);
+    print_message("points on %d edges: 1e-9 moves change T by at most %.3g times the move\n",
+                  n_edges, worst_move);
+    /* a vertex named by each face around it, and the vertex itself */
+    for (int32_t v = 5; v < nv; v += 97) {
+        int named = 0;
+        for (int32_t f = 0; f < nf; f++)
+            for (int k = 0; k < 3; k++)
+                if (F[3 * f + k] == v) {
+                    double b[3] = {0, 0, 0};
+                    b[k] = 1.0;
+                    solve_point(solver, f, b, named ? d1 : d0);
+                    for (int32_t w = 0; named && w < nv; w++)
+                        if (!(d0[w] == d1[w]))
+                            fail_msg("vertex %d: T(%d) differs by the face naming it", (int)v,
+                                     (int)w);
+                    named++;
+                }
+        assert_true(named >= 3);
+    }
+    free(d0);
+    free(d1);
+    mfmm_free(V);
+    mfmm_free(F2);
+    mfmm_free(F);
+    mfmm_solver_destroy(solver);
+    mfmm_mesh_destroy(mesh);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -436,6 +555,7 @@ int main(void)
         cmocka_unit_test(test_bad_meshes),
         cmocka_unit_test(test_degenerate_faces_accepted),
         cmocka_unit_test(test_bad_solves),
+        cmocka_unit_test(test_points_on_edges_and_vertices),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -7,6 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import meshfmm
+
 from conftest import MANIFOLD_MESHES, load, mesh, reference
 
 N_TARGETS = 20
@@ -71,3 +73,98 @@ def test_unreached_and_bad_target():
         m.geodesic_path(d, far, sources=[0])
     with pytest.raises(ValueError):
         m.geodesic_path(d, m.n_vertices + 5, sources=[0])
+
+
+# ---- issue 9.2 and 9.3: paths end at their source or raise; point sources on edges
+
+
+def _ends_at(p, x, h):
+    return np.linalg.norm(p.points[-1] - x) <= 1e-9 * h
+
+
+@pytest.mark.parametrize("name", ["wingnut.obj", "spot.obj", "decimated-max.obj"])
+def test_paths_end_at_source_sweep(name):
+    """A reduced bench/sweep_paths.py: 30 targets from one reference source,
+    the default call and with sources, and 30 random face-to-face pairs; none
+    may end away from the source or stall."""
+    V, F = load(name)
+    m = mesh(name)
+    h = mean_edge_length(V, F)
+    sources, _ = reference(name)
+    s = int(sources[-1])
+    d = m.distance(s)
+    rng = np.random.default_rng(9)
+    for t in rng.choice(np.flatnonzero(np.isfinite(d) & (d > 0)), 30, replace=False):
+        assert _ends_at(m.geodesic_path(d, int(t)), V[s], h), f"{name}: {s} -> {t}"
+        assert _ends_at(m.geodesic_path(d, int(t), sources=[s]), V[s], h)
+    for _ in range(30):
+        src = meshfmm.SurfacePoint(int(rng.integers(len(F))), tuple(rng.dirichlet((1, 1, 1))))
+        tgt = meshfmm.SurfacePoint(int(rng.integers(len(F))), tuple(rng.dirichlet((1, 1, 1))))
+        p = m.geodesic_path(m.distance(src), tgt, sources=[src])
+        assert _ends_at(p, np.asarray(src.bary) @ V[F[src.face]], h), f"{name}: {src} -> {tgt}"
+
+
+def test_wingnut_virtual_edge_minimum():
+    """wingnut, 2593 -> 128: T(2793) came through a virtual edge below all its
+    edge neighbours; the default call ended there (length 1.08 for T(128) =
+    1.56), with sources it raised. The path now follows the virtual edge."""
+    V, F = load("wingnut.obj")
+    m = mesh("wingnut.obj")
+    h = mean_edge_length(V, F)
+    d = m.distance(2593)
+    for kw in ({}, {"sources": [2593]}):
+        p = m.geodesic_path(d, 128, **kw)
+        assert _ends_at(p, V[2593], h)
+        assert p.length == pytest.approx(d[128], rel=0.05)
+
+
+def test_spot_face_source_across_edge():
+    """spot: the far vertex 597 seeded from a face source across an edge was a
+    1-ring minimum the path stalled at. Without sources the path cannot reach
+    the point (T > 0 at every vertex): it raises rather than end elsewhere."""
+    V, F = load("spot.obj")
+    m = mesh("spot.obj")
+    src = meshfmm.SurfacePoint(5007, (0.42, 0.14, 0.44))
+    tgt = meshfmm.SurfacePoint(4898, (0.05, 0.73, 0.22))
+    d = m.distance(src)
+    p = m.geodesic_path(d, tgt, sources=[src])
+    assert _ends_at(p, np.asarray(src.bary) @ V[F[src.face]], mean_edge_length(V, F))
+    with pytest.raises(RuntimeError, match="local minimum"):
+        m.geodesic_path(d, tgt)
+
+
+def test_hand_edge_midpoint_source():
+    """A point on an edge is a point of both faces: the same T whichever face
+    names it (to 1e-12 relative; in fact bit for bit) and no jump when it
+    moves 1e-9 off the edge (before: 0.76 % of the diagonal; the exact
+    distance moves by at most the move)."""
+    V, F = load("hand_lowres.obj")
+    m = mesh("hand_lowres.obj")
+    f = 100
+    for k in range(3):
+        a, b = F[f, (k + 1) % 3], F[f, (k + 2) % 3]
+        g = [i for i in np.flatnonzero((F == a).any(1) & (F == b).any(1)) if i != f]
+        if not g:
+            continue
+        g = int(g[0])
+        bf = np.zeros(3)
+        bf[[(k + 1) % 3, (k + 2) % 3]] = 0.5
+        bg = np.where((F[g] == a) | (F[g] == b), 0.5, 0.0)
+        d_f = m.distance(meshfmm.SurfacePoint(f, tuple(bf)))
+        d_g = m.distance(meshfmm.SurfacePoint(g, tuple(bg)))
+        np.testing.assert_allclose(d_g, d_f, rtol=1e-12, atol=0)
+        for face, bary, kk in ((f, bf, k), (g, bg, int(np.flatnonzero(bg == 0)[0]))):
+            bm = bary * (1 - 1e-9)
+            bm[kk] = 1e-9
+            move = 1e-9 * np.linalg.norm(V[F[face, kk]] - 0.5 * (V[a] + V[b]))
+            d_m = m.distance(meshfmm.SurfacePoint(face, tuple(bm)))
+            assert np.max(np.abs(d_m - d_f)) <= 10 * move
+
+
+@pytest.mark.parametrize("bad", [-1.0, float("-inf"), float("nan")])
+def test_max_distance_negative_or_nan_refused(bad):
+    m = mesh("hand_lowres.obj")
+    with pytest.raises(ValueError, match="max_distance"):
+        m.distance(0, max_distance=bad)
+    with pytest.raises(ValueError, match="max_distance"):
+        m.distance_matrix([0, 1], max_distance=bad, backend="serial")

@@ -545,7 +545,9 @@ class Mesh:
         distances: (n_vertices,) from :meth:`distance`.
         target: a vertex id or a :class:`SurfacePoint`.
         sources: the sources ``distances`` came from; the path then ends
-            exactly at the nearest one (else where T stops decreasing).
+            exactly at the nearest one. Without them it ends at a vertex
+            where T is 0 (a vertex source); where T stops decreasing above 0
+            (a face source, a source value > 0) it raises RuntimeError.
         cost, cost_location: the cost ``distances`` was solved with.
         max_points: most points the path may have (default: the library's).
         straighten: True (default): the traced path is replaced by the
@@ -557,7 +559,8 @@ class Mesh:
             than the traced path. False: the raw section-5 path.
 
         Raises ValueError for an unreached (+inf) target, RuntimeError when
-        tracing stalls.
+        tracing stalls or cannot reach a source; it never returns a path
+        that ends elsewhere.
         """
         d = np.ascontiguousarray(distances, dtype=np.float64)
         if d.shape != (self._nv,):

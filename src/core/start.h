@@ -1,0 +1,42 @@
+/* The exact start around a point source (private to the library): every
+ * vertex that a straight segment from the point reaches through the unfolded
+ * faces near it, with that segment. Used to seed a march (solve.c) and by the
+ * tracer to end a path at the source (paths/trace.c). */
+#ifndef MFMM_START_H
+#define MFMM_START_H
+
+#include "mesh.h"
+
+/* The walk reaches faces whose entry edge is nearer the point than this many
+ * mean edge lengths (or the longest edge, if longer), at most
+ * MFMM_START_DEPTH edges from it. */
+#define MFMM_START_RADIUS 2.0
+#define MFMM_START_DEPTH 32
+
+/* A vertex the walk reached, with the segment's way there. */
+typedef struct mfmm_start_hit {
+    int32_t vertex;
+    double length;      /* Euclidean length of the segment */
+    double cost_length; /* its length weighted by the cost (see mfmm_start_walk) */
+    int32_t depth;      /* edges crossed */
+    /* edge i crossed (i < depth): ends (a[i], b[i]) at a[i] + t[i] (b[i] - a[i]),
+     * from face face[i] into face[i + 1]; face[0] holds the point, face[depth] the vertex */
+    const int32_t *a, *b, *face;
+    const double *t;
+} mfmm_start_hit;
+
+/* Called for each vertex reached (a vertex may be reached several ways);
+ * returns non-zero to stop the walk. */
+typedef int (*mfmm_start_fn)(void *user, const mfmm_start_hit *hit);
+
+/* Walks from a checked point source (face >= 0): the faces holding the point
+ * (one, the two of an edge it lies on, or all around a vertex it is at, so
+ * that the result does not depend on which face names it), their corners,
+ * then straight on through their edges within MFMM_START_RADIUS. cost NULL:
+ * cost_length = length; per vertex: F at the vertex reached times length
+ * (the march's F(C)); per face: the sum over the faces crossed of F times the
+ * piece in that face. */
+void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double *cost,
+                     int cost_location, mfmm_start_fn fn, void *user);
+
+#endif
