@@ -6,7 +6,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake pkg-config python3 python3-venv python3-dev
-          pocl-opencl-icd ocl-icd-opencl-dev opencl-headers clinfo libcmocka-dev)
+          pocl-opencl-icd ocl-icd-opencl-dev opencl-headers clinfo libcmocka-dev
+          clang locales)
 if command -v apt-get >/dev/null 2>&1; then
     missing=()
     for p in "${packages[@]}"; do
