@@ -414,7 +414,14 @@ MFMM_API mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *
 
 /* Reads a triangle mesh: OBJ (v/vt/vn indices, negative indices, polygons
  * fan-triangulated), OFF (CRLF too), PLY (ascii, binary little/big endian;
- * faces or tristrips). On success *vertices is (nv,3) float64 and *faces
+ * faces or tristrips), STL (binary or ascii, told apart by binary STL's
+ * 84 + 50 n size; corners welded into vertices by exact position, facets
+ * with coinciding corners dropped). The format comes from the extension
+ * (case-insensitive), else from the content; other formats (glTF, FBX,
+ * 3DS, DAE, ...) fail with MFMM_ERR_PARSE and a sentence naming the formats
+ * read. Only regular files are read (a directory, FIFO or device fails at
+ * once with MFMM_ERR_IO). Numbers are read the same whatever the locale
+ * (correctly rounded). On success *vertices is (nv,3) float64 and *faces
  * (nf,3) int32, both allocated by the library: free them with mfmm_free. */
 MFMM_API mfmm_status mfmm_load_mesh(const char *path, double **vertices, int32_t *nv,
                                     int32_t **faces, int32_t *nf, mfmm_error *err);

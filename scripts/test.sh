@@ -7,6 +7,8 @@
 # UndefinedBehaviorSanitizer, and the Python tests (pytest) against the
 # clone's library. The clone's builds are the only builds (no duplicate in
 # place). Outside a git checkout it runs in place.
+# Last, a short run of every libFuzzer harness (tests/fuzz; a crash fails
+# the run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 repo=$PWD
@@ -40,3 +42,13 @@ ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-sanitize --output-on-failure 
 echo "== Python tests (pytest, against this tree's build)"
 MESHFMM_LIBRARY="$PWD/build/libmeshfmm.so" PYTHONPATH="$PWD/bindings/python" \
 MESHFMM_CLI="$PWD/build/meshfmm" .venv/bin/python -m pytest tests/python -q -p no:cacheprovider
+
+echo "== Fuzzing (libFuzzer harnesses of tests/fuzz, ${MESHFMM_FUZZ_SECONDS:-15} s each)"
+if command -v clang >/dev/null 2>&1; then
+    cmake -S . -B build-fuzz -DCMAKE_C_COMPILER=clang -DMESHFMM_BUILD_FUZZ=ON \
+          -DMESHFMM_BUILD_TESTS=OFF -DMESHFMM_BUILD_BENCH=OFF -DMESHFMM_BUILD_CLI=OFF >/dev/null
+    cmake --build build-fuzz -j"$jobs" >/dev/null
+    bash tests/fuzz/run.sh build-fuzz "${MESHFMM_FUZZ_SECONDS:-15}"
+else
+    echo "no clang: fuzzing skipped (scripts/setup.sh installs it)"
+fi

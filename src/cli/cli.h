@@ -5,6 +5,7 @@
 #define MFMM_CLI_H
 
 #include <stdint.h>
+#include <getopt.h>
 #include <stdio.h>
 
 #include "meshfmm.h"
@@ -42,12 +43,65 @@ int cli_has_ext(const char *path, const char *ext);
  * NULL on failure. */
 mfmm_mesh *cli_load_mesh(const char *path, const mfmm_mesh_options *options);
 
-/* ---- options shared by distance and path (options.c) ---- */
+/* ---- getopt_long (util.c) ---- */
 
-/* One point argument at argv[i] (the option itself): --source-like "I" or
- * --face-source-like "F W0 W1 W2". 1 with *s filled, 0 when malformed. */
-int cli_parse_vertex_point(int argc, char **argv, int i, mfmm_source *s);
-int cli_parse_face_point(int argc, char **argv, int i, mfmm_source *s);
+/* Long-only option codes (above any char). */
+enum {
+    OPT_SOURCE = 256, OPT_FACE_SOURCE, OPT_COST, OPT_COST_PER_FACE, OPT_MAX_DISTANCE,
+    OPT_NO_UNFOLDING, OPT_TARGET, OPT_TARGET_FACE, OPT_MAX_POINTS, OPT_NO_STRAIGHTEN,
+    OPT_JSON, OPT_MAX_UNFOLD_STEPS, OPT_STRETCH, OPT_RADII, OPT_DTYPE, OPT_BACKEND,
+    OPT_SOURCES, OPT_THREADS, OPT_MEMORY
+};
+/* Prints the usage error for getopt_long's '?' or ':' (opterr is 0; the
+ * optstring starts with ':'); returns CLI_USAGE. */
+int cli_getopt_error(const char *sub, int c, char **argv);
+/* After --face-source F: takes the three weights at argv[optind..] (they
+ * may start with '-') and advances optind. 1, or 0 when they are missing or
+ * malformed. */
+int cli_take_face_point(const char *face, int argc, char **argv, mfmm_source *s);
+
+/* ---- inputs and outputs (util.c) ---- */
+
+/* SIGINT and SIGTERM set a flag (cli_interrupted() reads it) instead of
+ * killing the process, so that temporary files get removed; the CLI only,
+ * never the library. */
+void cli_signals_install(void);
+int cli_interrupted(void);
+#define CLI_EXIT_INTERRUPTED 130
+
+/* Reads a whole regular file (refusing directories, FIFOs, devices) into a
+ * malloc'ed NUL-terminated buffer. 0, or -1 with the error printed. */
+int cli_read_file(const char *path, unsigned char **data, size_t *size);
+
+/* Refuses an output that is one of the inputs (NULL entries skipped),
+ * compared by device and inode, so a hard link or another spelling of the
+ * path is caught. CLI_OK, or CLI_USAGE with the error printed. */
+int cli_check_output_not_input(const char *sub, const char *out, const char *const *inputs,
+                               int n_inputs);
+
+/* An output file: "-" is standard output (text formats only); otherwise a
+ * unique temporary file beside the target, created exclusively (mkstemp:
+ * O_EXCL, so a planted symlink is never followed), fsync'ed and renamed
+ * over the target by cli_output_close; removed on failure or interrupt. */
+typedef struct cli_output {
+    FILE *f;
+    char *path;     /* final name (NULL for stdout) */
+    char *tmp_path; /* the temporary file */
+} cli_output;
+
+/* 0, or -1 with the error printed. */
+int cli_output_open(cli_output *o, const char *path);
+/* Flushes and, for a file, fsyncs, closes and renames (`bad`: a write
+ * already failed; an interrupt counts as a failure). 0, or -1 with the error
+ * printed and the temporary file removed. */
+int cli_output_close(cli_output *o, int bad);
+/* Closes and removes the temporary file; safe after a failed open. */
+void cli_output_abort(cli_output *o);
+/* Writes x as %.17g in the C locale, whatever the locale ("inf" for
+ * infinities); fputs's result. */
+int cli_put_double(FILE *f, double x);
+
+/* ---- options shared by distance and path (options.c) ---- */
 
 /* The positional mesh, --source I, --face-source F W0 W1 W2, --cost FILE,
  * --cost-per-face, -o/--output OUT and --help/-h; `sub` names the
@@ -65,22 +119,35 @@ typedef struct cli_sources_and_cost {
     double *cost;     /* loaded by cli_sources_and_cost_load */
 } cli_sources_and_cost;
 
+/* The shared options, for a command's getopt_long table. */
+#define CLI_SHARED_LONG_OPTIONS                                                              \
+    {"help", no_argument, NULL, 'h'}, {"output", required_argument, NULL, 'o'},             \
+        {"source", required_argument, NULL, OPT_SOURCE},                                     \
+        {"face-source", required_argument, NULL, OPT_FACE_SOURCE},                           \
+        {"cost", required_argument, NULL, OPT_COST},                                         \
+        {"cost-per-face", no_argument, NULL, OPT_COST_PER_FACE}
+#define CLI_SHARED_SHORT_OPTIONS ":ho:"
+
 /* 0, or -1 with "out of memory" printed. argc: the subcommand's. */
 int cli_sources_and_cost_init(cli_sources_and_cost *o, const char *sub, void (*help)(FILE *out),
                               int argc);
 void cli_sources_and_cost_free(cli_sources_and_cost *o);
-/* Takes argv[*i] (a shared option, with its values, or the mesh) and
- * advances *i past its values; anything else starting with '-' is an unknown
- * option. CLI_OK, or CLI_USAGE with the usage error printed. On --help it
- * prints the help on stdout, sets o->help_shown and returns CLI_OK. */
-int cli_sources_and_cost_arg(cli_sources_and_cost *o, int argc, char **argv, int *i);
+/* Takes getopt_long's result c (a shared option; '?' or ':' are usage
+ * errors; anything else is the caller's bug). CLI_OK, or CLI_USAGE with the
+ * usage error printed. On --help it prints the help on stdout, sets
+ * o->help_shown and returns CLI_OK. */
+int cli_sources_and_cost_opt(cli_sources_and_cost *o, int c, int argc, char **argv);
+/* The positional arguments left after getopt_long (argv[optind..]): one
+ * mesh. CLI_OK or CLI_USAGE (printed). */
+int cli_sources_and_cost_positional(cli_sources_and_cost *o, int argc, char **argv);
 /* After the argument loop: a mesh and at least one source. CLI_OK or
  * CLI_USAGE (printed). */
 int cli_sources_and_cost_check_inputs(const cli_sources_and_cost *o);
-/* An output ending in .ext0 or .ext1 (*which: 0 or 1) and no --cost-per-face
- * without --cost. CLI_OK or CLI_USAGE (printed). */
+/* An output ending in .ext0 or .ext1 (*which: 0 or 1; "-", standard output,
+ * gives text_which), no --cost-per-face without --cost, and an output that is
+ * not an input. CLI_OK or CLI_USAGE (printed). */
 int cli_sources_and_cost_check_output(const cli_sources_and_cost *o, const char *ext0,
-                                      const char *ext1, int *which);
+                                      const char *ext1, int text_which, int *which);
 /* Loads --cost FILE (if given) into o->cost, checks its length against the
  * mesh and sets opt->cost and opt->cost_location. hint_per_face: suggest
  * --cost-per-face when a per-vertex cost has one value per face. 0, or -1
@@ -92,24 +159,12 @@ int cli_sources_and_cost_load(cli_sources_and_cost *o, const mfmm_mesh *mesh,
 double *cli_solve_distances(const mfmm_mesh *mesh, const cli_sources_and_cost *o,
                             const mfmm_solve_options *opt);
 
-/* Text output written as "PATH.partial" and renamed to PATH once complete,
- * so a failed write leaves nothing under PATH. cli_partial_open returns the
- * stream and the temporary name (*tmp, malloc'ed), or NULL with the error
- * printed. cli_partial_close flushes, closes and renames (`bad`: a write
- * already failed), removes the temporary file on failure and frees tmp;
- * 0 or -1 (printed). */
-FILE *cli_partial_open(const char *path, char **tmp);
-int cli_partial_close(FILE *f, char *tmp, const char *path, int bad);
-
 /* ---- .npy files (format 1.0) ---- */
 
-/* Streaming writer: data goes to "PATH.partial", renamed to PATH by
- * cli_npy_close; cli_npy_abort removes the temporary file. Errors are
- * printed (cli_error). */
+/* Streaming writer on a cli_output (a temporary file renamed by
+ * cli_npy_close; cli_npy_abort removes it). Errors are printed. */
 typedef struct cli_npy_writer {
-    FILE *f;
-    char *path;      /* final name */
-    char *tmp_path;  /* PATH.partial */
+    cli_output out;
     int64_t rows;    /* rows promised in the header */
     int64_t cols;    /* values per row (1 for a 1-D array) */
     int64_t rows_written;
@@ -129,18 +184,28 @@ int cli_npy_close(cli_npy_writer *w);
 /* Closes and removes the temporary file; safe after a failed open. */
 void cli_npy_abort(cli_npy_writer *w);
 
-/* Reads a 1-D float64 or float32 .npy array (a 2-D one with a dimension of
- * 1 too) as doubles (malloc'ed). 0 on success, -1 with the error printed. */
-int cli_npy_read_vector(const char *path, double **values, int64_t *n);
+/* Readers of regular files (refusing FIFOs, devices, directories), over
+ * in-memory parsers that the fuzzers call. `name` labels messages. */
 
-/* Reads a 1-D integer .npy array (i1..i8, u1..u8, either byte order; a 2-D
- * one with a dimension of 1 too) as int32 ids (malloc'ed). 0 on success, 1
- * when the file holds another dtype (nothing printed: the caller may try
+/* A 1-D float64 or float32 .npy array (a 2-D one with a dimension of 1
+ * too) as doubles (malloc'ed). 0 on success, -1 with the error printed. */
+int cli_npy_read_vector(const char *path, double **values, int64_t *n);
+int cli_npy_parse_vector(const unsigned char *data, size_t size, const char *name,
+                         double **values, int64_t *n);
+
+/* A 1-D integer .npy array (i1..i8, u1..u8, either byte order) as int32
+ * ids (malloc'ed); other shapes are refused. 0 on success, 1 when the file
+ * holds a float dtype (nothing printed: the caller may try
  * cli_npy_read_vector), -1 with the error printed (a value outside int32:
  * "source I is out of range"). */
 int cli_npy_read_ints(const char *path, int32_t **ids, int64_t *n);
+int cli_npy_parse_ints(const unsigned char *data, size_t size, const char *name, int32_t **ids,
+                       int64_t *n);
 
-/* Reads whitespace-separated numbers from a text file ('#' comments). */
+/* Numbers separated by blanks, newlines or commas ('#' comments), read
+ * without the locale. data[size] must be '\0'. */
 int cli_txt_read_vector(const char *path, double **values, int64_t *n);
+int cli_txt_parse_vector(const char *data, size_t size, const char *name, double **values,
+                         int64_t *n);
 
 #endif /* MFMM_CLI_H */

@@ -1,7 +1,6 @@
 /* meshfmm allpairs MESH -o OUT.npy: the distance matrix, streamed in blocks
- * of rows into a .npy file (OUT.npy.partial, renamed when complete). */
+ * of rows into a .npy file (a temporary file beside it, renamed when complete). */
 #include <math.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,38 +9,34 @@
 
 #include "cli.h"
 
-#define EXIT_INTERRUPTED 130
-
-static volatile sig_atomic_t interrupted = 0;
-
-static void on_signal(int sig)
-{
-    (void)sig;
-    interrupted = 1;
-}
-
 static void help(FILE *out)
 {
     fprintf(out,
             "usage: meshfmm allpairs MESH -o OUT.npy [--dtype float32|float64]\n"
             "                        [--backend auto|opencl|serial|threads] [--sources FILE]\n"
-            "                        [--max-distance X] [--threads N] [--memory MB] [--quiet]\n\n"
+            "                        [--cost FILE [--cost-per-face]] [--max-distance X]\n"
+            "                        [--threads N] [--memory MB] [--quiet]\n\n"
             "The geodesic distance matrix: one row per source (default every vertex), one\n"
             "column per vertex, streamed into a .npy file block by block (the matrix is\n"
             "never held in memory). The file appears under its name only when complete.\n\n"
-            "  -o OUT.npy          output; written as OUT.npy.partial, then renamed\n"
+            "  -o, --output OUT.npy  output; written to a temporary file beside it, then\n"
+            "                      renamed (it may not be one of the inputs)\n"
             "  --dtype T           float32 (default) or float64; arithmetic is float64\n"
             "  --backend B         auto (default: OpenCL if a device works, else threads),\n"
             "                      opencl, serial (one thread) or threads\n"
             "  --sources FILE      source vertex ids: .txt (whitespace separated) or .npy\n"
             "                      (1-D integer array)\n"
+            "  --cost FILE         slowness F (.npy float64/float32 or .txt), one value per\n"
+            "                      vertex (default) or per face (--cost-per-face), as in\n"
+            "                      meshfmm distance\n"
             "  --max-distance X    stop each row past X; farther vertices get inf\n"
-            "  --threads N         threads for the threads backend (default: all cores)\n"
+            "  --threads N         threads for the threads backend (0, the default: all cores)\n"
             "  --memory MB         memory for workspaces and blocks in flight\n"
             "  --quiet             no progress lines\n\n"
             "Environment: MESHFMM_OPENCL_DEVICE (device index or name substring),\n"
             "MESHFMM_CACHE_DIR (OpenCL program cache, default ~/.cache/meshfmm).\n"
-            "SIGINT/SIGTERM stop the run, remove the partial file and exit with 130.\n");
+            "SIGINT/SIGTERM stop the run, remove the temporary file and exit with 130.\n"
+            "Options take their value as --dtype float64 or --dtype=float64.\n");
 }
 
 static double now(void)
@@ -93,7 +88,6 @@ static int read_sources(const char *path, int32_t **ids, int64_t *n)
 
 typedef struct run_state {
     cli_npy_writer w;
-    int32_t base;    /* rows already written by an earlier call (fallback) */
     int32_t total;
     int32_t done;
     int write_failed;
@@ -120,16 +114,15 @@ static void progress(run_state *s, int final)
 static int on_rows(void *user, int32_t first, int32_t n, const void *rows)
 {
     run_state *s = user;
-    (void)first;
-    if (interrupted)
+    if (cli_interrupted())
         return 1;
     if (cli_npy_append(&s->w, rows, n)) {
         s->write_failed = 1;
         return 1;
     }
-    s->done = s->base + first + n;
+    s->done = first + n;
     progress(s, 0);
-    return interrupted ? 1 : 0;
+    return cli_interrupted() ? 1 : 0;
 }
 
 static int parse_backend(const char *s, mfmm_backend *b)
@@ -144,62 +137,104 @@ static int parse_backend(const char *s, mfmm_backend *b)
     return 0;
 }
 
+/* --cost FILE: one value per vertex or per face, as `distance --cost`. */
+static int load_cost(const char *path, int per_face, const mfmm_mesh *mesh, double **cost)
+{
+    int64_t nc;
+    int r = cli_has_ext(path, "npy") ? cli_npy_read_vector(path, cost, &nc)
+                                     : cli_txt_read_vector(path, cost, &nc);
+    if (r)
+        return -1;
+    int32_t nv = mfmm_mesh_vertex_count(mesh), nf = mfmm_mesh_face_count(mesh);
+    int64_t want = per_face ? nf : nv;
+    if (nc != want) {
+        cli_error("%s: %lld cost values, the mesh has %lld %s%s", path, (long long)nc,
+                  (long long)want, per_face ? "faces" : "vertices",
+                  !per_face && nc == nf ? " (use --cost-per-face for face costs)" : "");
+        return -1;
+    }
+    return 0;
+}
+
 int cmd_allpairs(int argc, char **argv)
 {
-    const char *path = NULL, *out_path = NULL, *sources_path = NULL;
+    const char *path = NULL, *out_path = NULL, *sources_path = NULL, *cost_path = NULL;
+    int cost_per_face = 0;
     mfmm_matrix_options o;
     mfmm_matrix_options_init(&o);
     mfmm_backend backend = MFMM_BACKEND_AUTO;
     int quiet = 0;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *val = i + 1 < argc ? argv[i + 1] : NULL;
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+    static const struct option longopts[] = {
+        {"help", no_argument, NULL, 'h'},
+        {"output", required_argument, NULL, 'o'},
+        {"quiet", no_argument, NULL, 'q'},
+        {"dtype", required_argument, NULL, OPT_DTYPE},
+        {"backend", required_argument, NULL, OPT_BACKEND},
+        {"sources", required_argument, NULL, OPT_SOURCES},
+        {"cost", required_argument, NULL, OPT_COST},
+        {"cost-per-face", no_argument, NULL, OPT_COST_PER_FACE},
+        {"max-distance", required_argument, NULL, OPT_MAX_DISTANCE},
+        {"threads", required_argument, NULL, OPT_THREADS},
+        {"memory", required_argument, NULL, OPT_MEMORY},
+        {NULL, 0, NULL, 0}};
+    int c;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":ho:q", longopts, NULL)) != -1) {
+        const char *val = optarg;
+        switch (c) {
+        case 'h':
             help(stdout);
             return CLI_OK;
-        } else if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
-            if (!val)
-                return cli_usage_error("allpairs", "-o needs a file name");
-            out_path = argv[++i];
-        } else if (strcmp(a, "--dtype") == 0) {
-            if (val && strcmp(val, "float32") == 0)
+        case 'o':
+            out_path = val;
+            break;
+        case 'q':
+            quiet = 1;
+            break;
+        case OPT_DTYPE:
+            if (strcmp(val, "float32") == 0)
                 o.dtype = MFMM_FLOAT32;
-            else if (val && strcmp(val, "float64") == 0)
+            else if (strcmp(val, "float64") == 0)
                 o.dtype = MFMM_FLOAT64;
             else
                 return cli_usage_error("allpairs", "--dtype is float32 or float64");
-            i++;
-        } else if (strcmp(a, "--backend") == 0) {
-            if (!val || !parse_backend(val, &backend))
+            break;
+        case OPT_BACKEND:
+            if (!parse_backend(val, &backend))
                 return cli_usage_error("allpairs", "--backend is auto, opencl, serial or threads");
-            i++;
-        } else if (strcmp(a, "--sources") == 0) {
-            if (!val)
-                return cli_usage_error("allpairs", "--sources needs a file");
-            sources_path = argv[++i];
-        } else if (strcmp(a, "--max-distance") == 0) {
-            if (!val || !cli_parse_double(val, &o.max_distance) || !(o.max_distance >= 0))
+            break;
+        case OPT_SOURCES:
+            sources_path = val;
+            break;
+        case OPT_COST:
+            cost_path = val;
+            break;
+        case OPT_COST_PER_FACE:
+            cost_per_face = 1;
+            break;
+        case OPT_MAX_DISTANCE:
+            if (!cli_parse_double(val, &o.max_distance) || !(o.max_distance >= 0))
                 return cli_usage_error("allpairs", "--max-distance needs a number >= 0");
-            i++;
-        } else if (strcmp(a, "--threads") == 0) {
-            if (!val || !cli_parse_int32(val, &o.n_threads) || o.n_threads < 1)
-                return cli_usage_error("allpairs", "--threads needs a count >= 1");
-            i++;
-        } else if (strcmp(a, "--memory") == 0) {
+            break;
+        case OPT_THREADS:
+            if (!cli_parse_int32(val, &o.n_threads) || o.n_threads < 0)
+                return cli_usage_error("allpairs", "--threads needs a count >= 0 (0: all cores)");
+            break;
+        case OPT_MEMORY: {
             double mb;
-            if (!val || !cli_parse_double(val, &mb) || !(mb > 0) || mb > 1e9)
+            if (!cli_parse_double(val, &mb) || !(mb > 0) || mb > 1e9)
                 return cli_usage_error("allpairs", "--memory needs megabytes > 0");
             o.memory_limit = (size_t)(mb * 1048576.0);
-            i++;
-        } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
-            quiet = 1;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage_error("allpairs", "unknown option '%s'", a);
-        } else if (!path) {
-            path = a;
-        } else {
-            return cli_usage_error("allpairs", "one mesh at a time ('%s' is extra)", a);
+            break;
         }
+        default:
+            return cli_getopt_error("allpairs", c, argv);
+        }
+    }
+    for (int i = optind; i < argc; i++) {
+        if (path)
+            return cli_usage_error("allpairs", "one mesh at a time ('%s' is extra)", argv[i]);
+        path = argv[i];
     }
     if (!path)
         return cli_usage_error("allpairs", "no mesh file given");
@@ -207,16 +242,29 @@ int cmd_allpairs(int argc, char **argv)
         return cli_usage_error("allpairs", "no output given (-o OUT.npy)");
     if (!cli_has_ext(out_path, "npy"))
         return cli_usage_error("allpairs", "the output must end in .npy");
+    if (cost_per_face && !cost_path)
+        return cli_usage_error("allpairs", "--cost-per-face needs --cost");
+    const char *inputs[3] = {path, sources_path, cost_path};
+    if (cli_check_output_not_input("allpairs", out_path, inputs, 3) != CLI_OK)
+        return CLI_USAGE;
 
     int rc = CLI_FAIL;
     int32_t *src = NULL;
+    double *cost = NULL;
     int64_t n_src = 0;
     run_state s;
     memset(&s, 0, sizeof s);
+    cli_signals_install();
     mfmm_mesh *mesh = cli_load_mesh(path, NULL);
     if (!mesh)
         return CLI_FAIL;
     int32_t nv = mfmm_mesh_vertex_count(mesh);
+    if (cost_path) {
+        if (load_cost(cost_path, cost_per_face, mesh, &cost))
+            goto done;
+        o.cost = cost;
+        o.cost_location = cost_per_face ? MFMM_COST_PER_FACE : MFMM_COST_PER_VERTEX;
+    }
     if (sources_path) {
         if (read_sources(sources_path, &src, &n_src))
             goto done;
@@ -241,15 +289,9 @@ int cmd_allpairs(int argc, char **argv)
             src[i] = i;
     }
 
-    struct sigaction sa, old_int, old_term;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old_int);
-    sigaction(SIGTERM, &sa, &old_term);
-
-    if (cli_npy_open(&s.w, out_path, o.dtype == MFMM_FLOAT64 ? "<f8" : "<f4", n_src, nv))
-        goto restore;
+    if (cli_interrupted() ||
+        cli_npy_open(&s.w, out_path, o.dtype == MFMM_FLOAT64 ? "<f8" : "<f4", n_src, nv))
+        goto done;
     s.total = (int32_t)n_src;
     s.quiet = quiet;
     s.tty = isatty(2);
@@ -265,34 +307,37 @@ int cmd_allpairs(int argc, char **argv)
     if (o.fallback_reason[0])
         fprintf(stderr, "meshfmm allpairs: OpenCL not used (%s); falling back to threads\n",
                 o.fallback_reason);
-    if (interrupted) {
+    if (cli_interrupted()) {
         cli_npy_abort(&s.w);
         if (!quiet && s.tty)
             fputc('\n', stderr);
         fprintf(stderr, "meshfmm allpairs: interrupted after %d of %d rows; removed the "
-                        "partial file\n", (int)s.done, (int)s.total);
-        rc = EXIT_INTERRUPTED;
-        goto restore;
+                        "temporary file\n", (int)s.done, (int)s.total);
+        rc = CLI_EXIT_INTERRUPTED;
+        goto done;
     }
     if (st != MFMM_OK) {
         if (!s.write_failed)
             cli_error("%s", err.message);
         cli_npy_abort(&s.w);
-        goto restore;
+        goto done;
     }
     if (s.tty)
         progress(&s, 1); /* completes the \r line; the summary says the rest */
-    if (cli_npy_close(&s.w))
-        goto restore;
+    if (cli_npy_close(&s.w)) {
+        if (cli_interrupted())
+            rc = CLI_EXIT_INTERRUPTED;
+        goto done;
+    }
     fprintf(stderr, "meshfmm allpairs: %lld x %d %s matrix, backend %s, %.2f s, wrote %s\n",
             (long long)n_src, (int)nv, o.dtype == MFMM_FLOAT64 ? "float64" : "float32",
             mfmm_backend_name(used), now() - s.t0, out_path);
     rc = CLI_OK;
-restore:
-    sigaction(SIGINT, &old_int, NULL);
-    sigaction(SIGTERM, &old_term, NULL);
 done:
+    if (rc == CLI_FAIL && cli_interrupted())
+        rc = CLI_EXIT_INTERRUPTED;
     free(src);
+    free(cost);
     mfmm_mesh_destroy(mesh);
     return rc;
 }

@@ -20,28 +20,32 @@ static void help(FILE *out)
             "  --no-unfolding          plain stencils at obtuse corners (for comparison)\n"
             "  --cost FILE             slowness F (.npy float64/float32 or .txt), one value\n"
             "                          per vertex (default) or per face (--cost-per-face)\n"
-            "  -o OUT                  .npy (float64, shape (nv,)) or .txt (one value per\n"
-            "                          line, %%.17g, inf for unreached vertices)\n");
+            "  -o, --output OUT        .npy (float64, shape (nv,)) or .txt (one value per\n"
+            "                          line, %%.17g, inf for unreached vertices); - writes\n"
+            "                          the text to standard output\n\n"
+            "Options take their value as --source 3 or --source=3. The output is written\n"
+            "to a temporary file beside OUT and renamed when complete; it may not be one\n"
+            "of the inputs.\n");
 }
 
 static int write_txt(const char *path, const double *d, int32_t n)
 {
-    char *tmp;
-    FILE *f = cli_partial_open(path, &tmp);
-    if (!f)
+    cli_output out;
+    if (cli_output_open(&out, path))
         return -1;
     int bad = 0;
-    for (int32_t i = 0; i < n && !bad; i++) {
-        if (isinf(d[i]))
-            bad = fputs(d[i] > 0 ? "inf\n" : "-inf\n", f) < 0;
-        else
-            bad = fprintf(f, "%.17g\n", d[i]) < 0;
-    }
-    return cli_partial_close(f, tmp, path, bad);
+    for (int32_t i = 0; i < n && !bad && !cli_interrupted(); i++)
+        bad = cli_put_double(out.f, d[i]) < 0 || fputc('\n', out.f) == EOF;
+    return cli_output_close(&out, bad);
 }
 
 int cmd_distance(int argc, char **argv)
 {
+    static const struct option longopts[] = {
+        CLI_SHARED_LONG_OPTIONS,
+        {"max-distance", required_argument, NULL, OPT_MAX_DISTANCE},
+        {"no-unfolding", no_argument, NULL, OPT_NO_UNFOLDING},
+        {NULL, 0, NULL, 0}};
     int rc = CLI_FAIL;
     mfmm_solve_options opt;
     mfmm_solve_options_init(&opt);
@@ -50,34 +54,34 @@ int cmd_distance(int argc, char **argv)
     mfmm_mesh *mesh = NULL;
     if (cli_sources_and_cost_init(&o, "distance", help, argc))
         return CLI_FAIL;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (strcmp(a, "--max-distance") == 0) {
-            if (i + 1 >= argc || !cli_parse_double(argv[i + 1], &opt.max_distance) ||
-                !(opt.max_distance >= 0)) {
+    int c;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, CLI_SHARED_SHORT_OPTIONS, longopts, NULL)) != -1) {
+        if (c == OPT_MAX_DISTANCE) {
+            if (!cli_parse_double(optarg, &opt.max_distance) || !(opt.max_distance >= 0)) {
                 rc = cli_usage_error("distance", "--max-distance needs a number >= 0");
                 goto done;
             }
-            i++;
-        } else if (strcmp(a, "--no-unfolding") == 0) {
+        } else if (c == OPT_NO_UNFOLDING) {
             opt.unfolding = 0;
-        } else if ((rc = cli_sources_and_cost_arg(&o, argc, argv, &i)) != CLI_OK ||
-                   o.help_shown) {
+        } else if ((rc = cli_sources_and_cost_opt(&o, c, argc, argv)) != CLI_OK || o.help_shown) {
             goto done;
         }
     }
     int is_txt;
-    if ((rc = cli_sources_and_cost_check_inputs(&o)) != CLI_OK ||
-        (rc = cli_sources_and_cost_check_output(&o, "npy", "txt", &is_txt)) != CLI_OK)
+    if ((rc = cli_sources_and_cost_positional(&o, argc, argv)) != CLI_OK ||
+        (rc = cli_sources_and_cost_check_inputs(&o)) != CLI_OK ||
+        (rc = cli_sources_and_cost_check_output(&o, "npy", "txt", 1, &is_txt)) != CLI_OK)
         goto done;
     rc = CLI_FAIL;
+    cli_signals_install();
 
     mesh = cli_load_mesh(o.mesh_path, NULL);
     if (!mesh || cli_sources_and_cost_load(&o, mesh, 1, &opt))
         goto done;
     int32_t nv = mfmm_mesh_vertex_count(mesh);
     dist = cli_solve_distances(mesh, &o, &opt);
-    if (!dist)
+    if (!dist || cli_interrupted())
         goto done;
     if (!is_txt) {
         cli_npy_writer w;
@@ -94,6 +98,10 @@ int cmd_distance(int argc, char **argv)
     }
     rc = CLI_OK;
 done:
+    if (rc != CLI_OK && cli_interrupted()) {
+        fprintf(stderr, "meshfmm distance: interrupted; no output written\n");
+        rc = CLI_EXIT_INTERRUPTED;
+    }
     mfmm_mesh_destroy(mesh);
     free(dist);
     cli_sources_and_cost_free(&o);

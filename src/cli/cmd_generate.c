@@ -10,6 +10,7 @@ static void help(FILE *out)
 {
     fprintf(out,
             "usage: meshfmm generate SHAPE N -o OUT.obj [--stretch S] [--radii R r]\n\n"
+            "OUT may be - (standard output).\n"
             "Writes a generated mesh as OBJ (coordinates with 17 significant digits).\n\n"
             "  grid N      unit square, N x N squares split along alternating diagonals\n"
             "  sine N      z = 0.45 sin(2 pi x) sin(2 pi y) on [0,1]^2, N x N squares\n"
@@ -23,59 +24,66 @@ static void help(FILE *out)
 
 static int write_obj(const char *path, const mfmm_gen_mesh *m, const char *comment)
 {
-    char *tmp;
-    FILE *f = cli_partial_open(path, &tmp);
-    if (!f)
+    cli_output out;
+    if (cli_output_open(&out, path))
         return -1;
+    FILE *f = out.f;
     int bad = fprintf(f, "# %s\n", comment) < 0;
-    for (int32_t i = 0; i < m->nv && !bad; i++)
-        bad = fprintf(f, "v %.17g %.17g %.17g\n", m->V[3 * i], m->V[3 * i + 1],
-                      m->V[3 * i + 2]) < 0;
-    for (int32_t i = 0; i < m->nf && !bad; i++)
+    for (int32_t i = 0; i < m->nv && !bad && !cli_interrupted(); i++)
+        for (int k = 0; k < 3 && !bad; k++)
+            bad = fputs(k ? " " : "v ", f) < 0 || cli_put_double(f, m->V[3 * i + k]) < 0 ||
+                  (k == 2 && fputc('\n', f) == EOF);
+    for (int32_t i = 0; i < m->nf && !bad && !cli_interrupted(); i++)
         bad = fprintf(f, "f %ld %ld %ld\n", (long)m->F[3 * i] + 1, (long)m->F[3 * i + 1] + 1,
                       (long)m->F[3 * i + 2] + 1) < 0;
-    return cli_partial_close(f, tmp, path, bad);
+    return cli_output_close(&out, bad);
 }
 
 int cmd_generate(int argc, char **argv)
 {
     const char *shape = NULL, *n_arg = NULL, *out_path = NULL;
     double stretch = 3.0, R = 1.0, r = 0.4;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+    static const struct option longopts[] = {
+        {"help", no_argument, NULL, 'h'},
+        {"output", required_argument, NULL, 'o'},
+        {"stretch", required_argument, NULL, OPT_STRETCH},
+        {"radii", required_argument, NULL, OPT_RADII},
+        {NULL, 0, NULL, 0}};
+    int c;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":ho:", longopts, NULL)) != -1) {
+        if (c == 'h') {
             help(stdout);
             return CLI_OK;
-        } else if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
-            if (i + 1 >= argc)
-                return cli_usage_error("generate", "-o needs a file name");
-            out_path = argv[++i];
-        } else if (strcmp(a, "--stretch") == 0) {
-            if (i + 1 >= argc || !cli_parse_double(argv[i + 1], &stretch) || !(stretch > 0) ||
-                stretch > 1e6)
+        } else if (c == 'o') {
+            out_path = optarg;
+        } else if (c == OPT_STRETCH) {
+            if (!cli_parse_double(optarg, &stretch) || !(stretch > 0) || stretch > 1e6)
                 return cli_usage_error("generate", "--stretch needs a number > 0");
-            i++;
-        } else if (strcmp(a, "--radii") == 0) {
-            if (i + 2 >= argc || !cli_parse_double(argv[i + 1], &R) ||
-                !cli_parse_double(argv[i + 2], &r) || !(r > 0) || !(R > r) || R > 1e100)
+        } else if (c == OPT_RADII) {
+            /* two values: R in optarg, r next */
+            if (optind >= argc || !cli_parse_double(optarg, &R) ||
+                !cli_parse_double(argv[optind], &r) || !(r > 0) || !(R > r) || R > 1e100)
                 return cli_usage_error("generate", "--radii needs R > r > 0");
-            i += 2;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage_error("generate", "unknown option '%s'", a);
-        } else if (!shape) {
-            shape = a;
-        } else if (!n_arg) {
-            n_arg = a;
+            optind++;
         } else {
-            return cli_usage_error("generate", "unexpected argument '%s'", a);
+            return cli_getopt_error("generate", c, argv);
         }
+    }
+    for (int i = optind; i < argc; i++) {
+        if (!shape)
+            shape = argv[i];
+        else if (!n_arg)
+            n_arg = argv[i];
+        else
+            return cli_usage_error("generate", "unexpected argument '%s'", argv[i]);
     }
     if (!shape || !n_arg)
         return cli_usage_error("generate", "needs a shape and a size N");
     if (!out_path)
         return cli_usage_error("generate", "no output given (-o OUT.obj)");
-    if (!cli_has_ext(out_path, "obj"))
-        return cli_usage_error("generate", "the output must end in .obj");
+    if (strcmp(out_path, "-") != 0 && !cli_has_ext(out_path, "obj"))
+        return cli_usage_error("generate", "the output must end in .obj (or be - for standard output)");
     int32_t n;
     if (!cli_parse_int32(n_arg, &n))
         return cli_usage_error("generate", "N must be an integer, not '%s'", n_arg);
@@ -107,7 +115,10 @@ int cmd_generate(int argc, char **argv)
     char comment[128];
     snprintf(comment, sizeof comment, "meshfmm generate %s %d: %d vertices, %d faces", shape,
              (int)n, (int)m.nv, (int)m.nf);
+    cli_signals_install();
     int rc = write_obj(out_path, &m, comment) ? CLI_FAIL : CLI_OK;
+    if (rc != CLI_OK && cli_interrupted())
+        rc = CLI_EXIT_INTERRUPTED;
     mfmm_gen_free(&m);
     return rc;
 }

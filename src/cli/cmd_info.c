@@ -8,7 +8,7 @@ static void help(FILE *out)
 {
     fprintf(out,
             "usage: meshfmm info MESH [--json] [--max-unfold-steps N]\n\n"
-            "Reads MESH (.obj, .off, .ply) and prints its counts: vertices, faces, edges,\n"
+            "Reads MESH (.obj, .off, .ply, .stl) and prints its counts: vertices, faces, edges,\n"
             "boundary and non-manifold edges, components, unreferenced vertices,\n"
             "degenerate faces, obtuse corners, virtual edges found by unfolding and\n"
             "unfolding failures, edge lengths and the bounding-box diagonal.\n\n"
@@ -38,25 +38,30 @@ int cmd_info(int argc, char **argv)
     int json = 0;
     mfmm_mesh_options opt;
     mfmm_mesh_options_init(&opt);
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+    static const struct option longopts[] = {
+        {"help", no_argument, NULL, 'h'},
+        {"json", no_argument, NULL, OPT_JSON},
+        {"max-unfold-steps", required_argument, NULL, OPT_MAX_UNFOLD_STEPS},
+        {NULL, 0, NULL, 0}};
+    int c;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":h", longopts, NULL)) != -1) {
+        if (c == 'h') {
             help(stdout);
             return CLI_OK;
-        } else if (strcmp(a, "--json") == 0) {
+        } else if (c == OPT_JSON) {
             json = 1;
-        } else if (strcmp(a, "--max-unfold-steps") == 0) {
-            if (i + 1 >= argc || !cli_parse_int32(argv[i + 1], &opt.max_unfold_steps) ||
-                opt.max_unfold_steps < 1)
+        } else if (c == OPT_MAX_UNFOLD_STEPS) {
+            if (!cli_parse_int32(optarg, &opt.max_unfold_steps) || opt.max_unfold_steps < 1)
                 return cli_usage_error("info", "--max-unfold-steps needs an integer >= 1");
-            i++;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage_error("info", "unknown option '%s'", a);
-        } else if (!path) {
-            path = a;
         } else {
-            return cli_usage_error("info", "one mesh at a time ('%s' is extra)", a);
+            return cli_getopt_error("info", c, argv);
         }
+    }
+    for (int i = optind; i < argc; i++) {
+        if (path)
+            return cli_usage_error("info", "one mesh at a time ('%s' is extra)", argv[i]);
+        path = argv[i];
     }
     if (!path)
         return cli_usage_error("info", "no mesh file given");

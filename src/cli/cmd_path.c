@@ -26,21 +26,27 @@ static void help(FILE *out)
             "  --max-points N          most points the path may have (default 100000)\n"
             "  --no-straighten         keep the traced path of section 5 (by default it is\n"
             "                          straightened inside the strip of faces it crossed)\n"
-            "  -o OUT                  .csv (face,b0,b1,b2,x,y,z per point, with a header) or\n"
-            "                          .obj (v lines and one polyline 'l' element)\n");
+            "  -o, --output OUT        .csv (face,b0,b1,b2,x,y,z per point, with a header) or\n"
+            "                          .obj (v lines and one polyline 'l' element); - writes\n"
+            "                          the .csv to standard output (the length then goes to\n"
+            "                          standard error)\n\n"
+            "Options take their value as --target 3 or --target=3. The output is written to\n"
+            "a temporary file beside OUT and renamed when complete; it may not be an input.\n");
 }
 
 static int write_path(const char *path, const mfmm_surface_point *p, int32_t n, int obj)
 {
-    char *tmp;
-    FILE *f = cli_partial_open(path, &tmp);
-    if (!f)
+    cli_output out;
+    if (cli_output_open(&out, path))
         return -1;
+    FILE *f = out.f;
     int bad = 0;
     if (obj) {
         bad = fprintf(f, "# meshfmm path: %d points, target first\n", (int)n) < 0;
-        for (int32_t i = 0; i < n && !bad; i++)
-            bad = fprintf(f, "v %.17g %.17g %.17g\n", p[i].xyz[0], p[i].xyz[1], p[i].xyz[2]) < 0;
+        for (int32_t i = 0; i < n && !bad && !cli_interrupted(); i++)
+            for (int k = 0; k < 3 && !bad; k++)
+                bad = fputs(k ? " " : "v ", f) < 0 || cli_put_double(f, p[i].xyz[k]) < 0 ||
+                      (k == 2 && fputc('\n', f) == EOF);
         if (n >= 2 && !bad) {
             bad = fputs("l", f) < 0;
             for (int32_t i = 0; i < n && !bad; i++)
@@ -49,16 +55,27 @@ static int write_path(const char *path, const mfmm_surface_point *p, int32_t n, 
         }
     } else {
         bad = fputs("face,b0,b1,b2,x,y,z\n", f) < 0;
-        for (int32_t i = 0; i < n && !bad; i++)
-            bad = fprintf(f, "%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", (int)p[i].face,
-                          p[i].bary[0], p[i].bary[1], p[i].bary[2], p[i].xyz[0], p[i].xyz[1],
-                          p[i].xyz[2]) < 0;
+        for (int32_t i = 0; i < n && !bad && !cli_interrupted(); i++) {
+            const double v[6] = {p[i].bary[0], p[i].bary[1], p[i].bary[2],
+                                 p[i].xyz[0],  p[i].xyz[1],  p[i].xyz[2]};
+            bad = fprintf(f, "%d", (int)p[i].face) < 0;
+            for (int k = 0; k < 6 && !bad; k++)
+                bad = fputc(',', f) == EOF || cli_put_double(f, v[k]) < 0;
+            bad = bad || fputc('\n', f) == EOF;
+        }
     }
-    return cli_partial_close(f, tmp, path, bad);
+    return cli_output_close(&out, bad);
 }
 
 int cmd_path(int argc, char **argv)
 {
+    static const struct option longopts[] = {
+        CLI_SHARED_LONG_OPTIONS,
+        {"target", required_argument, NULL, OPT_TARGET},
+        {"target-face", required_argument, NULL, OPT_TARGET_FACE},
+        {"no-straighten", no_argument, NULL, OPT_NO_STRAIGHTEN},
+        {"max-points", required_argument, NULL, OPT_MAX_POINTS},
+        {NULL, 0, NULL, 0}};
     int have_target = 0, rc = CLI_FAIL;
     int32_t max_points = 100000;
     int straighten = 1;
@@ -69,46 +86,48 @@ int cmd_path(int argc, char **argv)
     mfmm_mesh *mesh = NULL;
     if (cli_sources_and_cost_init(&o, "path", help, argc))
         return CLI_FAIL;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (strcmp(a, "--target") == 0) {
-            if (!cli_parse_vertex_point(argc, argv, i, &target)) {
-                rc = cli_usage_error("path", "%s needs a vertex id", a);
+    int c;
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, CLI_SHARED_SHORT_OPTIONS, longopts, NULL)) != -1) {
+        if (c == OPT_TARGET) {
+            int32_t v;
+            if (!cli_parse_int32(optarg, &v)) {
+                rc = cli_usage_error("path", "--target needs a vertex id, not '%s'", optarg);
+                goto done;
+            }
+            mfmm_source x = {v, -1, {0, 0, 0}, 0.0};
+            target = x;
+            have_target = 1;
+        } else if (c == OPT_TARGET_FACE) {
+            if (!cli_take_face_point(optarg, argc, argv, &target)) {
+                rc = cli_usage_error("path",
+                                     "--target-face needs a face id and three barycentric weights");
                 goto done;
             }
             have_target = 1;
-            i++;
-        } else if (strcmp(a, "--target-face") == 0) {
-            if (!cli_parse_face_point(argc, argv, i, &target)) {
-                rc = cli_usage_error("path", "%s needs a face id and three barycentric weights",
-                                     a);
-                goto done;
-            }
-            have_target = 1;
-            i += 4;
-        } else if (strcmp(a, "--no-straighten") == 0) {
+        } else if (c == OPT_NO_STRAIGHTEN) {
             straighten = 0;
-        } else if (strcmp(a, "--max-points") == 0) {
-            if (i + 1 >= argc || !cli_parse_int32(argv[i + 1], &max_points) || max_points < 1) {
+        } else if (c == OPT_MAX_POINTS) {
+            if (!cli_parse_int32(optarg, &max_points) || max_points < 1) {
                 rc = cli_usage_error("path", "--max-points needs a number >= 1");
                 goto done;
             }
-            i++;
-        } else if ((rc = cli_sources_and_cost_arg(&o, argc, argv, &i)) != CLI_OK ||
-                   o.help_shown) {
+        } else if ((rc = cli_sources_and_cost_opt(&o, c, argc, argv)) != CLI_OK || o.help_shown) {
             goto done;
         }
     }
-    if ((rc = cli_sources_and_cost_check_inputs(&o)) != CLI_OK)
+    if ((rc = cli_sources_and_cost_positional(&o, argc, argv)) != CLI_OK ||
+        (rc = cli_sources_and_cost_check_inputs(&o)) != CLI_OK)
         goto done;
     if (!have_target) {
         rc = cli_usage_error("path", "no target given (--target or --target-face)");
         goto done;
     }
     int obj;
-    if ((rc = cli_sources_and_cost_check_output(&o, "csv", "obj", &obj)) != CLI_OK)
+    if ((rc = cli_sources_and_cost_check_output(&o, "csv", "obj", 0, &obj)) != CLI_OK)
         goto done;
     rc = CLI_FAIL;
+    cli_signals_install();
 
     mesh = cli_load_mesh(o.mesh_path, NULL);
     mfmm_solve_options opt;
@@ -139,14 +158,22 @@ int cmd_path(int argc, char **argv)
         cli_error("%s", err.message);
         goto done;
     }
-    if (write_path(o.out_path, pts, n, obj))
+    if (cli_interrupted() || write_path(o.out_path, pts, n, obj))
         goto done;
-    if (o.cost)
-        printf("%.17g %.17g\n", len, wlen);
-    else
-        printf("%.17g\n", len);
+    /* The length goes to stdout, or to stderr when stdout holds the path. */
+    FILE *lf = strcmp(o.out_path, "-") == 0 ? stderr : stdout;
+    cli_put_double(lf, len);
+    if (o.cost) {
+        fputc(' ', lf);
+        cli_put_double(lf, wlen);
+    }
+    fputc('\n', lf);
     rc = CLI_OK;
 done:
+    if (rc != CLI_OK && cli_interrupted()) {
+        fprintf(stderr, "meshfmm path: interrupted; no output written\n");
+        rc = CLI_EXIT_INTERRUPTED;
+    }
     mfmm_mesh_destroy(mesh);
     free(pts);
     free(dist);

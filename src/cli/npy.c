@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "io/io.h"
 
 static int host_is_little(void)
 {
@@ -26,17 +27,6 @@ static void swap_bytes(unsigned char *p, size_t n, size_t itemsize)
         }
 }
 
-static char *str_concat(const char *a, const char *b)
-{
-    size_t na = strlen(a), nb = strlen(b);
-    char *s = malloc(na + nb + 1);
-    if (s) {
-        memcpy(s, a, na);
-        memcpy(s + na, b, nb + 1);
-    }
-    return s;
-}
-
 int cli_npy_open(cli_npy_writer *w, const char *path, const char *dtype, int64_t rows,
                  int64_t cols)
 {
@@ -53,15 +43,12 @@ int cli_npy_open(cli_npy_writer *w, const char *path, const char *dtype, int64_t
         cli_error("npy: negative row count");
         return -1;
     }
-    w->rows = rows;
-    w->cols = cols < 0 ? 1 : cols;
-    w->path = str_concat(path, "");
-    w->tmp_path = str_concat(path, ".partial");
-    if (!w->path || !w->tmp_path) {
-        cli_error("out of memory");
-        cli_npy_abort(w);
+    if (strcmp(path, "-") == 0) {
+        cli_error("a .npy file cannot go to standard output ('-' is for text outputs)");
         return -1;
     }
+    w->rows = rows;
+    w->cols = cols < 0 ? 1 : cols;
     char dict[160];
     if (cols < 0)
         snprintf(dict, sizeof dict, "{'descr': '%s', 'fortran_order': False, 'shape': (%" PRId64 ",), }",
@@ -81,16 +68,10 @@ int cli_npy_open(cli_npy_writer *w, const char *path, const char *dtype, int64_t
     memset(header + 10, ' ', hlen);
     memcpy(header + 10, dict, strlen(dict));
     header[total - 1] = '\n';
-    w->f = fopen(w->tmp_path, "wb");
-    if (!w->f) {
-        cli_error("cannot create '%s': %s", w->tmp_path, strerror(errno));
-        free(w->path);
-        free(w->tmp_path);
-        w->path = w->tmp_path = NULL;
+    if (cli_output_open(&w->out, path))
         return -1;
-    }
-    if (fwrite(header, 1, total, w->f) != total) {
-        cli_error("cannot write '%s': %s", w->tmp_path, strerror(errno));
+    if (fwrite(header, 1, total, w->out.f) != total) {
+        cli_error("cannot write '%s': %s", w->out.tmp_path, strerror(errno));
         cli_npy_abort(w);
         return -1;
     }
@@ -99,15 +80,16 @@ int cli_npy_open(cli_npy_writer *w, const char *path, const char *dtype, int64_t
 
 int cli_npy_append(cli_npy_writer *w, const void *data, int64_t n_rows)
 {
-    if (!w->f)
+    if (!w->out.f)
         return -1;
     if (n_rows < 0 || n_rows > w->rows - w->rows_written) {
         cli_error("npy: more rows than the header promised (%" PRId64 ")", w->rows);
         return -1;
     }
     size_t n = (size_t)n_rows * (size_t)w->cols;
+    FILE *f = w->out.f;
     if (host_is_little()) {
-        if (n && fwrite(data, w->itemsize, n, w->f) != n)
+        if (n && fwrite(data, w->itemsize, n, f) != n)
             goto fail;
     } else {
         unsigned char buf[8192];
@@ -117,59 +99,52 @@ int cli_npy_append(cli_npy_writer *w, const void *data, int64_t n_rows)
             size_t k = n - i < per ? n - i : per;
             memcpy(buf, src + i * w->itemsize, k * w->itemsize);
             swap_bytes(buf, k, w->itemsize);
-            if (fwrite(buf, w->itemsize, k, w->f) != k)
+            if (fwrite(buf, w->itemsize, k, f) != k)
                 goto fail;
         }
     }
     w->rows_written += n_rows;
     return 0;
 fail:
-    cli_error("cannot write '%s': %s", w->tmp_path, strerror(errno));
+    cli_error("cannot write '%s': %s", w->out.tmp_path, strerror(errno));
     return -1;
 }
 
 int cli_npy_close(cli_npy_writer *w)
 {
-    if (!w->f)
+    if (!w->out.f)
         return -1;
     if (w->rows_written != w->rows) {
         cli_error("npy: %" PRId64 " rows written, %" PRId64 " promised", w->rows_written, w->rows);
         cli_npy_abort(w);
         return -1;
     }
-    int bad = fflush(w->f) != 0 || ferror(w->f);
-    bad |= fclose(w->f) != 0;
-    w->f = NULL;
-    if (bad) {
-        cli_error("cannot write '%s': %s", w->tmp_path, strerror(errno));
-        cli_npy_abort(w);
-        return -1;
-    }
-    if (rename(w->tmp_path, w->path) != 0) {
-        cli_error("cannot rename '%s' to '%s': %s", w->tmp_path, w->path, strerror(errno));
-        cli_npy_abort(w);
-        return -1;
-    }
-    free(w->path);
-    free(w->tmp_path);
-    w->path = w->tmp_path = NULL;
-    return 0;
+    return cli_output_close(&w->out, 0);
 }
 
 void cli_npy_abort(cli_npy_writer *w)
 {
-    if (w->f) {
-        fclose(w->f);
-        w->f = NULL;
-    }
-    if (w->tmp_path)
-        remove(w->tmp_path);
-    free(w->path);
-    free(w->tmp_path);
-    w->path = w->tmp_path = NULL;
+    cli_output_abort(&w->out);
 }
 
-/* ---- readers ---- */
+/* ---- readers: in-memory parsers over whole regular files ---- */
+
+typedef struct npy_info {
+    char kind;        /* 'f', 'i' or 'u' */
+    int big;          /* big-endian data */
+    size_t itemsize;
+    int ndim;
+    int64_t dims[8];
+    int64_t count;    /* product of dims */
+    const unsigned char *data;
+} npy_info;
+
+static const char *skip_sp(const char *p)
+{
+    while (*p == ' ')
+        p++;
+    return p;
+}
 
 /* Value of `key` in a numpy header dict: points just past "'key':" and blanks. */
 static const char *dict_value(const char *dict, const char *key)
@@ -179,302 +154,336 @@ static const char *dict_value(const char *dict, const char *key)
     const char *p = strstr(dict, pat);
     if (!p)
         return NULL;
-    p += strlen(pat);
-    while (*p == ' ')
-        p++;
+    p = skip_sp(p + strlen(pat));
     if (*p != ':')
         return NULL;
-    p++;
-    while (*p == ' ')
-        p++;
-    return p;
+    return skip_sp(p + 1);
 }
 
-/* Reads the magic string, version and header dict (format 1.0 to 3.0) of
- * a .npy file; *dict is malloc'ed and NUL-terminated, and f is left at the
- * data. 0, -1 when it is not a readable .npy file, -2 when out of memory
- * (nothing printed). */
-static int read_header(FILE *f, char **dict)
+static void shape_text(const npy_info *h, char *buf, size_t n)
 {
-    unsigned char pre[12];
-    *dict = NULL;
-    if (fread(pre, 1, 10, f) != 10 || memcmp(pre, "\x93NUMPY", 6) != 0)
-        return -1;
-    size_t hlen;
-    if (pre[6] == 1) {
-        hlen = (size_t)pre[8] | (size_t)pre[9] << 8;
-    } else if (pre[6] == 2 || pre[6] == 3) {
-        if (fread(pre + 10, 1, 2, f) != 2)
-            return -1;
-        hlen = (size_t)pre[8] | (size_t)pre[9] << 8 | (size_t)pre[10] << 16 |
-               (size_t)pre[11] << 24;
-        if (hlen > 1 << 20)
-            return -1;
-    } else {
+    size_t k = (size_t)snprintf(buf, n, "(");
+    for (int i = 0; i < h->ndim && k < n; i++)
+        k += (size_t)snprintf(buf + k, n - k, i ? ", %" PRId64 : "%" PRId64, h->dims[i]);
+    if (k < n)
+        snprintf(buf + k, n - k, h->ndim == 1 ? ",)" : ")");
+}
+
+/* Parses and checks the header: magic, version 1-3, header length within
+ * the file, descr, fortran_order and shape, and that the data is exactly
+ * count * itemsize bytes: nothing is allocated from the header's word.
+ * 0, or -1 with the error printed. */
+static int npy_header(const unsigned char *d, size_t size, const char *name, npy_info *h)
+{
+    memset(h, 0, sizeof *h);
+    if (size < 10 || memcmp(d, "\x93NUMPY", 6) != 0) {
+        cli_error("%s: not a .npy file (no \\x93NUMPY magic)", name);
         return -1;
     }
-    *dict = malloc(hlen + 1);
-    if (!*dict)
-        return -2;
-    if (fread(*dict, 1, hlen, f) != hlen)
+    size_t hlen, off;
+    if (d[6] == 1) {
+        hlen = (size_t)d[8] | (size_t)d[9] << 8;
+        off = 10;
+    } else if ((d[6] == 2 || d[6] == 3) && size >= 12) {
+        hlen = (size_t)d[8] | (size_t)d[9] << 8 | (size_t)d[10] << 16 | (size_t)d[11] << 24;
+        off = 12;
+    } else {
+        cli_error("%s: unsupported .npy version %d", name, (int)d[6]);
         return -1;
-    (*dict)[hlen] = '\0';
+    }
+    if (hlen > size - off) {
+        cli_error("%s: truncated .npy header (%zu bytes promised, %zu in the file)", name, hlen,
+                  size - off);
+        return -1;
+    }
+    if (hlen > (1u << 20)) {
+        cli_error("%s: .npy header too long", name);
+        return -1;
+    }
+    char dict[1024];
+    if (hlen >= sizeof dict) {
+        cli_error("%s: .npy header too long for a 1-D vector", name);
+        return -1;
+    }
+    memcpy(dict, d + off, hlen);
+    dict[hlen] = '\0';
+    if (strlen(dict) != hlen) {
+        cli_error("%s: NUL byte in the .npy header", name);
+        return -1;
+    }
+    const char *ds = dict_value(dict, "descr");
+    const char *fo = dict_value(dict, "fortran_order");
+    const char *sh = dict_value(dict, "shape");
+    if (!ds || !fo || !sh) {
+        cli_error("%s: the .npy header lacks descr, fortran_order or shape", name);
+        return -1;
+    }
+    /* descr: '<f8', '|u1', ...: quote, byte order, kind, size, quote */
+    if (!(ds[0] == '\'' && ds[1] && strchr("<>|=", ds[1]) && ds[2] && strchr("fiu", ds[2]) &&
+          ds[3] && strchr("1248", ds[3]) && ds[4] == '\'')) {
+        char shown[24];
+        size_t k = 0;
+        while (k + 1 < sizeof shown && ds[k] && ds[k] != ',')
+            shown[k] = ds[k], k++;
+        shown[k] = '\0';
+        cli_error("%s: unsupported dtype %s (integers or float32/float64)", name, shown);
+        return -1;
+    }
+    h->kind = ds[2];
+    h->itemsize = (size_t)(ds[3] - '0');
+    h->big = ds[1] == '>' || (ds[1] == '=' && !host_is_little());
+    if (h->kind == 'f' && h->itemsize < 4) {
+        cli_error("%s: unsupported dtype float16", name);
+        return -1;
+    }
+    int fortran = strncmp(fo, "True", 4) == 0;
+    if (!fortran && strncmp(fo, "False", 5) != 0) {
+        cli_error("%s: bad fortran_order in the .npy header", name);
+        return -1;
+    }
+    const char *p = sh;
+    if (*p != '(') {
+        cli_error("%s: bad shape in the .npy header", name);
+        return -1;
+    }
+    p = skip_sp(p + 1);
+    h->count = 1;
+    while (*p != ')') {
+        if (*p < '0' || *p > '9' || h->ndim >= 8) {
+            cli_error("%s: bad shape in the .npy header", name);
+            return -1;
+        }
+        int64_t v = 0;
+        while (*p >= '0' && *p <= '9') {
+            if (v > (INT64_MAX - 9) / 10) {
+                cli_error("%s: bad shape in the .npy header", name);
+                return -1;
+            }
+            v = v * 10 + (*p++ - '0');
+        }
+        h->dims[h->ndim++] = v;
+        if (v != 0 && h->count > INT64_MAX / v) {
+            cli_error("%s: the .npy shape is too large", name);
+            return -1;
+        }
+        h->count *= v;
+        p = skip_sp(p);
+        if (*p == ',')
+            p = skip_sp(p + 1);
+        else if (*p != ')') {
+            cli_error("%s: bad shape in the .npy header", name);
+            return -1;
+        }
+    }
+    if (fortran && h->ndim > 1) {
+        int ones = 0;
+        for (int i = 0; i < h->ndim; i++)
+            ones += h->dims[i] == 1;
+        if (ones < h->ndim - 1) {
+            cli_error("%s: Fortran-order arrays are not supported", name);
+            return -1;
+        }
+    }
+    size_t data_bytes = size - off - hlen;
+    if ((uint64_t)h->count > (uint64_t)data_bytes / h->itemsize ||
+        (uint64_t)h->count * h->itemsize != data_bytes) {
+        char shape[96];
+        shape_text(h, shape, sizeof shape);
+        cli_error("%s: shape %s of %zu-byte items needs %s bytes of data, the file has %zu",
+                  name, shape, h->itemsize,
+                  (uint64_t)h->count > (uint64_t)data_bytes / h->itemsize ? "more" : "fewer",
+                  data_bytes);
+        return -1;
+    }
+    h->data = d + off + hlen;
     return 0;
 }
 
-int cli_npy_read_vector(const char *path, double **values, int64_t *n)
+/* Item i as raw bits (host order). */
+static uint64_t npy_item(const npy_info *h, int64_t i)
+{
+    const unsigned char *p = h->data + (size_t)i * h->itemsize;
+    uint64_t u = 0;
+    for (size_t k = 0; k < h->itemsize; k++)
+        u = (u << 8) | p[h->big ? k : h->itemsize - 1 - k];
+    return u;
+}
+
+int cli_npy_parse_vector(const unsigned char *data, size_t size, const char *name,
+                         double **values, int64_t *n)
 {
     *values = NULL;
     *n = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        cli_error("cannot open '%s': %s", path, strerror(errno));
+    npy_info h;
+    if (npy_header(data, size, name, &h))
+        return -1;
+    if (h.kind != 'f') {
+        cli_error("%s: only float64 or float32 arrays are supported", name);
         return -1;
     }
-    char *dict = NULL;
-    void *raw = NULL;
-    double *out = NULL;
-    int hr = read_header(f, &dict);
-    if (hr == -2)
-        goto oom;
-    if (hr)
-        goto bad;
-    const char *d = dict_value(dict, "descr");
-    const char *fo = dict_value(dict, "fortran_order");
-    const char *sh = dict_value(dict, "shape");
-    if (!d || !fo || !sh)
-        goto bad;
-    size_t itemsize;
-    int big;
-    if (strncmp(d, "'<f8'", 5) == 0 || strncmp(d, "'>f8'", 5) == 0)
-        itemsize = 8;
-    else if (strncmp(d, "'<f4'", 5) == 0 || strncmp(d, "'>f4'", 5) == 0)
-        itemsize = 4;
-    else {
-        cli_error("%s: only float64 or float32 arrays are supported", path);
-        goto fail;
+    if (h.ndim == 0 || h.ndim > 2 || (h.ndim == 2 && h.dims[0] != 1 && h.dims[1] != 1)) {
+        char shape[96];
+        shape_text(&h, shape, sizeof shape);
+        cli_error("%s: expected a 1-D array, got shape %s", name, shape);
+        return -1;
     }
-    big = d[1] == '>';
-    /* Shape: (N,) or (N, 1) or (1, N). */
-    if (*sh != '(')
-        goto bad;
-    int64_t dims[2] = {1, 1};
-    int ndim = 0;
-    const char *p = sh + 1;
-    for (;;) {
-        while (*p == ' ')
-            p++;
-        if (*p == ')')
-            break;
-        char *end;
-        errno = 0;
-        long long v = strtoll(p, &end, 10);
-        if (end == p || errno || v < 0 || ndim >= 2)
-            goto shape;
-        dims[ndim++] = v;
-        p = end;
-        while (*p == ' ')
-            p++;
-        if (*p == ',')
-            p++;
-        else if (*p != ')')
-            goto bad;
+    double *out = malloc(h.count ? (size_t)h.count * sizeof *out : 1);
+    if (!out) {
+        cli_error("out of memory reading '%s'", name);
+        return -1;
     }
-    if (ndim == 0 || (ndim == 2 && dims[0] != 1 && dims[1] != 1))
-        goto shape;
-    int64_t count = dims[0] * dims[1];
-    /* Bound by the bytes left in the file. */
-    long here = ftell(f);
-    if (here < 0 || fseek(f, 0, SEEK_END) != 0)
-        goto bad;
-    long fend = ftell(f);
-    if (fend < here || fseek(f, here, SEEK_SET) != 0)
-        goto bad;
-    if ((uint64_t)count > (uint64_t)(fend - here) / itemsize) {
-        cli_error("%s: truncated .npy file (%" PRId64 " values promised)", path, count);
-        goto fail;
-    }
-    raw = malloc(count ? (size_t)count * itemsize : 1);
-    out = malloc(count ? (size_t)count * sizeof(double) : 1);
-    if (!raw || !out)
-        goto oom;
-    if (fread(raw, itemsize, (size_t)count, f) != (size_t)count)
-        goto bad;
-    if (big == host_is_little())
-        swap_bytes(raw, (size_t)count, itemsize);
-    for (int64_t i = 0; i < count; i++) {
-        if (itemsize == 8) {
-            memcpy(&out[i], (unsigned char *)raw + 8 * i, 8);
+    for (int64_t i = 0; i < h.count; i++) {
+        uint64_t u = npy_item(&h, i);
+        if (h.itemsize == 8) {
+            memcpy(&out[i], &u, 8);
         } else {
+            uint32_t u32 = (uint32_t)u;
             float x;
-            memcpy(&x, (unsigned char *)raw + 4 * i, 4);
+            memcpy(&x, &u32, 4);
             out[i] = x;
         }
     }
-    free(raw);
-    free(dict);
-    fclose(f);
     *values = out;
-    *n = count;
+    *n = h.count;
     return 0;
-shape:
-    cli_error("%s: expected a 1-D array", path);
-    goto fail;
-oom:
-    cli_error("out of memory reading '%s'", path);
-    goto fail;
-bad:
-    cli_error("%s: not a readable .npy file", path);
-fail:
-    free(raw);
-    free(out);
-    free(dict);
-    fclose(f);
-    return -1;
 }
 
-int cli_npy_read_ints(const char *path, int32_t **ids, int64_t *n)
+int cli_npy_parse_ints(const unsigned char *data, size_t size, const char *name, int32_t **ids,
+                       int64_t *n)
 {
     *ids = NULL;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        cli_error("cannot open '%s': %s", path, strerror(errno));
+    *n = 0;
+    npy_info h;
+    if (npy_header(data, size, name, &h))
+        return -1;
+    if (h.kind == 'f')
+        return 1;
+    if (h.ndim != 1) {
+        char shape[96];
+        shape_text(&h, shape, sizeof shape);
+        cli_error("%s: expected a 1-D array of vertex ids, got shape %s", name, shape);
         return -1;
     }
-    char *dict = NULL;
-    unsigned char *raw = NULL;
-    int rc = -1;
-    if (read_header(f, &dict))
-        goto bad;
-    const char *d = dict_value(dict, "descr");
-    const char *sh = dict_value(dict, "shape");
-    if (!d || !sh)
-        goto bad;
-    /* e.g. '<i4', '|u1' */
-    if (d[0] != '\'' || !strchr("<>|=", d[1]) || (d[2] != 'i' && d[2] != 'u') ||
-        !strchr("1248", d[3]) || d[4] != '\'') {
-        rc = 1;
-        goto out;
+    if (h.count > INT32_MAX) {
+        cli_error("%s: too many ids", name);
+        return -1;
     }
-    int big = d[1] == '>', is_signed = d[2] == 'i';
-    size_t size = (size_t)(d[3] - '0');
-    long long count = -1, other = 1;
-    if (sscanf(sh, "(%lld,)", &count) != 1 && sscanf(sh, "(%lld, %lld)", &count, &other) != 2)
-        goto bad;
-    if (count < 0 || other < 0 || (other != 1 && count != 1))
-        goto bad;
-    count *= other;
-    if (count > INT32_MAX) {
-        cli_error("%s: too many sources", path);
-        goto out;
+    int32_t *out = malloc(h.count ? (size_t)h.count * sizeof *out : 1);
+    if (!out) {
+        cli_error("out of memory reading '%s'", name);
+        return -1;
     }
-    raw = malloc(count ? (size_t)count * size : 1);
-    *ids = malloc(count ? (size_t)count * sizeof **ids : 1);
-    if (!raw || !*ids) {
-        cli_error("out of memory reading '%s'", path);
-        goto out;
-    }
-    if (fread(raw, size, (size_t)count, f) != (size_t)count)
-        goto bad;
-    for (long long i = 0; i < count; i++) {
-        const unsigned char *p = raw + (size_t)i * size;
-        unsigned long long u = 0;
-        for (size_t k = 0; k < size; k++) {
-            size_t byte = big ? k : size - 1 - k;
-            u = (u << 8) | p[byte];
-        }
-        long long v;
-        if (is_signed && size < 8 && (u >> (8 * size - 1)) & 1)
-            v = (long long)(u | (~0ull << (8 * size)));
+    for (int64_t i = 0; i < h.count; i++) {
+        uint64_t u = npy_item(&h, i);
+        int64_t v;
+        if (h.kind == 'i' && h.itemsize < 8 && (u >> (8 * h.itemsize - 1)) & 1)
+            v = (int64_t)(u | (~0ull << (8 * h.itemsize)));
         else
-            v = (long long)u;
-        if ((!is_signed && size == 8 && u > (unsigned long long)INT32_MAX) || v < INT32_MIN ||
-            v > INT32_MAX) {
-            cli_error("%s: source %lld is out of range", path, i);
-            goto out;
+            v = (int64_t)u;
+        if ((h.kind == 'u' && u > (uint64_t)INT32_MAX) || v < INT32_MIN || v > INT32_MAX) {
+            cli_error("%s: source %" PRId64 " is out of range", name, i);
+            free(out);
+            return -1;
         }
-        (*ids)[i] = (int32_t)v;
+        out[i] = (int32_t)v;
     }
-    *n = count;
-    rc = 0;
-    goto out;
-bad:
-    cli_error("%s: not a readable .npy file", path);
-out:
-    if (rc != 0) {
-        free(*ids);
-        *ids = NULL;
-    }
-    free(raw);
-    free(dict);
-    fclose(f);
-    return rc;
+    *ids = out;
+    *n = h.count;
+    return 0;
 }
 
-int cli_txt_read_vector(const char *path, double **values, int64_t *n)
+int cli_txt_parse_vector(const char *data, size_t size, const char *name, double **values,
+                         int64_t *n)
 {
     *values = NULL;
     *n = 0;
-    FILE *f = fopen(path, "r");
-    if (!f) {
-        cli_error("cannot open '%s': %s", path, strerror(errno));
-        return -1;
-    }
     size_t cap = 1024, len = 0;
     double *out = malloc(cap * sizeof *out);
-    char line[4096];
-    int64_t lineno = 0;
     if (!out) {
-        cli_error("out of memory reading '%s'", path);
-        fclose(f);
+        cli_error("out of memory reading '%s'", name);
         return -1;
     }
-    while (fgets(line, sizeof line, f)) {
-        lineno++;
-        size_t l = strlen(line);
-        if (l == sizeof line - 1 && line[l - 1] != '\n' && !feof(f)) {
-            cli_error("%s:%" PRId64 ": line too long", path, lineno);
-            goto fail;
-        }
-        char *hash = strchr(line, '#');
-        if (hash)
-            *hash = '\0';
-        char *p = line;
-        for (;;) {
-            while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n' || *p == ',')
+    const char *p = data, *end = data + size;
+    int64_t line = 1;
+    while (p < end) {
+        char c = *p;
+        if (c == '\n') {
+            line++;
+            p++;
+        } else if (c == ' ' || c == '\t' || c == '\r' || c == ',') {
+            p++;
+        } else if (c == '#') {
+            while (p < end && *p != '\n')
                 p++;
-            if (!*p)
-                break;
-            char *end;
-            double v = strtod(p, &end);
-            if (end == p || !(*end == '\0' || *end == ' ' || *end == '\t' || *end == '\r' ||
-                              *end == '\n' || *end == ',')) {
-                cli_error("%s:%" PRId64 ": not a number", path, lineno);
-                goto fail;
+        } else {
+            const char *q;
+            double v;
+            if (!mfmm_io_strtod(p, &q, &v) ||
+                !(q == end || *q == ' ' || *q == '\t' || *q == '\r' || *q == '\n' || *q == ',' ||
+                  *q == '#')) {
+                cli_error("%s:%" PRId64 ": not a number", name, line);
+                free(out);
+                return -1;
             }
             if (len == cap) {
-                double *nb = realloc(out, 2 * cap * sizeof *out);
+                double *nb = cap > SIZE_MAX / 2 / sizeof *out ? NULL : realloc(out, 2 * cap * sizeof *out);
                 if (!nb) {
-                    cli_error("out of memory reading '%s'", path);
-                    goto fail;
+                    cli_error("out of memory reading '%s'", name);
+                    free(out);
+                    return -1;
                 }
                 out = nb;
                 cap *= 2;
             }
             out[len++] = v;
-            p = end;
+            p = q;
         }
     }
-    if (ferror(f)) {
-        cli_error("cannot read '%s'", path);
-        goto fail;
-    }
-    fclose(f);
     *values = out;
     *n = (int64_t)len;
     return 0;
-fail:
-    free(out);
-    fclose(f);
-    return -1;
+}
+
+int cli_npy_read_vector(const char *path, double **values, int64_t *n)
+{
+    unsigned char *d;
+    size_t size;
+    *values = NULL;
+    *n = 0;
+    if (cli_read_file(path, &d, &size))
+        return -1;
+    int r = cli_npy_parse_vector(d, size, path, values, n);
+    free(d);
+    return r;
+}
+
+int cli_npy_read_ints(const char *path, int32_t **ids, int64_t *n)
+{
+    unsigned char *d;
+    size_t size;
+    *ids = NULL;
+    *n = 0;
+    if (cli_read_file(path, &d, &size))
+        return -1;
+    int r = cli_npy_parse_ints(d, size, path, ids, n);
+    free(d);
+    return r;
+}
+
+int cli_txt_read_vector(const char *path, double **values, int64_t *n)
+{
+    unsigned char *d;
+    size_t size;
+    *values = NULL;
+    *n = 0;
+    if (cli_read_file(path, &d, &size))
+        return -1;
+    if (memchr(d, '\0', size)) {
+        cli_error("%s: NUL byte in a text file", path);
+        free(d);
+        return -1;
+    }
+    int r = cli_txt_parse_vector((const char *)d, size, path, values, n);
+    free(d);
+    return r;
 }

@@ -1,32 +1,10 @@
 /* Options shared by `distance` and `path`: the mesh, the sources, the cost
  * file and the output; their checks and the cost loader. */
+#include <getopt.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
-
-int cli_parse_vertex_point(int argc, char **argv, int i, mfmm_source *s)
-{
-    int32_t v;
-    if (i + 1 >= argc || !cli_parse_int32(argv[i + 1], &v))
-        return 0;
-    mfmm_source x = {v, -1, {0, 0, 0}, 0.0};
-    *s = x;
-    return 1;
-}
-
-int cli_parse_face_point(int argc, char **argv, int i, mfmm_source *s)
-{
-    int32_t fid;
-    double w[3];
-    if (i + 4 >= argc || !cli_parse_int32(argv[i + 1], &fid) ||
-        !cli_parse_double(argv[i + 2], &w[0]) || !cli_parse_double(argv[i + 3], &w[1]) ||
-        !cli_parse_double(argv[i + 4], &w[2]))
-        return 0;
-    mfmm_source x = {-1, fid, {w[0], w[1], w[2]}, 0.0};
-    *s = x;
-    return 1;
-}
 
 int cli_sources_and_cost_init(cli_sources_and_cost *o, const char *sub, void (*help)(FILE *out),
                               int argc)
@@ -50,38 +28,48 @@ void cli_sources_and_cost_free(cli_sources_and_cost *o)
     o->cost = NULL;
 }
 
-int cli_sources_and_cost_arg(cli_sources_and_cost *o, int argc, char **argv, int *i)
+int cli_sources_and_cost_opt(cli_sources_and_cost *o, int c, int argc, char **argv)
 {
-    const char *a = argv[*i];
-    if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+    switch (c) {
+    case 'h':
         o->help(stdout);
         o->help_shown = 1;
-    } else if (strcmp(a, "--source") == 0) {
-        if (!cli_parse_vertex_point(argc, argv, *i, &o->src[o->n_src]))
-            return cli_usage_error(o->sub, "%s needs a vertex id", a);
+        return CLI_OK;
+    case OPT_SOURCE: {
+        int32_t v;
+        if (!cli_parse_int32(optarg, &v))
+            return cli_usage_error(o->sub, "--source needs a vertex id, not '%s'", optarg);
+        mfmm_source x = {v, -1, {0, 0, 0}, 0.0};
+        o->src[o->n_src++] = x;
+        return CLI_OK;
+    }
+    case OPT_FACE_SOURCE:
+        if (!cli_take_face_point(optarg, argc, argv, &o->src[o->n_src]))
+            return cli_usage_error(o->sub,
+                                   "--face-source needs a face id and three barycentric weights");
         o->n_src++;
-        *i += 1;
-    } else if (strcmp(a, "--face-source") == 0) {
-        if (!cli_parse_face_point(argc, argv, *i, &o->src[o->n_src]))
-            return cli_usage_error(o->sub, "%s needs a face id and three barycentric weights", a);
-        o->n_src++;
-        *i += 4;
-    } else if (strcmp(a, "--cost") == 0) {
-        if (*i + 1 >= argc)
-            return cli_usage_error(o->sub, "--cost needs a file");
-        o->cost_path = argv[++*i];
-    } else if (strcmp(a, "--cost-per-face") == 0) {
+        return CLI_OK;
+    case OPT_COST:
+        o->cost_path = optarg;
+        return CLI_OK;
+    case OPT_COST_PER_FACE:
         o->cost_per_face = 1;
-    } else if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
-        if (*i + 1 >= argc)
-            return cli_usage_error(o->sub, "-o needs a file name");
-        o->out_path = argv[++*i];
-    } else if (a[0] == '-' && a[1] != '\0') {
-        return cli_usage_error(o->sub, "unknown option '%s'", a);
-    } else if (!o->mesh_path) {
-        o->mesh_path = a;
-    } else {
-        return cli_usage_error(o->sub, "one mesh at a time ('%s' is extra)", a);
+        return CLI_OK;
+    case 'o':
+        o->out_path = optarg;
+        return CLI_OK;
+    default:
+        return cli_getopt_error(o->sub, c, argv);
+    }
+}
+
+int cli_sources_and_cost_positional(cli_sources_and_cost *o, int argc, char **argv)
+{
+    for (int i = optind; i < argc; i++) {
+        if (!o->mesh_path)
+            o->mesh_path = argv[i];
+        else
+            return cli_usage_error(o->sub, "one mesh at a time ('%s' is extra)", argv[i]);
     }
     return CLI_OK;
 }
@@ -96,19 +84,22 @@ int cli_sources_and_cost_check_inputs(const cli_sources_and_cost *o)
 }
 
 int cli_sources_and_cost_check_output(const cli_sources_and_cost *o, const char *ext0,
-                                      const char *ext1, int *which)
+                                      const char *ext1, int text_which, int *which)
 {
     if (!o->out_path)
-        return cli_usage_error(o->sub, "no output given (-o OUT.%s or OUT.%s)", ext0, ext1);
-    if (cli_has_ext(o->out_path, ext0))
+        return cli_usage_error(o->sub, "no output given (-o OUT.%s, OUT.%s or - for standard output)", ext0, ext1);
+    if (strcmp(o->out_path, "-") == 0)
+        *which = text_which;
+    else if (cli_has_ext(o->out_path, ext0))
         *which = 0;
     else if (cli_has_ext(o->out_path, ext1))
         *which = 1;
     else
-        return cli_usage_error(o->sub, "the output must end in .%s or .%s", ext0, ext1);
+        return cli_usage_error(o->sub, "the output must end in .%s or .%s (or be -)", ext0, ext1);
     if (o->cost_per_face && !o->cost_path)
         return cli_usage_error(o->sub, "--cost-per-face needs --cost");
-    return CLI_OK;
+    const char *inputs[2] = {o->mesh_path, o->cost_path};
+    return cli_check_output_not_input(o->sub, o->out_path, inputs, 2);
 }
 
 int cli_sources_and_cost_load(cli_sources_and_cost *o, const mfmm_mesh *mesh,

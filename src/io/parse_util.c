@@ -80,13 +80,13 @@ int mfmm_io_scan_int(const char **p, int64_t *value)
 int mfmm_io_scan_double(const char **p, double *value)
 {
     const char *s = *p;
-    /* strtod skips leading space; a token must start here. */
+    /* A token must start here. */
     if (!(*s == '+' || *s == '-' || *s == '.' || (*s >= '0' && *s <= '9') || *s == 'i' ||
           *s == 'I' || *s == 'n' || *s == 'N'))
         return 0;
-    char *end;
-    double v = strtod(s, &end);
-    if (end == s)
+    const char *end;
+    double v;
+    if (!mfmm_io_strtod(s, &end, &v))
         return 0;
     *value = v;
     *p = end;

@@ -13,7 +13,13 @@
 #include <unistd.h>
 #include <cmocka.h>
 
+#include <errno.h>
+#include <fcntl.h>
+#include <locale.h>
+#include <sys/stat.h>
+
 #include "meshfmm.h"
+#include "io/io.h"
 
 typedef struct loaded {
     mfmm_status st;
@@ -721,6 +727,303 @@ static void test_io_errors(void **state)
     assert_int_equal(mfmm_load_mesh(path, &V, &nv, &F, &nf, NULL), MFMM_ERR_PARSE);
 }
 
+
+/* ------------------------------------------------------ STL (issue 10) */
+
+static void put_le32(unsigned char *p, uint32_t v)
+{
+    for (int i = 0; i < 4; i++)
+        p[i] = (unsigned char)(v >> (8 * i));
+}
+
+/* A binary STL of the unit square (two facets) in buf; its size. */
+static size_t binary_square(unsigned char *buf, const char *header)
+{
+    static const float corners[2][9] = {{0, 0, 0, 1, 0, 0, 1, 1, 0}, {0, 0, 0, 1, 1, 0, -0.0f, 1, 0}};
+    memset(buf, 0, 84 + 100);
+    memcpy(buf, header, strlen(header));
+    put_le32(buf + 80, 2);
+    for (int f = 0; f < 2; f++)
+        for (int k = 0; k < 9; k++) {
+            uint32_t u;
+            memcpy(&u, &corners[f][k], 4);
+            put_le32(buf + 84 + 50 * f + 12 + 4 * k, u);
+        }
+    return 84 + 100;
+}
+
+static void check_square(const loaded *r)
+{
+    assert_int_equal(r->st, MFMM_OK);
+    assert_int_equal(r->nv, 4); /* welded by position, -0 == +0 */
+    assert_int_equal(r->nf, 2);
+    assert_vertex(r, 0, 0, 0, 0);
+    assert_vertex(r, 1, 1, 0, 0);
+    assert_vertex(r, 2, 1, 1, 0);
+    assert_vertex(r, 3, 0, 1, 0);
+    assert_face(r, 0, 0, 1, 2);
+    assert_face(r, 1, 0, 2, 3);
+}
+
+static void test_stl(void **state)
+{
+    char path[256];
+    unsigned char bin[184];
+    size_t n = binary_square(bin, "binary square");
+    put(*state, "sq.stl", bin, n, path, sizeof path);
+    loaded r = load(path);
+    check_square(&r);
+    unload(&r);
+    /* A binary header starting with "solid": the size formula decides. */
+    n = binary_square(bin, "solid but binary");
+    put(*state, "sq2.STL", bin, n, path, sizeof path);
+    r = load(path);
+    check_square(&r);
+    unload(&r);
+    /* Sniffed without an extension. */
+    put(*state, "sq_noext", bin, n, path, sizeof path);
+    r = load(path);
+    check_square(&r);
+    unload(&r);
+    /* Truncated binary: neither binary nor ascii, a clear message. */
+    put(*state, "cut.stl", bin, n - 7, path, sizeof path);
+    r = load(path);
+    assert_int_equal(r.st, MFMM_ERR_PARSE);
+    assert_non_null(strstr(r.err.message, "84 + 50 n"));
+    assert_null(r.V);
+
+    const char *ascii =
+        "solid square\n"
+        "  facet normal 0 0 1\n    outer loop\n      vertex 0 0 0\n      vertex 1 0 0\n"
+        "      vertex 1 1 0\n    endloop\n  endfacet\n"
+        "  FACET NORMAL 0 0 1\n    OUTER LOOP\n      VERTEX 0.0 0.0 0.0\n      VERTEX 1e0 1 0\n"
+        "      VERTEX -0 1.0 0\n    ENDLOOP\n  ENDFACET\n"
+        "  facet normal 0 0 1\n    outer loop\n      vertex 0 0 0\n      vertex 1 0 0\n"
+        "      vertex 0 0 0\n    endloop\n  endfacet\n" /* degenerate: dropped */
+        "endsolid square\n";
+    put_str(*state, "a.stl", ascii, path, sizeof path);
+    r = load(path);
+    check_square(&r);
+    unload(&r);
+    put_str(*state, "a.txt", ascii, path, sizeof path); /* sniffed */
+    r = load(path);
+    check_square(&r);
+    unload(&r);
+    /* A quad loop is fan-triangulated. */
+    put_str(*state, "q.stl",
+            "solid q\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\n"
+            "vertex 0 1 0\nendloop\nendfacet\nendsolid q\n",
+            path, sizeof path);
+    r = load(path);
+    check_square(&r);
+    unload(&r);
+    static const struct {
+        const char *name, *text, *msg;
+    } bad[] = {
+        {"b1.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0\nendloop\n", "three numbers"},
+        {"b2.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\nendfacet\n",
+         "at least three"},
+        {"b3.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 nan 0\n"
+                   "endloop\nendfacet\n", "NaN"},
+        {"b4.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n", "end of"},
+        {"b5.stl", "solid x\nendsolid x\n", "no facets"},
+        {"b6.stl", "hello\n", "solid"},
+        {"b7.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                   "endloop\nbogus\n", "bogus"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
+        check_broken(*state, bad[i].name, bad[i].text, strlen(bad[i].text), MFMM_ERR_PARSE,
+                     bad[i].msg);
+}
+
+/* Unsupported formats get one sentence naming the formats read. */
+static void test_unsupported(void **state)
+{
+    const char *names[] = {"m.gltf", "m.glb", "m.3ds", "m.FBX", "m.dae"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        check_broken(*state, names[i], "{\"asset\": {}}", 13, MFMM_ERR_PARSE,
+                     "OBJ, OFF, PLY (ascii and binary) and STL");
+    unsigned char glb[40] = "glTF\002\000\000\000";
+    check_broken(*state, "m.bin", glb, sizeof glb, MFMM_ERR_PARSE, "meshfmm reads OBJ");
+    check_broken(*state, "m.unknown", "\001\002\003 garbage", 12, MFMM_ERR_PARSE,
+                 "meshfmm reads OBJ");
+}
+
+/* /dev/zero, a FIFO with no writer and a directory are refused at once
+ * (issue 9 item 10), naming the path and what it is. */
+static void test_not_regular(void **state)
+{
+    loaded r = load("/dev/zero");
+    assert_int_equal(r.st, MFMM_ERR_IO);
+    assert_non_null(strstr(r.err.message, "/dev/zero"));
+    assert_non_null(strstr(r.err.message, "character device"));
+    assert_null(r.V);
+    r = load(*state);
+    assert_int_equal(r.st, MFMM_ERR_IO);
+    assert_non_null(strstr(r.err.message, "directory"));
+    char fifo[256];
+    snprintf(fifo, sizeof fifo, "%s/pipe.obj", (char *)*state);
+    assert_int_equal(mkfifo(fifo, 0600), 0);
+    time_t t0 = time(NULL);
+    r = load(fifo); /* blocked forever before the fix */
+    assert_true(time(NULL) - t0 < 5);
+    assert_int_equal(r.st, MFMM_ERR_IO);
+    assert_non_null(strstr(r.err.message, "FIFO"));
+    assert_non_null(strstr(r.err.message, "pipe.obj"));
+}
+
+/* ------------------------------------------------ numbers without locale */
+
+/* Bits equal. */
+static void assert_same_double(double a, double b, const char *text)
+{
+    if (memcmp(&a, &b, sizeof a) != 0)
+        fail_msg("'%s': %.17g, want %.17g", text, a, b);
+}
+
+/* mfmm_io_strtod is correctly rounded: compared with glibc's strtod in the C
+ * locale (this test runs before any setlocale) on hard cases and random
+ * text. */
+static void test_strtod(void **state)
+{
+    (void)state;
+    static const char *cases[] = {
+        "0", "-0", "1", "0.1", "1e23", "9007199254740993", "9007199254740992.5",
+        "2.2250738585072011e-308", "2.2250738585072012e-308", "4.9406564584124654e-324",
+        "2.4703282292062327e-324", "2.4703282292062328e-324", "1.7976931348623157e308",
+        "1.7976931348623158e308", "1.7976931348623159e308", "1e-400", "1e400", "-.5e-3", "3.",
+        "0.12345678901234567", "123456789012345678901234567890e-10", "7.2057594037927933e16",
+        "8.98846567431158e307", "1.00000000000000011102230246251565404236316680908203125",
+        "1.00000000000000011102230246251565404236316680908203124",
+        "1.00000000000000011102230246251565404236316680908203126"};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const char *end;
+        char *want_end;
+        double got, want = strtod(cases[i], &want_end);
+        assert_int_equal(mfmm_io_strtod(cases[i], &end, &got), 1);
+        assert_same_double(got, want, cases[i]);
+        assert_ptr_equal(end, want_end);
+    }
+    unsigned long long x = 88172645463325252ull;
+    char buf[128];
+    for (int it = 0; it < 100000; it++) {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        double d;
+        memcpy(&d, &x, sizeof d);
+        if (!isfinite(d))
+            continue;
+        snprintf(buf, sizeof buf, "%.*g", (int)(x % 19) + 1, d);
+        const char *end;
+        double got, want = strtod(buf, NULL);
+        assert_int_equal(mfmm_io_strtod(buf, &end, &got), 1);
+        assert_same_double(got, want, buf);
+        assert_true(*end == '\0');
+    }
+    const char *end;
+    double v;
+    assert_int_equal(mfmm_io_strtod("inf", &end, &v), 1);
+    assert_true(isinf(v) && *end == '\0');
+    assert_int_equal(mfmm_io_strtod("-Infinity", &end, &v), 1);
+    assert_true(isinf(v) && v < 0 && *end == '\0');
+    assert_int_equal(mfmm_io_strtod("nan(0x1)", &end, &v), 1);
+    assert_true(isnan(v));
+    assert_int_equal(mfmm_io_strtod("1,5", &end, &v), 1); /* stops at the comma */
+    assert_true(v == 1.0 && *end == ',');
+    assert_int_equal(mfmm_io_strtod("1e+", &end, &v), 1);
+    assert_true(v == 1.0 && *end == 'e');
+    assert_int_equal(mfmm_io_strtod(".", &end, &v), 0);
+    assert_int_equal(mfmm_io_strtod("-", &end, &v), 0);
+    assert_int_equal(mfmm_io_strtod("x", &end, &v), 0);
+}
+
+/* Sets a decimal-comma locale: de_DE.UTF-8 if installed, else one built
+ * by localedef into dir (LOCPATH). 1 on success. */
+static int set_comma_locale(const char *dir)
+{
+    if (setlocale(LC_ALL, "de_DE.UTF-8"))
+        return 1;
+    char cmd[512];
+    snprintf(cmd, sizeof cmd,
+             "localedef -i de_DE -f UTF-8 '%s/de_DE.UTF-8' >/dev/null 2>&1", dir);
+    int rc = system(cmd); /* localedef may warn and exit 1 yet write the locale */
+    (void)rc;
+    setenv("LOCPATH", dir, 1);
+    if (setlocale(LC_ALL, "de_DE.UTF-8"))
+        return 1;
+    unsetenv("LOCPATH");
+    return 0;
+}
+
+/* Issue 9 item 4: under a decimal-comma locale the text readers read '.'
+ * numbers and the .txt writers' formatter writes '.'. */
+static void test_comma_locale(void **state)
+{
+    if (!set_comma_locale(*state)) {
+        printf("SKIPPED: no de_DE.UTF-8 locale and localedef cannot make one "
+               "(install the Debian package 'locales')\n");
+        skip();
+        return;
+    }
+    char *e;
+    double comma = strtod("1,5", &e);
+    int is_comma = comma == 1.5 && *e == '\0';
+    char path[256];
+    const char *obj = "v 0.5 0 0\nv 1.25 0 0\nv 0 1e-1 0.75\nf 1 2 3\n";
+    put_str(*state, "l.obj", obj, path, sizeof path);
+    loaded r = load(path);
+    if (r.st != MFMM_OK)
+        fail_msg("OBJ under de_DE: %s", r.err.message);
+    assert_vertex(&r, 0, 0.5, 0, 0);
+    assert_vertex(&r, 1, 1.25, 0, 0);
+    assert_vertex(&r, 2, 0, 0.1, 0.75);
+    unload(&r);
+    put_str(*state, "l.off", "OFF\n3 1 0\n0.5 0 0\n1.25 0 0\n0 1e-1 0.75\n3 0 1 2\n", path,
+            sizeof path);
+    r = load(path);
+    if (r.st != MFMM_OK)
+        fail_msg("OFF under de_DE: %s", r.err.message);
+    assert_vertex(&r, 2, 0, 0.1, 0.75);
+    unload(&r);
+    put_str(*state, "l.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property double z\nelement face 1\nproperty list uchar int vertex_indices\n"
+            "end_header\n0.5 0 0\n1.25 0 0\n0 0.1 0.75\n3 0 1 2\n",
+            path, sizeof path);
+    r = load(path);
+    if (r.st != MFMM_OK)
+        fail_msg("PLY under de_DE: %s", r.err.message);
+    assert_vertex(&r, 0, 0.5, 0, 0);
+    assert_vertex(&r, 2, 0, 0.1, 0.75);
+    unload(&r);
+    put_str(*state, "l.stl",
+            "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0.5 0 0\nvertex 1.25 0 0\n"
+            "vertex 0 0.1 0.75\nendloop\nendfacet\nendsolid s\n",
+            path, sizeof path);
+    r = load(path);
+    if (r.st != MFMM_OK)
+        fail_msg("STL under de_DE: %s", r.err.message);
+    assert_vertex(&r, 2, 0, 0.1, 0.75);
+    unload(&r);
+    /* The .txt writers' formatter. */
+    char buf[40];
+    assert_true(mfmm_io_format_double(buf, sizeof buf, 0.5) > 0);
+    assert_string_equal(buf, "0.5");
+    assert_true(mfmm_io_format_double(buf, sizeof buf, -1.0 / 3.0) > 0);
+    assert_string_equal(buf, "-0.33333333333333331");
+    assert_true(mfmm_io_format_double(buf, sizeof buf, 0.1) > 0);
+    assert_string_equal(buf, "0.10000000000000001");
+    assert_true(mfmm_io_format_double(buf, sizeof buf, 1.5e-300) > 0);
+    assert_string_equal(buf, "1.5000000000000001e-300");
+    assert_true(mfmm_io_format_double(buf, sizeof buf, 2.0) > 0);
+    assert_string_equal(buf, "2");
+    assert_int_equal(mfmm_io_format_double(buf, 3, 0.5), -1);
+    setlocale(LC_ALL, "C");
+    unsetenv("LOCPATH");
+    assert_true(is_comma); /* the locale really had a decimal comma */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -737,6 +1040,11 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_broken_binary_ply, make_dir, remove_dir),
         cmocka_unit_test_setup_teardown(test_fuzz_small, make_dir, remove_dir),
         cmocka_unit_test_setup_teardown(test_io_errors, make_dir, remove_dir),
+        cmocka_unit_test_setup_teardown(test_stl, make_dir, remove_dir),
+        cmocka_unit_test_setup_teardown(test_unsupported, make_dir, remove_dir),
+        cmocka_unit_test_setup_teardown(test_not_regular, make_dir, remove_dir),
+        cmocka_unit_test(test_strtod),
+        cmocka_unit_test_setup_teardown(test_comma_locale, make_dir, remove_dir),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

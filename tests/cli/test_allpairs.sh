@@ -26,7 +26,7 @@ for b in auto opencl serial threads; do
         fi
         cat "$T/err_$b.txt"; fail "allpairs --backend $b"; }
     grep -q "backend" "$T/err_$b.txt" || fail "no summary line ($b)"
-    [ -e "$T/d_$b.npy.partial" ] && fail "partial file left ($b)"
+    ls "$T" | grep -q "^d_$b.npy.......$" && fail "temporary file left ($b)"
     # magic and header
     head -c 6 "$T/d_$b.npy" | od -c | head -1 | grep -q "N   U   M   P   Y" || fail "not .npy ($b)"
 done
@@ -91,13 +91,13 @@ for sig in INT TERM; do
     "$M" allpairs "$BIG" -o "$T/big.npy" --backend threads --threads 1 --quiet 2>/dev/null &
     pid=$!
     i=0
-    while [ ! -e "$T/big.npy.partial" ] && [ $i -lt 200 ]; do sleep 0.05; i=$((i + 1)); done
+    while ! ls "$T" | grep -q '^big.npy.......$' && [ $i -lt 200 ]; do sleep 0.05; i=$((i + 1)); done
     sleep 0.3
     kill -$sig $pid
     wait $pid
     rc=$?
     [ $rc -eq 130 ] || fail "SIG$sig: exit status $rc, not 130"
     [ -e "$T/big.npy" ] && fail "SIG$sig left $T/big.npy"
-    [ -e "$T/big.npy.partial" ] && fail "SIG$sig left the partial file"
+    ls "$T" | grep -q '^big.npy.......$' && fail "SIG$sig left the temporary file"
 done
 echo "allpairs CLI: all checks passed"

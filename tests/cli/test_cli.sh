@@ -40,7 +40,7 @@ value() { awk -F: -v k="$1" '$1 == k { gsub(/ /, "", $2); print $2 }' "$2"; }
 expect 0 "--version" "$BIN" --version && grep -q '^meshfmm [0-9]*\.[0-9]*\.[0-9]*$' "$T/out" ||
     fail "--version output: $(cat "$T/out")"
 expect 0 "--help" "$BIN" --help
-for c in info distance generate; do
+for c in info distance generate path allpairs; do
     expect 0 "$c --help" "$BIN" "$c" --help && grep -q "usage: meshfmm $c" "$T/out" ||
         fail "$c --help text"
 done
@@ -90,7 +90,7 @@ done
 grep -q 'line 4' "$T/err" 2>/dev/null || true
 "$BIN" info "$T/range.obj" 2>"$T/err"
 grep -q 'range.obj: line 4' "$T/err" && ok "message names the line" || fail "message: $(cat "$T/err")"
-[ ! -e "$T/bad.txt" ] && [ ! -e "$T/bad.txt.partial" ] && ok "no output after a failure" ||
+[ ! -e "$T/bad.txt" ] && ! ls "$T" | grep -q '^bad.txt.' && ok "no output after a failure" ||
     fail "output left behind after a failure"
 
 # ---- generate ----
@@ -185,10 +185,130 @@ if expect 0 "distance -> npy" "$BIN" distance "$T/g.obj" --source "$C" -o "$T/d.
     [ "$(head -c 6 "$T/d.npy" | tail -c 5)" = "NUMPY" ] && ok "npy magic" || fail "npy magic"
     head -c 128 "$T/d.npy" | grep -q "'descr': '<f8', 'fortran_order': False, 'shape': ($NV,)" &&
         ok "npy header" || fail "npy header"
-    [ ! -e "$T/d.npy.partial" ] && ok "no .partial left" || fail ".partial left"
+    ls "$T" | grep -q '^d.npy.' && fail "temporary file left" || ok "no temporary file left"
 fi
 # An unwritable output: exit 1.
 expect 1 "unwritable output" "$BIN" distance "$T/g.obj" --source "$C" -o "$T/no/such/dir/d.txt"
+
+# ---- getopt_long conventions (issue 10): --opt=value, -o -, --help ----
+if expect 0 "distance --source=C --output=FILE" "$BIN" distance "$T/g.obj" --source="$C" --output="$T/eq.txt"; then
+    cmp -s "$T/eq.txt" "$T/d.txt" && ok "--source=C equals --source C" || fail "--source=C differs"
+fi
+if expect 0 "distance -o - (stdout)" "$BIN" distance "$T/g.obj" --source "$C" -o -; then
+    cmp -s "$T/out" "$T/d.txt" && ok "-o - writes the .txt to stdout" || fail "-o - output differs"
+fi
+expect 0 "options after the mesh, mesh last" "$BIN" distance --source "$C" -o "$T/perm.txt" "$T/g.obj" &&
+    { cmp -s "$T/perm.txt" "$T/d.txt" && ok "argument order free" || fail "permuted args differ"; }
+expect 0 "path -o - (csv to stdout)" "$BIN" path "$T/g.obj" --source "$C" --target="$C2" -o - &&
+    { head -1 "$T/out" | grep -q '^face,b0,b1,b2,x,y,z$' && [ "$(grep -c '' "$T/err")" -eq 1 ] &&
+      awk -F, 'NR > 1 && NF != 7 { bad++ } END { exit bad > 0 || NR < 3 }' "$T/out" &&
+      ok "path csv on stdout, length on stderr ($(cat "$T/err"))" || fail "path -o -: $(cat "$T/out" "$T/err")"; }
+expect 0 "path --face-source with negative-looking weights" "$BIN" path "$T/g.obj" --face-source "$FACE" 1 0 0 --target "$C2" -o "$T/p.obj" &&
+    { grep -q '^l 1 2' "$T/p.obj" && ok "path .obj polyline" || fail "path .obj"; }
+expect 2 "distance --face-source missing weights" "$BIN" distance "$T/g.obj" --face-source 0 1 -o "$T/x.txt"
+expect 2 "option without its value" "$BIN" distance "$T/g.obj" --source
+expect 2 "unknown long option" "$BIN" distance "$T/g.obj" --source 0 --frobnicate -o "$T/x.txt"
+expect 2 "allpairs -o - refused" "$BIN" allpairs "$T/g.obj" -o -
+expect 0 "generate -o -" "$BIN" generate grid 2 -o - && { grep -c '^v ' "$T/out" | grep -qx 9 && ok "generate to stdout" || fail "generate stdout"; }
+
+# ---- allpairs --cost and --threads 0 (issue 10) ----
+# A single-source allpairs row equals `distance` with the same cost, bit for bit.
+echo "$C" >"$T/one.txt"
+if expect 0 "allpairs --cost --threads 0" "$BIN" allpairs "$T/g.obj" --sources "$T/one.txt" --cost "$T/fcost.txt" --cost-per-face --dtype float64 --threads 0 --backend threads -o "$T/ap.npy"; then
+    expect 0 "distance --cost (npy)" "$BIN" distance "$T/g.obj" --source "$C" --cost "$T/fcost.txt" --cost-per-face -o "$T/dc.npy"
+    tail -c +129 "$T/ap.npy" >"$T/ap.bin"; tail -c +129 "$T/dc.npy" >"$T/dc.bin"
+    cmp -s "$T/ap.bin" "$T/dc.bin" && [ -s "$T/ap.bin" ] && ok "allpairs --cost row == distance --cost" ||
+        fail "allpairs --cost row differs"
+fi
+expect 1 "allpairs cost count mismatch" "$BIN" allpairs "$T/g.obj" --sources "$T/one.txt" --cost "$T/fcost.txt" -o "$T/x.npy"
+expect 2 "allpairs --threads -1" "$BIN" allpairs "$T/g.obj" --threads -1 -o "$T/x.npy"
+
+# ---- outputs: unique temporary, exclusive create, rename (issue 9 item 8) ----
+# A symlink planted at the old predictable name OUT.partial is not followed.
+echo "precious" >"$T/victim"
+ln -s "$T/victim" "$T/sym.txt.partial"
+expect 0 "distance beside a planted symlink" "$BIN" distance "$T/g.obj" --source "$C" -o "$T/sym.txt" &&
+    { [ "$(cat "$T/victim")" = precious ] && cmp -s "$T/sym.txt" "$T/d.txt" &&
+      ok "planted symlink not followed" || fail "the symlink was followed"; }
+# Two concurrent runs to one target: one complete, valid file, no temporaries.
+"$BIN" generate sphere 5 -o "$T/big.obj" >/dev/null 2>&1
+"$BIN" distance "$T/big.obj" --source 0 -o "$T/ref.txt" 2>/dev/null
+"$BIN" distance "$T/big.obj" --source 0 -o "$T/race.txt" 2>"$T/err1" & p1=$!
+"$BIN" distance "$T/big.obj" --source 0 -o "$T/race.txt" 2>"$T/err2" & p2=$!
+wait $p1; r1=$?; wait $p2; r2=$?
+[ $r1 -eq 0 ] && [ $r2 -eq 0 ] && cmp -s "$T/race.txt" "$T/ref.txt" && ! ls "$T" | grep -q '^race.txt.' &&
+    ok "two concurrent runs: one complete file" || fail "concurrent runs: $r1 $r2 $(cat "$T/err1" "$T/err2")"
+# SIGTERM during a write leaves neither the target nor a temporary.
+"$BIN" allpairs "$T/big.obj" -o "$T/sig.npy" --backend threads --threads 1 --quiet 2>/dev/null & p=$!
+i=0; while ! ls "$T" | grep -q '^sig.npy.' && [ $i -lt 100 ]; do sleep 0.05; i=$((i + 1)); done
+kill -TERM $p; wait $p; r=$?
+[ $r -eq 130 ] && [ ! -e "$T/sig.npy" ] && ! ls "$T" | grep -q '^sig.npy.' && ok "SIGTERM: exit 130, nothing left" ||
+    fail "SIGTERM: exit $r, left: $(ls "$T" | grep sig)"
+
+# ---- an output that is an input is refused (issue 9 item 9) ----
+cp "$T/g.obj" "$T/in.obj"; cp "$T/cost.txt" "$T/incost.txt"
+ln "$T/in.obj" "$T/hard.txt"
+mkdir -p "$T/sub"
+expect 2 "distance -o hard link to the mesh" "$BIN" distance "$T/in.obj" --source "$C" -o "$T/hard.txt"
+expect 2 "path -o MESH (different spelling)" "$BIN" path "$T/in.obj" --source "$C" --target "$C2" -o "$T/sub/../in.obj"
+ln "$T/incost.txt" "$T/costlink.txt"
+expect 2 "output hard-linked to --cost" "$BIN" distance "$T/in.obj" --source "$C" --cost "$T/incost.txt" -o "$T/costlink.txt"
+ln "$T/one.txt" "$T/srclink.npy"
+expect 2 "allpairs output hard-linked to --sources" "$BIN" allpairs "$T/in.obj" --sources "$T/one.txt" -o "$T/srclink.npy"
+ln "$T/in.obj" "$T/meshlink.npy"
+expect 2 "allpairs output hard-linked to the mesh" "$BIN" allpairs "$T/in.obj" -o "$T/meshlink.npy"
+cmp -s "$T/in.obj" "$T/g.obj" && cmp -s "$T/incost.txt" "$T/cost.txt" && ok "inputs untouched" || fail "an input was overwritten"
+
+# ---- not regular files (issue 9 item 10): refused at once, with the path ----
+mkfifo "$T/fifo.obj" "$T/fifo.txt"
+for m in /dev/zero "$T/fifo.obj" "$T/sub"; do
+    expect 1 "info $m refused" timeout 20 "$BIN" info "$m" &&
+        { grep -q "$m" "$T/err" && grep -Eq 'device|FIFO|directory' "$T/err" && ok "message: $(cat "$T/err")" ||
+          fail "message: $(cat "$T/err")"; }
+done
+expect 1 "--cost /dev/zero refused" timeout 20 "$BIN" distance "$T/g.obj" --source 0 --cost /dev/zero -o "$T/x.txt"
+expect 1 "--cost FIFO refused" timeout 20 "$BIN" distance "$T/g.obj" --source 0 --cost "$T/fifo.txt" -o "$T/x.txt"
+expect 1 "--sources FIFO refused" timeout 20 "$BIN" allpairs "$T/g.obj" --sources "$T/fifo.txt" -o "$T/x.npy"
+expect 1 "--sources /dev/zero (.npy) refused" timeout 20 "$BIN" allpairs "$T/g.obj" --sources /dev/zero -o "$T/x.npy"
+
+# ---- .npy --sources (issue 9 item 12) ----
+# npy_file FILE HLEN DICT [DATA]: a version-1 .npy with a declared header length.
+npy_file() { { printf '\223NUMPY\001\000'; printf "\\$(printf %o $(($2 % 256)))\\$(printf %o $(($2 / 256)))"; printf '%s' "$3"; printf "${4:-}"; } >"$1"; }
+# 36 bytes, the header length promising more than the file: read past its buffer before.
+npy_file "$T/s36.npy" 26 "{'shape': (1,), 'descr': '"
+[ "$(wc -c <"$T/s36.npy")" -eq 36 ] || fail "s36.npy is not 36 bytes"
+expect 1 "36-byte --sources .npy" "$BIN" allpairs "$T/g.obj" --sources "$T/s36.npy" -o "$T/x.npy"
+npy_file "$T/s36b.npy" 40 "{'descr': '<i"
+expect 1 "truncated header --sources .npy" "$BIN" allpairs "$T/g.obj" --sources "$T/s36b.npy" -o "$T/x.npy"
+# 128 bytes claiming 1e9 int32 values: refused before allocating 4 GB.
+d="{'descr': '<i4', 'fortran_order': False, 'shape': (1100000000,), }"
+npy_file "$T/s128.npy" 118 "$(printf '%-117s' "$d")
+"
+[ "$(wc -c <"$T/s128.npy")" -eq 128 ] || fail "s128.npy is $(wc -c <"$T/s128.npy") bytes"
+expect 1 "128-byte --sources claiming 1.1e9 ids" "$BIN" allpairs "$T/g.obj" --sources "$T/s128.npy" -o "$T/x.npy" &&
+    { grep -q "needs more bytes" "$T/err" && ok "size checked first" || fail "message: $(cat "$T/err")"; }
+# A 2-D (3, 3) integer array is refused, not taken as 3 sources.
+d="{'descr': '<i4', 'fortran_order': False, 'shape': (3, 3), }"
+npy_file "$T/s33.npy" 118 "$(printf '%-117s' "$d")
+" '\0\0\0\0\1\0\0\0\2\0\0\0\3\0\0\0\4\0\0\0\5\0\0\0\6\0\0\0\7\0\0\0\10\0\0\0'
+expect 1 "(3, 3) --sources refused" "$BIN" allpairs "$T/g.obj" --sources "$T/s33.npy" -o "$T/x.npy" &&
+    { grep -q "1-D" "$T/err" && grep -q "(3, 3)" "$T/err" && ok "2-D message" || fail "message: $(cat "$T/err")"; }
+d="{'descr': '<i4', 'fortran_order': False, 'shape': (3,), }"
+npy_file "$T/s3.npy" 118 "$(printf '%-117s' "$d")
+" "\\0\\0\\0\\0\\$(printf %o "$C")\\0\\0\\0\\2\\0\\0\\0"
+expect 0 "a valid (3,) --sources" "$BIN" allpairs "$T/g.obj" --sources "$T/s3.npy" -o "$T/ok3.npy"
+
+# ---- STL and unsupported formats (issue 10) ----
+awk 'BEGIN { print "solid g" } /^v / { v[++n] = $2 " " $3 " " $4 }
+     /^f / { print "facet normal 0 0 1\nouter loop"; for (i = 2; i <= 4; i++) print "vertex " v[$i]
+             print "endloop\nendfacet" } END { print "endsolid g" }' "$T/g.obj" >"$T/g.stl"
+if expect 0 "distance on an ascii STL" "$BIN" distance "$T/g.stl" --source 0 -o "$T/stl.txt"; then
+    [ "$(wc -l <"$T/stl.txt")" -eq "$NV" ] && ok "STL welded to $NV vertices" || fail "STL vertex count"
+fi
+printf '{"asset": {"version": "2.0"}}' >"$T/m.gltf"
+expect 1 "glTF refused" "$BIN" info "$T/m.gltf" &&
+    { grep -q "OBJ, OFF, PLY (ascii and binary) and STL" "$T/err" && ok "names the formats read" ||
+      fail "message: $(cat "$T/err")"; }
 
 echo "$FAILS failure(s)"
 [ "$FAILS" -eq 0 ]
