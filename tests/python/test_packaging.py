@@ -74,7 +74,7 @@ def test_python_m_meshfmm_passes_exit_codes_and_output(binary, tmp_path):
 
 def test_python_m_meshfmm_sigint_reaches_the_binary(binary, tmp_path):
     """os.execv: the process is the binary, so Ctrl-C is its own (the
-    binary removes its .partial file and exits; no Python traceback)."""
+    binary removes its temporary file and exits; no Python traceback)."""
     src = tmp_path / "g.obj"
     assert run([binary, "generate", "grid", "120", "-o", str(src)]).returncode == 0
     out = tmp_path / "all.npy"
@@ -83,8 +83,9 @@ def test_python_m_meshfmm_sigint_reaches_the_binary(binary, tmp_path):
                             stderr=subprocess.PIPE, text=True)
     try:
         deadline = time.time() + 30
-        partial = Path(str(out) + ".partial")
-        while not partial.exists() and time.time() < deadline and proc.poll() is None:
+        # the binary writes a unique temporary file beside the target (all.npy.XXXXXX)
+        while (not list(tmp_path.glob("all.npy.*")) and time.time() < deadline
+               and proc.poll() is None):
             time.sleep(0.05)
         time.sleep(0.2)
         proc.send_signal(signal.SIGINT)
@@ -96,6 +97,7 @@ def test_python_m_meshfmm_sigint_reaches_the_binary(binary, tmp_path):
     assert proc.returncode != 0
     assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
     assert not out.exists()
+    assert not list(tmp_path.glob("all.npy*"))
 
 
 def test_allpairs_zarr_runs_the_dask_job(tmp_path):

@@ -167,13 +167,10 @@ def test_matrix_rows_equal_single_solves(mesh_case, data):
 # Found by the path property (a jittered 4 x 4 grid): T(7) comes from source 3
 # through a virtual edge (section 4.2), across faces that do not touch vertex
 # 7's neighbours, so T has a local minimum at vertex 7 among its mesh
-# neighbours and backtracking along -grad T stalls there. The core's fix
-# (paths through virtual edges) is issue 9 points 2/3.
-VIRTUAL_EDGE_STALL = ("issue 9 point 2/3: the path stalls at a vertex whose T came "
-                      "through a virtual edge (a local minimum of T among its neighbours)")
+# neighbours and backtracking along -grad T stalled there until paths learned
+# to follow virtual edges through their strips (issue 9 points 2/3).
 
 
-@pytest.mark.xfail(reason=VIRTUAL_EDGE_STALL, raises=RuntimeError, strict=False)
 @pytest.mark.parametrize("straighten", [True, False])
 def test_regression_path_stalls_at_a_virtual_edge_minimum(straighten):
     V, F = random_mesh(0, 4, 4, 0.28, 0.3)
@@ -200,15 +197,7 @@ def test_path_from_target_to_source_no_shorter_than_exact(mesh_case, data):
     t = data.draw(st.integers(0, n - 1).filter(lambda x: x != s), label="target")
     straighten = data.draw(st.booleans(), label="straighten")
     T = m.distance(s)
-    try:
-        path = m.geodesic_path(T, t, sources=[s], straighten=straighten)
-    except RuntimeError as exc:
-        if "local minimum" in str(exc):
-            # known (issue 9 point 2/3): the xfail regression test above holds
-            # one case; the other examples still check the path properties
-            hypothesis.note(f"{VIRTUAL_EDGE_STALL}: {exc}")
-            hypothesis.reject()
-        raise
+    path = m.geodesic_path(T, t, sources=[s], straighten=straighten)
     exact = float(igl.exact_geodesic(V, F.astype(np.int64), VS=np.array([s], dtype=np.int64),
                                      VT=np.array([t], dtype=np.int64))[0])
     diag = float(np.linalg.norm(V.max(0) - V.min(0)))
