@@ -1,0 +1,145 @@
+"""Exact geodesics: meshfmm's mfmm_solve_exact against the stored
+igl.exact_geodesic references (Kirsanov's MMP) and against gdist
+(gdist.compute_gdist, also Kirsanov's MMP), timed per source in one run.
+
+    MESHFMM_LIBRARY=build/libmeshfmm.so python bench/bench_exact.py [mesh ...]
+
+Meshes: ../shared/meshes (or MESHFMM_SHARED_DIR), references in
+../shared/reference. gdist is skipped (and said so) when it does not import
+(its wheels are built against numpy 1; numpy 2 refuses them)."""
+
+from __future__ import annotations
+
+import ctypes
+import json
+import os
+import sys
+import time
+from ctypes import POINTER as P, c_double, c_int32, c_int64, c_size_t, c_void_p
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "bindings" / "python"))
+os.environ.setdefault("MESHFMM_LIBRARY", str(REPO / "build" / "libmeshfmm.so"))
+from meshfmm import _lib  # noqa: E402
+
+SHARED = Path(os.environ.get("MESHFMM_SHARED_DIR", REPO.parent / "shared"))
+MESHES = ["hand_lowres.obj", "beetle.obj", "spot.obj", "wingnut.obj", "fertility_FE_10k.off",
+          "decimated-max.obj", "camelhead.off", "nefertiti-lowres.obj", "stanford-bunny.obj"]
+
+
+class mfmm_exact_options(ctypes.Structure):
+    _fields_ = [("cost", P(c_double)), ("cost_location", _lib.c_enum),
+                ("max_distance", c_double), ("memory_limit", c_size_t)]
+
+
+class mfmm_exact_info(ctypes.Structure):
+    _fields_ = [("n_windows", c_int64), ("n_propagated", c_int64),
+                ("n_pseudo_sources", c_int64), ("peak_windows", c_int64),
+                ("peak_bytes", c_size_t)]
+
+
+lib = _lib.lib
+lib.mfmm_exact_solver_create.restype = _lib.c_enum
+lib.mfmm_exact_solver_create.argtypes = [c_void_p, P(c_void_p)]
+lib.mfmm_exact_solver_destroy.argtypes = [c_void_p]
+lib.mfmm_exact_options_init.argtypes = [P(mfmm_exact_options)]
+lib.mfmm_solve_exact.restype = _lib.c_enum
+lib.mfmm_solve_exact.argtypes = [c_void_p, P(_lib.mfmm_source), c_int32, P(mfmm_exact_options),
+                                 P(c_double), P(mfmm_exact_info), P(_lib.mfmm_error)]
+
+
+def load(path: Path):
+    import igl
+    V, F = igl.read_triangle_mesh(str(path))
+    return np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(F, dtype=np.int32)
+
+
+class Exact:
+    def __init__(self, V, F):
+        self.V, self.F = V, F
+        err = _lib.mfmm_error()
+        self.mesh = c_void_p()
+        st = _lib.mfmm_mesh_create(V.ctypes.data_as(P(c_double)), len(V),
+                                   F.ctypes.data_as(P(c_int32)), len(F), None,
+                                   ctypes.byref(self.mesh), ctypes.byref(err))
+        assert st == 0, err.message
+        self.solver = c_void_p()
+        assert lib.mfmm_exact_solver_create(self.mesh, ctypes.byref(self.solver)) == 0
+
+    def solve(self, source: int, max_distance=np.inf):
+        src = _lib.mfmm_source(source, -1, (c_double * 3)(0, 0, 0), 0.0)
+        opt = mfmm_exact_options()
+        lib.mfmm_exact_options_init(ctypes.byref(opt))
+        opt.max_distance = max_distance
+        out = np.empty(len(self.V))
+        info = mfmm_exact_info()
+        err = _lib.mfmm_error()
+        st = lib.mfmm_solve_exact(self.solver, ctypes.byref(src), 1, ctypes.byref(opt),
+                                  out.ctypes.data_as(P(c_double)), ctypes.byref(info),
+                                  ctypes.byref(err))
+        assert st == 0, err.message
+        return out, info
+
+    def close(self):
+        lib.mfmm_exact_solver_destroy(self.solver)
+        _lib.mfmm_mesh_destroy(self.mesh)
+
+
+def gdist_module():
+    try:
+        import gdist
+        return gdist, None
+    except Exception as exc:  # numpy 2 vs a numpy 1 wheel: ValueError at import
+        return None, f"{type(exc).__name__}: {exc}"
+
+
+def main(names):
+    gd, why = gdist_module()
+    if gd is None:
+        print(f"gdist skipped: it does not import ({why})")
+    rows = []
+    for name in names or MESHES:
+        V, F = load(SHARED / "meshes" / name)
+        ex = Exact(V, F)
+        ref_path = SHARED / "reference" / (Path(name).stem + ".npz")
+        if ref_path.exists():
+            ref = np.load(ref_path)
+            sources, refd = [int(s) for s in ref["sources"]], ref["distances"]
+        else:
+            ref, refd = None, None
+            sources = [int(np.argmax(np.bincount(F.ravel(), minlength=len(V)) > 0))]
+        worst, t_ours, t_gd = 0.0, [], []
+        for i, s in enumerate(sources):
+            t0 = time.perf_counter()
+            d, info = ex.solve(s)
+            t_ours.append(time.perf_counter() - t0)
+            if refd is not None:
+                r = refd[i]
+                fin = np.isfinite(r)
+                assert np.array_equal(fin, np.isfinite(d)), f"{name}: finite sets differ"
+                rel = np.abs(d[fin] - r[fin]) / np.maximum(r[fin], 1e-300)
+                rel[r[fin] == 0] = np.abs(d[fin][r[fin] == 0])
+                worst = max(worst, float(rel.max()))
+            else:
+                assert not np.isnan(d).any()
+            if gd is not None and ref is not None:
+                t0 = time.perf_counter()
+                gd.compute_gdist(V, F, source_indices=np.array([s], dtype=np.int32))
+                t_gd.append(time.perf_counter() - t0)
+        row = {"mesh": name, "nv": len(V), "nf": len(F), "max_rel_err": worst if ref else None,
+               "ours_s": float(np.mean(t_ours)), "windows": info.n_windows,
+               "peak_windows": info.peak_windows, "peak_MB": info.peak_bytes / 2**20,
+               "gdist_s": float(np.mean(t_gd)) if t_gd else None}
+        if t_gd:
+            row["speedup"] = row["gdist_s"] / row["ours_s"]
+        rows.append(row)
+        print(json.dumps(row), flush=True)
+        ex.close()
+    return rows
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

@@ -1,0 +1,731 @@
+/* src/exact/README -- exact polyhedral geodesic distances.
+ *
+ * Algorithm: window propagation of Chen & Han ("Shortest paths on a
+ * polyhedron", SoCG 1990 / IJCGA 1996) as improved by Xin & Wang ("Improving
+ * Chen and Han's algorithm on the discrete geodesic problem", ACM TOG 28(4),
+ * 2009; "ICH"): windows are not kept on edges and never intersected (unlike
+ * Mitchell, Mount & Papadimitriou / Surazhsky et al. 2005, "MMP", which
+ * Kirsanov's library implements); instead every window is checked against
+ * the best distances known at the three vertices of the triangle it lies in,
+ * and dropped when a path through one of those vertices is shorter at every
+ * point of it. Windows and pseudo-source (vertex) events share one priority
+ * queue ordered by their least distance (ICH's queue), so vertex distances
+ * are near their final values when they are used to prune.
+ *
+ * A window lies on an edge, seen from the face it is about to cross: an
+ * interval [b0, b1] of the edge, its pseudo-source I unfolded into the
+ * edge's plane (px, py), py <= 0 on the far side from that face, and sigma,
+ * the distance from the sources to I. The distance it gives a point X of
+ * the interval is sigma + |I X|. Crossing the face it may see the opposite
+ * vertex C (then d(C) <= sigma + |I C|) and splits into at most two children
+ * on the face's other edges ("one window, two children"). A vertex through
+ * which a shortest path may bend (a source, a saddle with angle sum > 2 pi,
+ * a boundary or non-manifold vertex, a vertex of a zero-area face) becomes a
+ * pseudo-source when its distance improves: it starts a window on the
+ * opposite edge of every face around it.
+ *
+ * Pruning (sound, derived for this code): for a window on edge PQ of face
+ * PQR, with D(X) = sigma + |I X|,
+ *   - |I X| - |P X| does not increase as X moves away from P along the edge,
+ *     so D(X) > d(P) + |P X| at the end far from P implies it on the whole
+ *     window: drop it (likewise for Q at the end near P);
+ *   - for R: min D > d(R) + max(|R E0|, |R E1|) (|R X| is convex on the
+ *     segment): drop it.
+ * A child is checked against the face it was born in, and again when it is
+ * taken from the queue, against the face it is about to cross (with the
+ * distances known by then). Dropping a window is safe in any order: every
+ * point of it has a shorter path through a vertex, so no shortest path
+ * crosses it. Vertex distances are min over windows that reach them.
+ *
+ * Sources: a vertex source is a pseudo-source with its value; a point in a
+ * face (on an edge too) starts a window on each edge of its face. Boundary
+ * and non-manifold edges (face_neighbor -1) and edges of zero-area faces are
+ * walls. max_distance (and the radius of mfmm_exact_patch) drops every
+ * window and event beyond it, so the work grows with the area reached.
+ *
+ * Memory: per-mesh tables (edge lengths, the opposite corner unfolded into
+ * each edge's frame, neighbour corners: 61 bytes per face; 26 per vertex),
+ * and a pool of windows with a binary heap of (key, index) that grow by
+ * doubling, bounded by memory_limit; no recursion. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "exact/exact.h"
+#include "core/mesh.h"
+#include "core/solve.h"
+
+#define EX_TWO_PI 6.283185307179586476925286766559
+/* a window narrower than this fraction of its edge is dropped */
+#define EX_MIN_WIDTH 1e-13
+/* a point of an edge this close (relative) to a window's end is in it */
+#define EX_POS_TOL 1e-12
+/* a vertex whose angle sum exceeds 2 pi by this much is a saddle */
+#define EX_SADDLE_TOL 1e-12
+
+typedef struct ex_window {
+    double b0, b1;   /* interval on the edge, from its first vertex */
+    double px, py;   /* pseudo-source in the edge's frame, py <= 0 */
+    double sigma;    /* distance at the pseudo-source */
+    int32_t he;      /* 3 f + k: the edge opposite corner k of face f, crossing f;
+                        the next free slot when in the free list */
+    int32_t pad;
+} ex_window;
+
+typedef struct ex_entry {
+    double key;
+    int32_t idx;     /* >= 0: a window; < 0: vertex -idx-1 as a pseudo-source */
+    int32_t pad;
+} ex_entry;
+
+struct mfmm_exact_solver {
+    const mfmm_mesh *mesh;
+    int32_t nv, nf;
+    const int32_t *faces;
+    const int32_t *vf_offset, *vf_corner;
+    /* per half-edge 3f+k (the edge opposite corner k of face f, from corner
+     * k+1 to k+2): its length, corner k in its frame (x along the edge,
+     * y > 0), and the same edge in the face across it (3g+m, -1 at a wall)
+     * with whether it runs the other way there */
+    double *len, *cx, *cy;
+    int32_t *across;
+    uint8_t *flip;
+    uint8_t *skip;     /* (nf,) zero-area faces */
+    uint8_t *pseudo;   /* (nv,) vertices that may bend a path */
+    double *d;         /* (nv,) best distance so far, +inf untouched */
+    double *emitted;   /* (nv,) the distance a pseudo-source was started with */
+    int32_t *touched;  /* vertices with finite d, in order of first touch */
+    int32_t n_touched;
+    double *patch_d;   /* (nv,) distances of mfmm_exact_patch */
+    /* the queue */
+    ex_window *pool;
+    int32_t pool_cap, pool_used, free_head;
+    ex_entry *heap;
+    int32_t heap_cap, heap_n;
+    size_t fixed_bytes, memory_limit, peak_bytes;
+    double max_d;
+    int failed; /* MFMM_ERR_MEMORY_LIMIT or MFMM_ERR_OUT_OF_MEMORY once a growth fails */
+    int64_t n_windows, n_propagated, n_pseudo, peak_windows;
+};
+
+/* ------------------------------------------------------------- workspace */
+
+void mfmm_exact_options_init(mfmm_exact_options *options)
+{
+    if (!options)
+        return;
+    options->cost = NULL;
+    options->cost_location = MFMM_COST_NONE;
+    options->max_distance = INFINITY;
+    options->memory_limit = 0;
+}
+
+void mfmm_exact_ws_destroy(mfmm_exact_ws *ws)
+{
+    if (!ws)
+        return;
+    free(ws->len);
+    free(ws->cx);
+    free(ws->cy);
+    free(ws->across);
+    free(ws->flip);
+    free(ws->skip);
+    free(ws->pseudo);
+    free(ws->d);
+    free(ws->emitted);
+    free(ws->touched);
+    free(ws->patch_d);
+    free(ws->pool);
+    free(ws->heap);
+    free(ws);
+}
+
+void mfmm_exact_solver_destroy(mfmm_exact_solver *solver)
+{
+    mfmm_exact_ws_destroy(solver);
+}
+
+static double vdist(const double *p, const double *q)
+{
+    double a = p[0] - q[0], b = p[1] - q[1], c = p[2] - q[2];
+    return sqrt(a * a + b * b + c * c);
+}
+
+mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
+{
+    if (!out)
+        return MFMM_ERR_NULL_POINTER;
+    *out = NULL;
+    if (!mesh)
+        return MFMM_ERR_NULL_POINTER;
+    if (mesh->nf > INT32_MAX / 3 - 1)
+        return MFMM_ERR_BAD_COUNT;
+    mfmm_exact_ws *ws = calloc(1, sizeof *ws);
+    if (!ws)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    size_t nv = (size_t)mesh->nv, nf = (size_t)mesh->nf, nh = 3 * nf;
+    ws->mesh = mesh;
+    ws->nv = mesh->nv;
+    ws->nf = mesh->nf;
+    ws->faces = mesh->faces;
+    ws->vf_offset = mesh->vertex_face_offset;
+    ws->vf_corner = mesh->vertex_face_corner;
+    ws->len = malloc(nh * sizeof *ws->len);
+    ws->cx = malloc(nh * sizeof *ws->cx);
+    ws->cy = malloc(nh * sizeof *ws->cy);
+    ws->across = malloc(nh * sizeof *ws->across);
+    ws->flip = malloc(nh * sizeof *ws->flip);
+    ws->skip = malloc(nf * sizeof *ws->skip);
+    ws->pseudo = calloc(nv ? nv : 1, sizeof *ws->pseudo);
+    ws->d = malloc((nv ? nv : 1) * sizeof *ws->d);
+    ws->emitted = malloc((nv ? nv : 1) * sizeof *ws->emitted);
+    ws->touched = malloc((nv ? nv : 1) * sizeof *ws->touched);
+    ws->patch_d = malloc((nv ? nv : 1) * sizeof *ws->patch_d);
+    double *angle = calloc(nv ? nv : 1, sizeof *angle);
+    if (!ws->len || !ws->cx || !ws->cy || !ws->across || !ws->flip || !ws->skip || !ws->pseudo ||
+        !ws->d || !ws->emitted || !ws->touched || !ws->patch_d || !angle) {
+        free(angle);
+        mfmm_exact_ws_destroy(ws);
+        return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    ws->fixed_bytes = sizeof *ws + nh * (3 * sizeof(double) + sizeof(int32_t) + 1) + nf +
+                      nv * (1 + 3 * sizeof(double) + sizeof(int32_t));
+    const double *X = mesh->xyz;
+    const int32_t *F = mesh->faces;
+    for (size_t f = 0; f < nf; f++) {
+        const int32_t *fv = F + 3 * f;
+        int bad = mesh->degenerate[f] != 0;
+        for (int k = 0; k < 3; k++)
+            ws->len[3 * f + k] = vdist(X + 3 * (size_t)fv[(k + 1) % 3], X + 3 * (size_t)fv[(k + 2) % 3]);
+        for (int k = 0; k < 3; k++) {
+            double L = ws->len[3 * f + k], la = ws->len[3 * f + (k + 2) % 3],
+                   lb = ws->len[3 * f + (k + 1) % 3];
+            /* corner k: at distance la from the edge's first vertex, lb from its second */
+            double x = (L * L + la * la - lb * lb) / (2.0 * L);
+            double y2 = la * la - x * x;
+            double y = y2 > 0.0 ? sqrt(y2) : 0.0;
+            ws->cx[3 * f + k] = x;
+            ws->cy[3 * f + k] = y;
+            if (!(L > 0.0) || !(y > 0.0) || !isfinite(x) || !isfinite(y))
+                bad = 1;
+        }
+        ws->skip[f] = (uint8_t)bad;
+    }
+    for (size_t f = 0; f < nf; f++) {
+        const int32_t *fv = F + 3 * f;
+        for (int k = 0; k < 3; k++) {
+            size_t h = 3 * f + k;
+            int32_t g = mesh->face_neighbor[h];
+            ws->across[h] = -1;
+            ws->flip[h] = 0;
+            if (g < 0 || ws->skip[f] || ws->skip[g])
+                continue;
+            int32_t a = fv[(k + 1) % 3], b = fv[(k + 2) % 3];
+            const int32_t *gv = F + 3 * (size_t)g;
+            for (int m = 0; m < 3; m++) {
+                if (gv[m] != a && gv[m] != b) {
+                    ws->across[h] = 3 * g + m;
+                    ws->flip[h] = gv[(m + 1) % 3] != a;
+                }
+            }
+        }
+    }
+    /* pseudo-source candidates: saddles, vertices at a wall, and vertices of
+     * zero-area faces; unreferenced vertices have nothing to start */
+    for (size_t f = 0; f < nf; f++) {
+        const int32_t *fv = F + 3 * f;
+        if (ws->skip[f]) {
+            for (int k = 0; k < 3; k++)
+                ws->pseudo[fv[k]] = 1;
+            continue;
+        }
+        for (int k = 0; k < 3; k++) {
+            /* angle at corner k, seen in the frame of the opposite edge */
+            double x = ws->cx[3 * f + k], y = ws->cy[3 * f + k], L = ws->len[3 * f + k];
+            angle[fv[k]] += atan2(y * L, y * y - x * (L - x));
+            if (ws->across[3 * f + k] < 0) {
+                ws->pseudo[fv[(k + 1) % 3]] = 1;
+                ws->pseudo[fv[(k + 2) % 3]] = 1;
+            }
+        }
+    }
+    for (size_t v = 0; v < nv; v++) {
+        if (angle[v] > EX_TWO_PI + EX_SADDLE_TOL)
+            ws->pseudo[v] = 1;
+        ws->d[v] = INFINITY;
+        ws->emitted[v] = INFINITY;
+    }
+    free(angle);
+    ws->free_head = -1;
+    ws->max_d = INFINITY;
+    ws->peak_bytes = ws->fixed_bytes;
+    *out = ws;
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_exact_solver_create(const mfmm_mesh *mesh, mfmm_exact_solver **out)
+{
+    return mfmm_exact_ws_create(mesh, out);
+}
+
+/* ----------------------------------------------------------------- queue */
+
+static size_t ex_bytes(const mfmm_exact_ws *ws, int32_t pool_cap, int32_t heap_cap)
+{
+    return ws->fixed_bytes + (size_t)pool_cap * sizeof(ex_window) +
+           (size_t)heap_cap * sizeof(ex_entry);
+}
+
+/* Grows pool or heap (which = 0, 1) by doubling, within memory_limit. */
+static int ex_grow(mfmm_exact_ws *ws, int which)
+{
+    int32_t cap = which ? ws->heap_cap : ws->pool_cap;
+    if (cap >= INT32_MAX / 2) {
+        ws->failed = MFMM_ERR_MEMORY_LIMIT;
+        return 0;
+    }
+    int32_t ncap = cap ? 2 * cap : 1024;
+    size_t bytes = which ? ex_bytes(ws, ws->pool_cap, ncap) : ex_bytes(ws, ncap, ws->heap_cap);
+    if (ws->memory_limit && bytes > ws->memory_limit) {
+        /* the largest size that fits, if it is any larger */
+        size_t room = ws->memory_limit - ex_bytes(ws, which ? ws->pool_cap : 0,
+                                                  which ? 0 : ws->heap_cap);
+        size_t each = which ? sizeof(ex_entry) : sizeof(ex_window);
+        if (ws->memory_limit < ex_bytes(ws, which ? ws->pool_cap : 0, which ? 0 : ws->heap_cap) ||
+            room / each <= (size_t)cap) {
+            ws->failed = MFMM_ERR_MEMORY_LIMIT;
+            return 0;
+        }
+        ncap = (int32_t)(room / each);
+        bytes = which ? ex_bytes(ws, ws->pool_cap, ncap) : ex_bytes(ws, ncap, ws->heap_cap);
+    }
+    if (which) {
+        ex_entry *p = realloc(ws->heap, (size_t)ncap * sizeof *p);
+        if (!p) {
+            ws->failed = MFMM_ERR_OUT_OF_MEMORY;
+            return 0;
+        }
+        ws->heap = p;
+        ws->heap_cap = ncap;
+    } else {
+        ex_window *p = realloc(ws->pool, (size_t)ncap * sizeof *p);
+        if (!p) {
+            ws->failed = MFMM_ERR_OUT_OF_MEMORY;
+            return 0;
+        }
+        ws->pool = p;
+        ws->pool_cap = ncap;
+    }
+    if (bytes > ws->peak_bytes)
+        ws->peak_bytes = bytes;
+    return 1;
+}
+
+static int ex_push(mfmm_exact_ws *ws, double key, int32_t idx)
+{
+    if (ws->heap_n == ws->heap_cap && !ex_grow(ws, 1))
+        return 0;
+    ex_entry *h = ws->heap;
+    int32_t i = ws->heap_n++;
+    while (i > 0) {
+        int32_t p = (i - 1) >> 1;
+        if (!(key < h[p].key))
+            break;
+        h[i] = h[p];
+        i = p;
+    }
+    h[i].key = key;
+    h[i].idx = idx;
+    return 1;
+}
+
+static ex_entry ex_pop(mfmm_exact_ws *ws)
+{
+    ex_entry *h = ws->heap;
+    ex_entry top = h[0], last = h[--ws->heap_n];
+    int32_t n = ws->heap_n, i = 0;
+    for (;;) {
+        int32_t c = 2 * i + 1;
+        if (c >= n)
+            break;
+        if (c + 1 < n && h[c + 1].key < h[c].key)
+            c++;
+        if (!(h[c].key < last.key))
+            break;
+        h[i] = h[c];
+        i = c;
+    }
+    if (n > 0)
+        h[i] = last;
+    return top;
+}
+
+static int32_t ex_alloc_window(mfmm_exact_ws *ws)
+{
+    int32_t i = ws->free_head;
+    if (i >= 0) {
+        ws->free_head = ws->pool[i].he;
+        return i;
+    }
+    if (ws->pool_used == ws->pool_cap && !ex_grow(ws, 0))
+        return -1;
+    return ws->pool_used++;
+}
+
+static void ex_free_window(mfmm_exact_ws *ws, int32_t i)
+{
+    ws->pool[i].he = ws->free_head;
+    ws->free_head = i;
+}
+
+/* ------------------------------------------------------------ propagation */
+
+static void ex_update(mfmm_exact_ws *ws, int32_t v, double dist, int force)
+{
+    if (!(dist < ws->d[v]))
+        return;
+    if (ws->d[v] == INFINITY)
+        ws->touched[ws->n_touched++] = v;
+    ws->d[v] = dist;
+    if ((ws->pseudo[v] || force) && dist <= ws->max_d)
+        ex_push(ws, dist, -v - 1);
+}
+
+/* A window on half-edge h = 3f+k in f's frame (I on f's side: iy >= 0),
+ * interval [s0, s1], leaving f: updates the vertices it reaches, checks it
+ * against f's vertices, and queues it in the face across, in that face's
+ * frame. */
+static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double ix, double iy,
+                    double sigma)
+{
+    const int32_t *fv = ws->faces + 3 * (size_t)(h / 3);
+    int k = h % 3;
+    int32_t va = fv[k == 2 ? 0 : k + 1], vb = fv[k == 0 ? 2 : k - 1], vr = fv[k];
+    double L = ws->len[h];
+    if (s0 < 0.0)
+        s0 = 0.0;
+    if (s1 > L)
+        s1 = L;
+    double dx0 = ix - s0, dx1 = ix - s1, iy2 = iy * iy;
+    double D0 = sigma + sqrt(dx0 * dx0 + iy2), D1 = sigma + sqrt(dx1 * dx1 + iy2);
+    if (s0 <= EX_POS_TOL * L)
+        ex_update(ws, va, D0, 0);
+    if (s1 >= L - EX_POS_TOL * L)
+        ex_update(ws, vb, D1, 0);
+    int32_t g = ws->across[h];
+    if (g < 0 || !(s1 - s0 > EX_MIN_WIDTH * L))
+        return;
+    double key = (ix >= s0 && ix <= s1) ? sigma + iy : (D0 < D1 ? D0 : D1);
+    if (key > ws->max_d)
+        return;
+    /* pruning against the face the window leaves */
+    if (D1 > ws->d[va] + s1 || D0 > ws->d[vb] + (L - s0))
+        return;
+    double rx = ws->cx[h], ry = ws->cy[h];
+    double r0 = (rx - s0) * (rx - s0), r1 = (rx - s1) * (rx - s1);
+    if (key > ws->d[vr] + sqrt((r0 > r1 ? r0 : r1) + ry * ry))
+        return;
+    int32_t wi = ex_alloc_window(ws);
+    if (wi < 0)
+        return;
+    ex_window *w = ws->pool + wi;
+    if (ws->flip[h]) {
+        w->b0 = L - s1;
+        w->b1 = L - s0;
+        w->px = L - ix;
+    } else {
+        w->b0 = s0;
+        w->b1 = s1;
+        w->px = ix;
+    }
+    w->py = -iy;
+    w->sigma = sigma;
+    w->he = g;
+    if (!ex_push(ws, key, wi)) {
+        ex_free_window(ws, wi);
+        return;
+    }
+    ws->n_windows++;
+    if (ws->heap_n > ws->peak_windows)
+        ws->peak_windows = ws->heap_n;
+}
+
+/* Where the line from I through X = (x, 0) meets the line O + s u (s). */
+static double ex_hit(double ox, double oy, double ux, double uy, double ix, double iy, double x,
+                     double len)
+{
+    double xx = x - ox, xy = -oy, jx = ix - ox, jy = iy - oy;
+    double num = xx * jy - xy * jx;
+    double den = (xx - jx) * uy - (xy - jy) * ux;
+    double s = num / den;
+    if (!(s >= 0.0))
+        s = 0.0;
+    if (!(s <= len))
+        s = len;
+    return s;
+}
+
+static void ex_propagate(mfmm_exact_ws *ws, const ex_window *w)
+{
+    int32_t h = w->he;
+    int32_t f = h / 3;
+    int m = h % 3;
+    const int32_t *fv = ws->faces + 3 * (size_t)f;
+    int32_t va = fv[m == 2 ? 0 : m + 1], vb = fv[m == 0 ? 2 : m - 1], vc = fv[m];
+    double L = ws->len[h], cx = ws->cx[h], cy = ws->cy[h];
+    double b0 = w->b0, b1 = w->b1, px = w->px, py = w->py, sigma = w->sigma;
+    /* pruning against the face it crosses, with today's distances */
+    double dx0 = px - b0, dx1 = px - b1, py2 = py * py;
+    double D0 = sigma + sqrt(dx0 * dx0 + py2), D1 = sigma + sqrt(dx1 * dx1 + py2);
+    if (D1 > ws->d[va] + b1 || D0 > ws->d[vb] + (L - b0))
+        return;
+    double key = (px >= b0 && px <= b1) ? sigma - py : (D0 < D1 ? D0 : D1);
+    double r0 = (cx - b0) * (cx - b0), r1 = (cx - b1) * (cx - b1);
+    if (key > ws->d[vc] + sqrt((r0 > r1 ? r0 : r1) + cy * cy))
+        return;
+    ws->n_propagated++;
+    /* where the ray from I through C crosses the edge */
+    double tc = px + (cx - px) * (-py) / (cy - py);
+    double tol = EX_POS_TOL * L;
+    if (tc >= b0 - tol && tc <= b1 + tol) {
+        double ex = cx - px, ey = cy - py;
+        ex_update(ws, vc, sigma + sqrt(ex * ex + ey * ey), 0);
+    }
+    int m1 = m == 2 ? 0 : m + 1, m2 = m == 0 ? 2 : m - 1;
+    if (b0 < tc) {
+        /* left child: edge C -> A (half-edge 3f+m2), rays through [b0, min(b1, tc)] */
+        int32_t hl = 3 * f + m2;
+        double lac = ws->len[hl];
+        double ux = -cx / lac, uy = -cy / lac;
+        double s_hi = b0 <= 0.0 ? lac : ex_hit(cx, cy, ux, uy, px, py, b0, lac);
+        double s_lo = tc <= b1 ? 0.0 : ex_hit(cx, cy, ux, uy, px, py, b1, lac);
+        double qx = px - cx, qy = py - cy;
+        double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
+        ex_emit(ws, hl, s_lo, s_hi, ix, iy > 0.0 ? iy : 0.0, sigma);
+    }
+    if (b1 > tc) {
+        /* right child: edge B -> C (half-edge 3f+m1), rays through [max(b0, tc), b1] */
+        int32_t hr = 3 * f + m1;
+        double lbc = ws->len[hr];
+        double ux = (cx - L) / lbc, uy = cy / lbc;
+        double s_lo = b1 >= L ? 0.0 : ex_hit(L, 0.0, ux, uy, px, py, b1, lbc);
+        double s_hi = tc >= b0 ? lbc : ex_hit(L, 0.0, ux, uy, px, py, b0, lbc);
+        double qx = px - L, qy = py;
+        double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
+        ex_emit(ws, hr, s_lo, s_hi, ix, iy > 0.0 ? iy : 0.0, sigma);
+    }
+}
+
+/* A pseudo-source at v with distance dv: a window on the far edge of every
+ * face around v. */
+static void ex_start_vertex(mfmm_exact_ws *ws, int32_t v, double dv)
+{
+    ws->n_pseudo++;
+    for (int32_t i = ws->vf_offset[v]; i < ws->vf_offset[v + 1]; i++) {
+        int32_t c = ws->vf_corner[i];
+        if (ws->skip[c / 3])
+            continue;
+        ex_emit(ws, c, 0.0, ws->len[c], ws->cx[c], ws->cy[c], dv);
+    }
+}
+
+/* A point source in face f (barycentric w, not at a corner): a window on
+ * each of f's edges. */
+static void ex_start_face(mfmm_exact_ws *ws, int32_t f, const double *w, double value)
+{
+    ws->n_pseudo++;
+    for (int k = 0; k < 3; k++) {
+        int32_t h = 3 * f + k;
+        /* corners k+1 at (0,0), k+2 at (L,0), k at (cx,cy) */
+        double ix = w[(k + 2) % 3] * ws->len[h] + w[k] * ws->cx[h];
+        double iy = w[k] * ws->cy[h];
+        ex_emit(ws, h, 0.0, ws->len[h], ix, iy, value);
+    }
+}
+
+/* Clears the previous run's vertex state (only what it touched). */
+static void ex_reset(mfmm_exact_ws *ws)
+{
+    for (int32_t i = 0; i < ws->n_touched; i++) {
+        int32_t v = ws->touched[i];
+        ws->d[v] = INFINITY;
+        ws->emitted[v] = INFINITY;
+    }
+    ws->n_touched = 0;
+    ws->heap_n = 0;
+    ws->pool_used = 0;
+    ws->free_head = -1;
+    ws->failed = 0;
+    ws->n_windows = ws->n_propagated = ws->n_pseudo = ws->peak_windows = 0;
+    ws->peak_bytes = ex_bytes(ws, ws->pool_cap, ws->heap_cap);
+}
+
+/* The propagation from checked sources; d[] holds the result for touched
+ * vertices (values > max_d are not final). */
+static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t n_sources,
+                          double max_d, size_t memory_limit)
+{
+    ex_reset(ws);
+    ws->max_d = max_d;
+    ws->memory_limit = memory_limit;
+    if (memory_limit && ws->fixed_bytes > memory_limit)
+        return MFMM_ERR_MEMORY_LIMIT;
+    for (int32_t i = 0; i < n_sources; i++) {
+        const mfmm_source *s = sources + i;
+        if (s->face < 0) {
+            ex_update(ws, s->vertex, s->value, 1);
+            continue;
+        }
+        const int32_t *fv = ws->faces + 3 * (size_t)s->face;
+        double w[3], sum = 0.0;
+        for (int k = 0; k < 3; k++) {
+            w[k] = s->bary[k] > 0.0 ? s->bary[k] : 0.0;
+            sum += w[k];
+        }
+        int corner = -1;
+        for (int k = 0; k < 3; k++) {
+            w[k] /= sum;
+            if (w[k] >= 1.0 - 1e-12)
+                corner = k;
+        }
+        if (corner >= 0) {
+            /* at a corner: a vertex source, offset by the (tiny) distance */
+            const double *X = ws->mesh->xyz;
+            double p[3] = {0.0, 0.0, 0.0};
+            for (int k = 0; k < 3; k++)
+                for (int e = 0; e < 3; e++)
+                    p[e] += w[k] * X[3 * (size_t)fv[k] + e];
+            ex_update(ws, fv[corner], s->value + vdist(p, X + 3 * (size_t)fv[corner]), 1);
+            continue;
+        }
+        ex_start_face(ws, s->face, w, s->value);
+    }
+    while (ws->heap_n > 0 && !ws->failed) {
+        ex_entry e = ex_pop(ws);
+        if (e.idx < 0) {
+            int32_t v = -e.idx - 1;
+            if (e.key != ws->d[v] || !(ws->emitted[v] > e.key))
+                continue;
+            ws->emitted[v] = e.key;
+            ex_start_vertex(ws, v, e.key);
+        } else {
+            ex_window w = ws->pool[e.idx];
+            ex_free_window(ws, e.idx);
+            ex_propagate(ws, &w);
+        }
+    }
+    return ws->failed ? (mfmm_status)ws->failed : MFMM_OK;
+}
+
+static void ex_fill_info(const mfmm_exact_ws *ws, mfmm_exact_info *info)
+{
+    if (!info)
+        return;
+    info->n_windows = ws->n_windows;
+    info->n_propagated = ws->n_propagated;
+    info->n_pseudo_sources = ws->n_pseudo;
+    info->peak_windows = ws->peak_windows;
+    info->peak_bytes = ws->peak_bytes;
+}
+
+/* Sources as mfmm_solve checks them, and not in a face this solver skips. */
+static mfmm_status ex_check_sources(const mfmm_exact_ws *ws, const mfmm_source *sources,
+                                    int32_t n_sources, mfmm_error *err)
+{
+    for (int32_t i = 0; i < n_sources; i++) {
+        mfmm_status st = mfmm_check_source(ws->mesh, sources + i, i, err);
+        if (st != MFMM_OK)
+            return st;
+        if (sources[i].face >= 0 && ws->skip[sources[i].face])
+            return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, i,
+                             "source %ld lies on face %ld, which has zero area", (long)i,
+                             (long)sources[i].face);
+    }
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_solve_exact(mfmm_exact_solver *solver, const mfmm_source *sources,
+                             int32_t n_sources, const mfmm_exact_options *options,
+                             double *distances, mfmm_exact_info *info, mfmm_error *err)
+{
+    mfmm_ok(err);
+    if (info)
+        memset(info, 0, sizeof *info);
+    if (!solver || !distances)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "%s is NULL",
+                         !solver ? "solver" : "distances");
+    for (int32_t v = 0; v < solver->nv; v++)
+        distances[v] = INFINITY;
+    if (!sources)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "sources is NULL");
+    if (n_sources < 1)
+        return mfmm_fail(err, MFMM_ERR_BAD_COUNT, -1, "n_sources is %ld; at least one is needed",
+                         (long)n_sources);
+    mfmm_exact_options defaults;
+    if (!options) {
+        mfmm_exact_options_init(&defaults);
+        options = &defaults;
+    }
+    if (options->cost)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "mfmm_solve_exact computes geodesic distance (F = 1) and takes no cost; "
+                         "use mfmm_solve for weighted distances");
+    double max_d = options->max_distance;
+    if (isnan(max_d) || max_d < 0.0)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "max_distance is %g; it must be >= 0",
+                         max_d);
+    mfmm_status st = ex_check_sources(solver, sources, n_sources, err);
+    if (st != MFMM_OK)
+        return st;
+    st = ex_run(solver, sources, n_sources, max_d, options->memory_limit);
+    ex_fill_info(solver, info);
+    if (st != MFMM_OK) {
+        if (st == MFMM_ERR_MEMORY_LIMIT)
+            return mfmm_fail(err, st, -1,
+                             "the exact solve needed more than memory_limit = %zu bytes "
+                             "(%lld windows queued)",
+                             options->memory_limit, (long long)solver->heap_n);
+        return mfmm_fail(err, st, -1, "out of memory for the window queue");
+    }
+    for (int32_t i = 0; i < solver->n_touched; i++) {
+        int32_t v = solver->touched[i];
+        double dv = solver->d[v];
+        distances[v] = dv <= max_d ? dv : INFINITY;
+    }
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_exact_patch(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t n_sources,
+                             double radius, size_t memory_limit, int32_t *n_vertices,
+                             const int32_t **vertices, const double **distances,
+                             mfmm_exact_info *info)
+{
+    if (!ws || !sources || !n_vertices || !vertices || !distances)
+        return MFMM_ERR_NULL_POINTER;
+    *n_vertices = 0;
+    *vertices = ws->touched;
+    *distances = ws->patch_d;
+    if (n_sources < 1)
+        return MFMM_ERR_BAD_COUNT;
+    if (isnan(radius) || radius < 0.0)
+        return MFMM_ERR_BAD_ARGUMENT;
+    mfmm_status st = ex_run(ws, sources, n_sources, radius, memory_limit);
+    ex_fill_info(ws, info);
+    if (st != MFMM_OK)
+        return st;
+    /* touched vertices within the radius, moved to the front of touched
+     * (the rest stay behind them, so the next reset still clears them) */
+    int32_t n = 0;
+    for (int32_t i = 0; i < ws->n_touched; i++) {
+        int32_t v = ws->touched[i];
+        if (ws->d[v] <= radius) {
+            ws->touched[i] = ws->touched[n];
+            ws->touched[n] = v;
+            ws->patch_d[n] = ws->d[v];
+            n++;
+        }
+    }
+    *n_vertices = n;
+    return MFMM_OK;
+}
