@@ -51,12 +51,18 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <stdio.h>
 
 #include "exact/exact.h"
 #include "core/mesh.h"
 #include "core/solve.h"
 
+#define EX_PI 3.14159265358979323846264338328
 #define EX_TWO_PI 6.283185307179586476925286766559
+/* the shadow of a saddle is widened by this angle on each side */
+#define EX_SHADOW_MARGIN 1e-7
+/* distances equal to this relative amount are ties */
+#define EX_TIE 1e-12
 /* a window narrower than this fraction of its edge is dropped */
 #define EX_MIN_WIDTH 1e-13
 /* a point of an edge this close (relative) to a window's end is in it */
@@ -93,6 +99,14 @@ struct mfmm_exact_solver {
     uint8_t *flip;
     uint8_t *skip;     /* (nf,) zero-area faces */
     uint8_t *pseudo;   /* (nv,) vertices that may bend a path */
+    /* the fan of corners around a vertex, by angle: corner 3f+k (at v = f[k])
+     * spans the angles between fan_a0 (the direction to f[k+1]) and
+     * fan_a0 + fan_sgn * angle (to f[k+2]); fan_total (nv) is the angle sum,
+     * NaN where the fan is not one closed disk (walls, zero-area faces,
+     * non-manifold vertices): those start windows in every direction */
+    double *angle, *fan_a0, *fan_total;
+    int8_t *fan_sgn;
+    double *in_angle;  /* (nv,) direction (fan angle) back along the path that gave d */
     double *d;         /* (nv,) best distance so far, +inf untouched */
     double *emitted;   /* (nv,) the distance a pseudo-source was started with */
     int32_t *touched;  /* vertices with finite d, in order of first touch */
@@ -132,6 +146,11 @@ void mfmm_exact_ws_destroy(mfmm_exact_ws *ws)
     free(ws->flip);
     free(ws->skip);
     free(ws->pseudo);
+    free(ws->angle);
+    free(ws->fan_a0);
+    free(ws->fan_total);
+    free(ws->fan_sgn);
+    free(ws->in_angle);
     free(ws->d);
     free(ws->emitted);
     free(ws->touched);
@@ -150,6 +169,74 @@ static double vdist(const double *p, const double *q)
 {
     double a = p[0] - q[0], b = p[1] - q[1], c = p[2] - q[2];
     return sqrt(a * a + b * b + c * c);
+}
+
+static int ex_corner_of(const int32_t *fv, int32_t v)
+{
+    return fv[0] == v ? 0 : fv[1] == v ? 1 : fv[2] == v ? 2 : -1;
+}
+
+/* Walks the fan of every vertex through the faces across its edges, giving
+ * each corner its angles (fan_a0, fan_sgn) and each vertex its angle sum;
+ * NaN for vertices whose corners do not form one closed disk. */
+static mfmm_status ex_build_fans(mfmm_exact_ws *ws)
+{
+    const int32_t *F = ws->faces;
+    for (int32_t v = 0; v < ws->nv; v++) {
+        int32_t n_c = ws->vf_offset[v + 1] - ws->vf_offset[v];
+        ws->fan_total[v] = NAN;
+        ws->in_angle[v] = NAN;
+        if (n_c < 3)
+            continue;
+        int ok = 1;
+        for (int32_t i = ws->vf_offset[v]; i < ws->vf_offset[v + 1]; i++)
+            if (ws->skip[ws->vf_corner[i] / 3])
+                ok = 0;
+        if (!ok)
+            continue;
+        int32_t c0 = ws->vf_corner[ws->vf_offset[v]];
+        int32_t f = c0 / 3, k = c0 % 3;
+        int32_t ent = F[3 * (size_t)f + (k + 1) % 3];
+        double e = 0.0;
+        int32_t steps = 0;
+        for (;;) {
+            const int32_t *fv = F + 3 * (size_t)f;
+            int32_t c = 3 * f + k, far;
+            int kent;
+            if (fv[(k + 1) % 3] == ent) {
+                ws->fan_a0[c] = e;
+                ws->fan_sgn[c] = 1;
+                far = fv[(k + 2) % 3];
+                kent = (k + 1) % 3;
+            } else {
+                ws->fan_a0[c] = e + ws->angle[c];
+                ws->fan_sgn[c] = -1;
+                far = fv[(k + 1) % 3];
+                kent = (k + 2) % 3;
+            }
+            e += ws->angle[c];
+            steps++;
+            int32_t nx = ws->across[3 * f + kent];
+            if (nx < 0 || steps > n_c) {
+                ok = 0;
+                break;
+            }
+            f = nx / 3;
+            k = ex_corner_of(F + 3 * (size_t)f, v);
+            ent = far;
+            if (k < 0) {
+                ok = 0;
+                break;
+            }
+            if (3 * f + k == c0) {
+                ok = steps == n_c && F[3 * (size_t)f + (k + 1) % 3] == ent;
+                break;
+            }
+        }
+        if (ok)
+            ws->fan_total[v] = e;
+    }
+    return MFMM_OK;
 }
 
 mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
@@ -183,14 +270,20 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
     ws->touched = malloc((nv ? nv : 1) * sizeof *ws->touched);
     ws->patch_d = malloc((nv ? nv : 1) * sizeof *ws->patch_d);
     double *angle = calloc(nv ? nv : 1, sizeof *angle);
+    ws->angle = malloc(nh * sizeof *ws->angle);
+    ws->fan_a0 = malloc(nh * sizeof *ws->fan_a0);
+    ws->fan_sgn = malloc(nh * sizeof *ws->fan_sgn);
+    ws->fan_total = malloc((nv ? nv : 1) * sizeof *ws->fan_total);
+    ws->in_angle = malloc((nv ? nv : 1) * sizeof *ws->in_angle);
     if (!ws->len || !ws->cx || !ws->cy || !ws->across || !ws->flip || !ws->skip || !ws->pseudo ||
-        !ws->d || !ws->emitted || !ws->touched || !ws->patch_d || !angle) {
+        !ws->d || !ws->emitted || !ws->touched || !ws->patch_d || !angle || !ws->angle ||
+        !ws->fan_a0 || !ws->fan_sgn || !ws->fan_total || !ws->in_angle) {
         free(angle);
         mfmm_exact_ws_destroy(ws);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
-    ws->fixed_bytes = sizeof *ws + nh * (3 * sizeof(double) + sizeof(int32_t) + 1) + nf +
-                      nv * (1 + 3 * sizeof(double) + sizeof(int32_t));
+    ws->fixed_bytes = sizeof *ws + nh * (5 * sizeof(double) + sizeof(int32_t) + 2) + nf +
+                      nv * (1 + 5 * sizeof(double) + sizeof(int32_t));
     const double *X = mesh->xyz;
     const int32_t *F = mesh->faces;
     for (size_t f = 0; f < nf; f++) {
@@ -243,7 +336,9 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
         for (int k = 0; k < 3; k++) {
             /* angle at corner k, seen in the frame of the opposite edge */
             double x = ws->cx[3 * f + k], y = ws->cy[3 * f + k], L = ws->len[3 * f + k];
-            angle[fv[k]] += atan2(y * L, y * y - x * (L - x));
+            double a = atan2(y * L, y * y - x * (L - x));
+            ws->angle[3 * f + k] = a;
+            angle[fv[k]] += a;
             if (ws->across[3 * f + k] < 0) {
                 ws->pseudo[fv[(k + 1) % 3]] = 1;
                 ws->pseudo[fv[(k + 2) % 3]] = 1;
@@ -257,6 +352,11 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
         ws->emitted[v] = INFINITY;
     }
     free(angle);
+    mfmm_status st = ex_build_fans(ws);
+    if (st != MFMM_OK) {
+        mfmm_exact_ws_destroy(ws);
+        return st;
+    }
     ws->free_head = -1;
     ws->max_d = INFINITY;
     ws->peak_bytes = ws->fixed_bytes;
@@ -381,15 +481,74 @@ static void ex_free_window(mfmm_exact_ws *ws, int32_t i)
 
 /* ------------------------------------------------------------ propagation */
 
-static void ex_update(mfmm_exact_ws *ws, int32_t v, double dist, int force)
+/* Lowers d(v) to dist if that is less. Returns 1 when v is then a
+ * pseudo-source to start, with a known fan, and the new distance is less
+ * by more than rounding: the caller then gives the direction it came from
+ * (ex_set_in). A gain within rounding keeps the direction of the path it
+ * ties with: rays that graze a vertex along an edge reach it again from
+ * faces they do not cross, with directions that are not theirs. */
+static int ex_update(mfmm_exact_ws *ws, int32_t v, double dist, int force)
 {
-    if (!(dist < ws->d[v]))
-        return;
-    if (ws->d[v] == INFINITY)
+    double old = ws->d[v];
+    if (!(dist < old))
+        return 0;
+    if (old == INFINITY)
         ws->touched[ws->n_touched++] = v;
     ws->d[v] = dist;
-    if ((ws->pseudo[v] || force) && dist <= ws->max_d)
+    int gain = !(dist >= old - EX_TIE * old);
+    if (gain)
+        ws->in_angle[v] = NAN;
+    if ((ws->pseudo[v] || force) && dist <= ws->max_d) {
         ex_push(ws, dist, -v - 1);
+        return gain && !force && ws->fan_total[v] == ws->fan_total[v];
+    }
+    return 0;
+}
+
+/* in_angle of v = corner c's vertex from the angle psi inside the corner,
+ * measured from the direction to the corner's first vertex. */
+static void ex_set_in(mfmm_exact_ws *ws, int32_t v, int32_t c, double psi)
+{
+    /* a direction outside the corner (rounding at a grazing ray) is not
+     * trusted: in_angle stays NaN and v starts windows all around */
+    if (!(psi >= -1e-9 && psi <= ws->angle[c] + 1e-9))
+        return;
+    if (psi < 0.0)
+        psi = 0.0;
+    if (psi > ws->angle[c])
+        psi = ws->angle[c];
+    ws->in_angle[v] = ws->fan_a0[c] + ws->fan_sgn[c] * psi;
+}
+
+/* Trims the interval [*b0, *b1] of an edge of length L (in the frame where
+ * its pseudo-source is (px, py) at distance sigma) to the part where it is
+ * shorter than the paths through the edge's ends, with distances dA (at 0)
+ * and dB (at L). sigma + |I X| - (dA + t) does not increase with t, so the
+ * part beaten by A is [0, t*), t* the root of
+ * sigma + sqrt((t - px)^2 + py^2) = dA + t; likewise from B. Returns 0 when
+ * too little is left. */
+static int ex_trim(double px, double py, double sigma, double L, double dA, double dB,
+                   double *b0, double *b1)
+{
+    double py2 = py * py;
+    double a = dA - sigma;
+    if (a < INFINITY) {
+        if (px + a <= 0.0)
+            return 0;
+        double t = (px * px + py2 - a * a) / (2.0 * (px + a));
+        if (t > *b0)
+            *b0 = t;
+    }
+    a = dB - sigma;
+    if (a < INFINITY) {
+        double qx = L - px;
+        if (qx + a <= 0.0)
+            return 0;
+        double t = L - (qx * qx + py2 - a * a) / (2.0 * (qx + a));
+        if (t < *b1)
+            *b1 = t;
+    }
+    return *b1 - *b0 > EX_MIN_WIDTH * L;
 }
 
 /* A window on half-edge h = 3f+k in f's frame (I on f's side: iy >= 0),
@@ -407,20 +566,24 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
         s0 = 0.0;
     if (s1 > L)
         s1 = L;
-    double dx0 = ix - s0, dx1 = ix - s1, iy2 = iy * iy;
-    double D0 = sigma + sqrt(dx0 * dx0 + iy2), D1 = sigma + sqrt(dx1 * dx1 + iy2);
-    if (s0 <= EX_POS_TOL * L)
-        ex_update(ws, va, D0, 0);
-    if (s1 >= L - EX_POS_TOL * L)
-        ex_update(ws, vb, D1, 0);
+    double iy2 = iy * iy;
+    if (s0 <= EX_POS_TOL * L && ex_update(ws, va, sigma + sqrt(ix * ix + iy2), 0))
+        ex_set_in(ws, va, h - k + (k == 2 ? 0 : k + 1), atan2(iy, ix));
+    if (s1 >= L - EX_POS_TOL * L &&
+        ex_update(ws, vb, sigma + sqrt((ix - L) * (ix - L) + iy2), 0)) {
+        int32_t c = h - k + (k == 0 ? 2 : k - 1);
+        ex_set_in(ws, vb, c, ws->angle[c] - atan2(iy, L - ix));
+    }
     int32_t g = ws->across[h];
     if (g < 0 || !(s1 - s0 > EX_MIN_WIDTH * L))
         return;
+    /* pruning against the face the window leaves */
+    if (!ex_trim(ix, -iy, sigma, L, ws->d[va], ws->d[vb], &s0, &s1))
+        return;
+    double dx0 = ix - s0, dx1 = ix - s1;
+    double D0 = sigma + sqrt(dx0 * dx0 + iy2), D1 = sigma + sqrt(dx1 * dx1 + iy2);
     double key = (ix >= s0 && ix <= s1) ? sigma + iy : (D0 < D1 ? D0 : D1);
     if (key > ws->max_d)
-        return;
-    /* pruning against the face the window leaves */
-    if (D1 > ws->d[va] + s1 || D0 > ws->d[vb] + (L - s0))
         return;
     double rx = ws->cx[h], ry = ws->cy[h];
     double r0 = (rx - s0) * (rx - s0), r1 = (rx - s1) * (rx - s1);
@@ -476,10 +639,10 @@ static void ex_propagate(mfmm_exact_ws *ws, const ex_window *w)
     double L = ws->len[h], cx = ws->cx[h], cy = ws->cy[h];
     double b0 = w->b0, b1 = w->b1, px = w->px, py = w->py, sigma = w->sigma;
     /* pruning against the face it crosses, with today's distances */
+    if (!ex_trim(px, py, sigma, L, ws->d[va], ws->d[vb], &b0, &b1))
+        return;
     double dx0 = px - b0, dx1 = px - b1, py2 = py * py;
     double D0 = sigma + sqrt(dx0 * dx0 + py2), D1 = sigma + sqrt(dx1 * dx1 + py2);
-    if (D1 > ws->d[va] + b1 || D0 > ws->d[vb] + (L - b0))
-        return;
     double key = (px >= b0 && px <= b1) ? sigma - py : (D0 < D1 ? D0 : D1);
     double r0 = (cx - b0) * (cx - b0), r1 = (cx - b1) * (cx - b1);
     if (key > ws->d[vc] + sqrt((r0 > r1 ? r0 : r1) + cy * cy))
@@ -490,7 +653,11 @@ static void ex_propagate(mfmm_exact_ws *ws, const ex_window *w)
     double tol = EX_POS_TOL * L;
     if (tc >= b0 - tol && tc <= b1 + tol) {
         double ex = cx - px, ey = cy - py;
-        ex_update(ws, vc, sigma + sqrt(ex * ex + ey * ey), 0);
+        if (ex_update(ws, vc, sigma + sqrt(ex * ex + ey * ey), 0)) {
+            /* angle at C between C -> A = (-cx, -cy) and C -> I = (-ex, -ey) */
+            double cr = cx * ey - cy * ex, dt = cx * ex + cy * ey;
+            ex_set_in(ws, vc, h, atan2(fabs(cr), dt));
+        }
     }
     int m1 = m == 2 ? 0 : m + 1, m2 = m == 0 ? 2 : m - 1;
     if (b0 < tc) {
@@ -517,16 +684,67 @@ static void ex_propagate(mfmm_exact_ws *ws, const ex_window *w)
     }
 }
 
+/* Where the ray from C = (cx, cy) at angle psi from C -> (0,0), turning
+ * towards (L, 0), meets the x axis, clamped to [0, L]. */
+static double ex_ray_x(double cx, double cy, double psi, double L)
+{
+    double r = sqrt(cx * cx + cy * cy);
+    double ux = -cx / r, uy = -cy / r, c = cos(psi), sn = sin(psi);
+    double dx = ux * c - uy * sn, dy = ux * sn + uy * c;
+    if (!(dy < 0.0))
+        return dx < 0.0 ? 0.0 : L;
+    double x = cx + (-cy / dy) * dx;
+    return x < 0.0 ? 0.0 : x > L ? L : x;
+}
+
 /* A pseudo-source at v with distance dv: a window on the far edge of every
  * face around v. */
 static void ex_start_vertex(mfmm_exact_ws *ws, int32_t v, double dv)
 {
     ws->n_pseudo++;
+    double th = ws->in_angle[v], total = ws->fan_total[v];
+    if (!(th == th) || !(total == total)) {
+        for (int32_t i = ws->vf_offset[v]; i < ws->vf_offset[v + 1]; i++) {
+            int32_t c = ws->vf_corner[i];
+            if (ws->skip[c / 3])
+                continue;
+            ex_emit(ws, c, 0.0, ws->len[c], ws->cx[c], ws->cy[c], dv);
+        }
+        return;
+    }
+    /* A shortest path that arrived from direction th can go on through v
+     * only where both angles it makes there are >= pi (else cutting the
+     * corner is shorter): the "shadow" [th + pi, th + total - pi], modulo
+     * total. Elsewhere the windows passing v already carry the distance. */
+    double lo = th + EX_PI - EX_SHADOW_MARGIN, hi = th + total - EX_PI + EX_SHADOW_MARGIN;
+    if (!(hi > lo))
+        return;
     for (int32_t i = ws->vf_offset[v]; i < ws->vf_offset[v + 1]; i++) {
         int32_t c = ws->vf_corner[i];
-        if (ws->skip[c / 3])
-            continue;
-        ex_emit(ws, c, 0.0, ws->len[c], ws->cx[c], ws->cy[c], dv);
+        double ang = ws->angle[c];
+        double f0 = ws->fan_sgn[c] > 0 ? ws->fan_a0[c] : ws->fan_a0[c] - ang, f1 = f0 + ang;
+        for (int wrap = -1; wrap <= 1; wrap++) {
+            double a = lo + wrap * total, b = hi + wrap * total;
+            if (a < f0)
+                a = f0;
+            if (b > f1)
+                b = f1;
+            if (!(b > a))
+                continue;
+            /* psi: angles from the direction to the corner's first vertex */
+            double p0, p1;
+            if (ws->fan_sgn[c] > 0) {
+                p0 = a - f0;
+                p1 = b - f0;
+            } else {
+                p0 = f1 - b;
+                p1 = f1 - a;
+            }
+            double L = ws->len[c], cx = ws->cx[c], cy = ws->cy[c];
+            double s0 = p0 <= 0.0 ? 0.0 : ex_ray_x(cx, cy, p0, L);
+            double s1 = p1 >= ang ? L : ex_ray_x(cx, cy, p1, L);
+            ex_emit(ws, c, s0, s1, cx, cy, dv);
+        }
     }
 }
 
@@ -728,4 +946,15 @@ mfmm_status mfmm_exact_patch(mfmm_exact_ws *ws, const mfmm_source *sources, int3
     }
     *n_vertices = n;
     return MFMM_OK;
+}
+#include <stdio.h>
+void mfmm_exact_debug_fan(mfmm_exact_ws *ws, int32_t v);
+void mfmm_exact_debug_fan(mfmm_exact_ws *ws, int32_t v)
+{
+    printf("v %d total %.6f pseudo %d in %.6f d %.6f\n", v, ws->fan_total[v], ws->pseudo[v], ws->in_angle[v], ws->d[v]);
+    for (int32_t i = ws->vf_offset[v]; i < ws->vf_offset[v + 1]; i++) {
+        int32_t c = ws->vf_corner[i];
+        const int32_t *fv = ws->faces + 3 * (c / 3);
+        printf("  c %d f %d (%d %d %d) a0 %.6f sgn %d ang %.6f\n", c, c / 3, fv[0], fv[1], fv[2], ws->fan_a0[c], ws->fan_sgn[c], ws->angle[c]);
+    }
 }
