@@ -422,6 +422,8 @@ static int ex_grow(mfmm_exact_ws *ws, int which)
     return 1;
 }
 
+/* The queue: a 4-ary min-heap of (key, index), shallower than a binary one
+ * (the sift is most of the cost of a window that is quickly dropped). */
 static int ex_push(mfmm_exact_ws *ws, double key, int32_t idx)
 {
     if (ws->heap_n == ws->heap_cap && !ex_grow(ws, 1))
@@ -429,7 +431,7 @@ static int ex_push(mfmm_exact_ws *ws, double key, int32_t idx)
     ex_entry *h = ws->heap;
     int32_t i = ws->heap_n++;
     while (i > 0) {
-        int32_t p = (i - 1) >> 1;
+        int32_t p = (i - 1) >> 2;
         if (!(key < h[p].key))
             break;
         h[i] = h[p];
@@ -446,15 +448,22 @@ static ex_entry ex_pop(mfmm_exact_ws *ws)
     ex_entry top = h[0], last = h[--ws->heap_n];
     int32_t n = ws->heap_n, i = 0;
     for (;;) {
-        int32_t c = 2 * i + 1;
+        int32_t c = 4 * i + 1;
         if (c >= n)
             break;
-        if (c + 1 < n && h[c + 1].key < h[c].key)
-            c++;
-        if (!(h[c].key < last.key))
+        int32_t best = c;
+        double bk = h[c].key;
+        int32_t end = c + 4 < n ? c + 4 : n;
+        for (int32_t j = c + 1; j < end; j++) {
+            if (h[j].key < bk) {
+                bk = h[j].key;
+                best = j;
+            }
+        }
+        if (!(bk < last.key))
             break;
-        h[i] = h[c];
-        i = c;
+        h[i] = h[best];
+        i = best;
     }
     if (n > 0)
         h[i] = last;
