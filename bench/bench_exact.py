@@ -25,6 +25,8 @@ sys.path.insert(0, str(REPO / "bindings" / "python"))
 os.environ.setdefault("MESHFMM_LIBRARY", str(REPO / "build" / "libmeshfmm.so"))
 from meshfmm import _lib  # noqa: E402
 
+# each solve is timed REPEAT times and the least kept (the machine is shared)
+REPEAT = int(os.environ.get("BENCH_REPEAT", "3"))
 SHARED = Path(os.environ.get("MESHFMM_SHARED_DIR", REPO.parent / "shared"))
 MESHES = ["hand_lowres.obj", "beetle.obj", "spot.obj", "wingnut.obj", "fertility_FE_10k.off",
           "decimated-max.obj", "camelhead.off", "nefertiti-lowres.obj", "stanford-bunny.obj"]
@@ -94,9 +96,12 @@ z = np.load(sys.argv[1])
 V, F = z["V"], z["F"]
 times, rows = [], []
 for s in z["sources"]:
-    t0 = time.perf_counter()
-    d = gdist.compute_gdist(V, F, source_indices=np.array([s], dtype=np.int32))
-    times.append(time.perf_counter() - t0)
+    best = np.inf
+    for _ in range(int(z["repeat"])):
+        t0 = time.perf_counter()
+        d = gdist.compute_gdist(V, F, source_indices=np.array([s], dtype=np.int32))
+        best = min(best, time.perf_counter() - t0)
+    times.append(best)
     rows.append(d)
 np.savez(sys.argv[2], times=np.array(times), distances=np.array(rows))
 """
@@ -109,12 +114,12 @@ class GdistProcess:
     def __init__(self, python):
         self.python = python
 
-    def run(self, V, F, sources):
+    def run(self, V, F, sources, repeat):
         import subprocess
         import tempfile
         with tempfile.TemporaryDirectory() as tmp:
             a, b = Path(tmp) / "in.npz", Path(tmp) / "out.npz"
-            np.savez(a, V=V, F=F, sources=np.array(sources, dtype=np.int32))
+            np.savez(a, V=V, F=F, sources=np.array(sources, dtype=np.int32), repeat=repeat)
             subprocess.run([self.python, "-c", GDIST_CHILD, str(a), str(b)], check=True)
             z = np.load(b)
             return list(z["times"]), z["distances"]
@@ -153,11 +158,14 @@ def main(names):
         worst, worst_gd, t_ours, t_gd, gd_rows = 0.0, None, [], [], None
         # no reference: beetle, on which gdist and igl crash (non-manifold)
         if isinstance(gd, GdistProcess) and refd is not None:
-            t_gd, gd_rows = gd.run(V, F, sources)
+            t_gd, gd_rows = gd.run(V, F, sources, REPEAT)
         for i, s in enumerate(sources):
-            t0 = time.perf_counter()
-            d, info = ex.solve(s)
-            t_ours.append(time.perf_counter() - t0)
+            best = np.inf
+            for _ in range(REPEAT):
+                t0 = time.perf_counter()
+                d, info = ex.solve(s)
+                best = min(best, time.perf_counter() - t0)
+            t_ours.append(best)
             if refd is not None:
                 r = refd[i]
                 fin = np.isfinite(r)
@@ -173,9 +181,12 @@ def main(names):
                 e = float((np.abs(d[fin] - g[fin]) / d[fin]).max())
                 worst_gd = e if worst_gd is None else max(worst_gd, e)
             elif gd is not None and refd is not None:
-                t0 = time.perf_counter()
-                gd.compute_gdist(V, F, source_indices=np.array([s], dtype=np.int32))
-                t_gd.append(time.perf_counter() - t0)
+                best = np.inf
+                for _ in range(REPEAT):
+                    t0 = time.perf_counter()
+                    gd.compute_gdist(V, F, source_indices=np.array([s], dtype=np.int32))
+                    best = min(best, time.perf_counter() - t0)
+                t_gd.append(best)
         row = {"mesh": name, "nv": len(V), "nf": len(F), "max_rel_err": worst if ref else None,
                "ours_s": float(np.mean(t_ours)), "windows": info.n_windows,
                "peak_windows": info.peak_windows, "propagated": info.n_propagated, "pseudo": info.n_pseudo_sources, "peak_MB": info.peak_bytes / 2**20,

@@ -45,7 +45,7 @@
  *
  * Memory: per-mesh tables (edge lengths, the opposite corner unfolded into
  * each edge's frame, neighbour corners: 61 bytes per face; 26 per vertex),
- * and a pool of windows with a binary heap of (key, index) that grow by
+ * and a pool of windows with a bucket queue of (key, index) entries that grow by
  * doubling, bounded by memory_limit; no recursion. */
 #include <float.h>
 #include <math.h>
@@ -63,6 +63,10 @@
 #define EX_SHADOW_MARGIN 1e-7
 /* distances equal to this relative amount are ties */
 #define EX_TIE 1e-12
+/* buckets in the queue's window (a power of 2), and their width in mean
+ * edge lengths */
+#define EX_NB 4096
+#define EX_BUCKET_WIDTH 0.25
 /* a window narrower than this fraction of its edge is dropped */
 #define EX_MIN_WIDTH 1e-13
 /* a point of an edge this close (relative) to a window's end is in it */
@@ -115,8 +119,13 @@ struct mfmm_exact_solver {
     /* the queue */
     ex_window *pool;
     int32_t pool_cap, pool_used, free_head;
-    ex_entry *heap;
-    int32_t heap_cap, heap_n;
+    ex_entry *heap;    /* the entries of the bucket queue, linked by pad */
+    int32_t heap_cap, heap_n, heap_used, qfree;
+    int32_t *bhead, *btail; /* (EX_NB,) FIFO lists of the buckets in the window */
+    int32_t over;      /* entries beyond the window, unsorted */
+    int64_t cur, redist; /* current bucket; where the window was last refilled */
+    int32_t n_in;      /* entries in the window's buckets */
+    double inv_w;      /* 1 / bucket width */
     size_t fixed_bytes, memory_limit, peak_bytes;
     double max_d;
     int failed; /* MFMM_ERR_MEMORY_LIMIT or MFMM_ERR_OUT_OF_MEMORY once a growth fails */
@@ -157,6 +166,8 @@ void mfmm_exact_ws_destroy(mfmm_exact_ws *ws)
     free(ws->patch_d);
     free(ws->pool);
     free(ws->heap);
+    free(ws->bhead);
+    free(ws->btail);
     free(ws);
 }
 
@@ -274,16 +285,20 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
     ws->fan_a0 = malloc(nh * sizeof *ws->fan_a0);
     ws->fan_sgn = malloc(nh * sizeof *ws->fan_sgn);
     ws->fan_total = malloc((nv ? nv : 1) * sizeof *ws->fan_total);
+    ws->bhead = malloc(EX_NB * sizeof *ws->bhead);
+    ws->btail = malloc(EX_NB * sizeof *ws->btail);
     ws->in_angle = malloc((nv ? nv : 1) * sizeof *ws->in_angle);
     if (!ws->len || !ws->cx || !ws->cy || !ws->across || !ws->flip || !ws->skip || !ws->pseudo ||
         !ws->d || !ws->emitted || !ws->touched || !ws->patch_d || !angle || !ws->angle ||
-        !ws->fan_a0 || !ws->fan_sgn || !ws->fan_total || !ws->in_angle) {
+        !ws->fan_a0 || !ws->fan_sgn || !ws->fan_total || !ws->in_angle || !ws->bhead ||
+        !ws->btail) {
         free(angle);
         mfmm_exact_ws_destroy(ws);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
     ws->fixed_bytes = sizeof *ws + nh * (5 * sizeof(double) + sizeof(int32_t) + 2) + nf +
-                      nv * (1 + 5 * sizeof(double) + sizeof(int32_t));
+                      nv * (1 + 5 * sizeof(double) + sizeof(int32_t)) +
+                      2 * EX_NB * sizeof(int32_t);
     const double *X = mesh->xyz;
     const int32_t *F = mesh->faces;
     for (size_t f = 0; f < nf; f++) {
@@ -352,6 +367,16 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
         ws->emitted[v] = INFINITY;
     }
     free(angle);
+    double sum_len = 0.0;
+    size_t n_len = 0;
+    for (size_t hh = 0; hh < nh; hh++) {
+        if (!ws->skip[hh / 3]) {
+            sum_len += ws->len[hh];
+            n_len++;
+        }
+    }
+    double width = n_len ? EX_BUCKET_WIDTH * sum_len / (double)n_len : 1.0;
+    ws->inv_w = width > 0.0 && isfinite(1.0 / width) ? 1.0 / width : 1.0;
     mfmm_status st = ex_build_fans(ws);
     if (st != MFMM_OK) {
         mfmm_exact_ws_destroy(ws);
@@ -422,52 +447,101 @@ static int ex_grow(mfmm_exact_ws *ws, int which)
     return 1;
 }
 
-/* The queue: a 4-ary min-heap of (key, index), shallower than a binary one
- * (the sift is most of the cost of a window that is quickly dropped). */
+/* The queue: buckets of keys (width about a tenth of an edge) in a
+ * circular window of EX_NB buckets, FIFO inside a bucket, entries beyond
+ * the window in one overflow list that is sorted in when the window moves
+ * on. Pops come in key order to within a bucket's width (as the "fast
+ * wavefront propagation" of Xu et al. 2015 does for MMP and CH): enough for
+ * the pruning, and the result does not depend on it (a pseudo-source
+ * started before its distance was final is started again when it
+ * improves). */
+static int64_t ex_bucket(const mfmm_exact_ws *ws, double key)
+{
+    double b = floor(key * ws->inv_w);
+    if (!(b > -1e18))
+        b = -1e18;
+    if (b > 1e18)
+        b = 1e18;
+    return (int64_t)b;
+}
+
+static void ex_link(mfmm_exact_ws *ws, int32_t e)
+{
+    int64_t b = ex_bucket(ws, ws->heap[e].key);
+    if (b < ws->cur)
+        b = ws->cur;
+    if (b >= ws->cur + EX_NB) {
+        ws->heap[e].pad = ws->over;
+        ws->over = e;
+        return;
+    }
+    int32_t i = (int32_t)(b & (EX_NB - 1));
+    ws->heap[e].pad = ws->bhead[i];
+    ws->bhead[i] = e;
+    ws->n_in++;
+}
+
 static int ex_push(mfmm_exact_ws *ws, double key, int32_t idx)
 {
-    if (ws->heap_n == ws->heap_cap && !ex_grow(ws, 1))
-        return 0;
-    ex_entry *h = ws->heap;
-    int32_t i = ws->heap_n++;
-    while (i > 0) {
-        int32_t p = (i - 1) >> 2;
-        if (!(key < h[p].key))
-            break;
-        h[i] = h[p];
-        i = p;
+    int32_t e = ws->qfree;
+    if (e >= 0) {
+        ws->qfree = ws->heap[e].pad;
+    } else {
+        if (ws->heap_used == ws->heap_cap && !ex_grow(ws, 1))
+            return 0;
+        e = ws->heap_used++;
     }
-    h[i].key = key;
-    h[i].idx = idx;
+    ws->heap[e].key = key;
+    ws->heap[e].idx = idx;
+    ws->heap_n++;
+    ex_link(ws, e);
     return 1;
 }
 
+/* Moves the overflow entries that now fall in the window into it; with
+ * the window empty, first moves the window to the least of them. */
+static void ex_refill(mfmm_exact_ws *ws)
+{
+    if (ws->n_in == 0) {
+        int64_t lo = INT64_MAX;
+        for (int32_t e = ws->over; e >= 0; e = ws->heap[e].pad) {
+            int64_t b = ex_bucket(ws, ws->heap[e].key);
+            if (b < lo)
+                lo = b;
+        }
+        if (lo > ws->cur)
+            ws->cur = lo;
+    }
+    ws->redist = ws->cur;
+    int32_t e = ws->over;
+    ws->over = -1;
+    while (e >= 0) {
+        int32_t next = ws->heap[e].pad;
+        ex_link(ws, e);
+        e = next;
+    }
+}
+
+/* The next entry (the queue must not be empty). */
 static ex_entry ex_pop(mfmm_exact_ws *ws)
 {
-    ex_entry *h = ws->heap;
-    ex_entry top = h[0], last = h[--ws->heap_n];
-    int32_t n = ws->heap_n, i = 0;
     for (;;) {
-        int32_t c = 4 * i + 1;
-        if (c >= n)
-            break;
-        int32_t best = c;
-        double bk = h[c].key;
-        int32_t end = c + 4 < n ? c + 4 : n;
-        for (int32_t j = c + 1; j < end; j++) {
-            if (h[j].key < bk) {
-                bk = h[j].key;
-                best = j;
-            }
+        if (ws->n_in == 0 || ws->cur >= ws->redist + EX_NB)
+            ex_refill(ws);
+        int32_t i = (int32_t)(ws->cur & (EX_NB - 1));
+        int32_t e = ws->bhead[i];
+        if (e < 0) {
+            ws->cur++;
+            continue;
         }
-        if (!(bk < last.key))
-            break;
-        h[i] = h[best];
-        i = best;
+        ws->bhead[i] = ws->heap[e].pad;
+        ws->n_in--;
+        ws->heap_n--;
+        ex_entry top = ws->heap[e];
+        ws->heap[e].pad = ws->qfree;
+        ws->qfree = e;
+        return top;
     }
-    if (n > 0)
-        h[i] = last;
-    return top;
 }
 
 static int32_t ex_alloc_window(mfmm_exact_ws *ws)
@@ -781,6 +855,14 @@ static void ex_reset(mfmm_exact_ws *ws)
     }
     ws->n_touched = 0;
     ws->heap_n = 0;
+    ws->heap_used = 0;
+    ws->qfree = -1;
+    ws->over = -1;
+    ws->n_in = 0;
+    ws->cur = -((int64_t)1 << 62);
+    ws->redist = ws->cur;
+    for (int32_t i = 0; i < EX_NB; i++)
+        ws->bhead[i] = -1;
     ws->pool_used = 0;
     ws->free_head = -1;
     ws->failed = 0;
