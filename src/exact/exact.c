@@ -307,12 +307,18 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
         for (int k = 0; k < 3; k++)
             ws->len[3 * f + k] = vdist(X + 3 * (size_t)fv[(k + 1) % 3], X + 3 * (size_t)fv[(k + 2) % 3]);
         for (int k = 0; k < 3; k++) {
-            double L = ws->len[3 * f + k], la = ws->len[3 * f + (k + 2) % 3],
-                   lb = ws->len[3 * f + (k + 1) % 3];
-            /* corner k: at distance la from the edge's first vertex, lb from its second */
-            double x = (L * L + la * la - lb * lb) / (2.0 * L);
-            double y2 = la * la - x * x;
-            double y = y2 > 0.0 ? sqrt(y2) : 0.0;
+            /* corner k in the frame of the opposite edge, from the vectors
+             * (not the law of cosines: that loses about (L / y)^2 eps of y
+             * in a needle, 1e-7 for a 1e-6 wide one) */
+            double L = ws->len[3 * f + k];
+            const double *a = X + 3 * (size_t)fv[(k + 1) % 3], *b = X + 3 * (size_t)fv[(k + 2) % 3],
+                         *c = X + 3 * (size_t)fv[k];
+            double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+            double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+            double cr[3] = {e[1] * w[2] - e[2] * w[1], e[2] * w[0] - e[0] * w[2],
+                            e[0] * w[1] - e[1] * w[0]};
+            double x = (e[0] * w[0] + e[1] * w[1] + e[2] * w[2]) / L;
+            double y = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]) / L;
             ws->cx[3 * f + k] = x;
             ws->cy[3 * f + k] = y;
             if (!(L > 0.0) || !(y > 0.0) || !isfinite(x) || !isfinite(y))
