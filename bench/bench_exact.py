@@ -125,6 +125,25 @@ class GdistProcess:
             return list(z["times"]), z["distances"]
 
 
+def components(nv, F):
+    """Vertex components of the faces (union-find), -1 for unreferenced."""
+    parent = np.arange(nv)
+
+    def find(a):
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+    for f in F:
+        r = [find(int(v)) for v in f]
+        for x in r[1:]:
+            parent[find(x)] = find(r[0])
+    roots = np.array([find(v) for v in range(nv)])
+    used = np.zeros(nv, bool)
+    used[F.ravel()] = True
+    return np.where(used, roots, -1)
+
+
 def gdist_module():
     try:
         import gdist
@@ -174,7 +193,11 @@ def main(names):
                 rel[r[fin] == 0] = np.abs(d[fin][r[fin] == 0])
                 worst = max(worst, float(rel.max()))
             else:
+                # no reference (beetle: igl and gdist crash on it): finite on
+                # exactly the source's component, never NaN
                 assert not np.isnan(d).any()
+                comp = components(len(V), F)
+                assert np.array_equal(np.isfinite(d), comp == comp[s]), f"{name}: finite set"
             if gd_rows is not None:
                 g = gd_rows[i]
                 fin = np.isfinite(d) & (d > 0)
