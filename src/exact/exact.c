@@ -45,7 +45,7 @@
  *
  * Memory: per-mesh tables (edge lengths, the opposite corner unfolded into
  * each edge's frame, neighbour corners: 61 bytes per face; 26 per vertex),
- * and a pool of windows with a bucket queue of (key, index) entries that grow by
+ * and the queue's entries (windows and vertex events, 56 bytes each) that grow by
  * doubling, bounded by memory_limit; no recursion. */
 #include <float.h>
 #include <math.h>
@@ -74,19 +74,15 @@
 /* a vertex whose angle sum exceeds 2 pi by this much is a saddle */
 #define EX_SADDLE_TOL 1e-12
 
-typedef struct ex_window {
+/* An entry of the queue: a window, or a vertex to start as a pseudo-source. */
+typedef struct ex_entry {
+    double key;      /* the least distance of the window; a vertex's distance */
     double b0, b1;   /* interval on the edge, from its first vertex */
     double px, py;   /* pseudo-source in the edge's frame, py <= 0 */
     double sigma;    /* distance at the pseudo-source */
-    int32_t he;      /* 3 f + k: the edge opposite corner k of face f, crossing f;
-                        the next free slot when in the free list */
-    int32_t pad;
-} ex_window;
-
-typedef struct ex_entry {
-    double key;
-    int32_t idx;     /* >= 0: a window; < 0: vertex -idx-1 as a pseudo-source */
-    int32_t pad;
+    int32_t he;      /* >= 0: 3 f + k, the edge opposite corner k of face f, the
+                        window about to cross f; < 0: vertex -he-1 */
+    int32_t next;    /* the next entry in its bucket or in the free list */
 } ex_entry;
 
 struct mfmm_exact_solver {
@@ -117,11 +113,9 @@ struct mfmm_exact_solver {
     int32_t n_touched;
     double *patch_d;   /* (nv,) distances of mfmm_exact_patch */
     /* the queue */
-    ex_window *pool;
-    int32_t pool_cap, pool_used, free_head;
     ex_entry *heap;    /* the entries of the bucket queue, linked by pad */
     int32_t heap_cap, heap_n, heap_used, qfree;
-    int32_t *bhead, *btail; /* (EX_NB,) FIFO lists of the buckets in the window */
+    int32_t *bhead;    /* (EX_NB,) LIFO lists of the buckets in the window */
     int32_t over;      /* entries beyond the window, unsorted */
     int64_t cur, redist; /* current bucket; where the window was last refilled */
     int32_t n_in;      /* entries in the window's buckets */
@@ -164,10 +158,8 @@ void mfmm_exact_ws_destroy(mfmm_exact_ws *ws)
     free(ws->emitted);
     free(ws->touched);
     free(ws->patch_d);
-    free(ws->pool);
     free(ws->heap);
     free(ws->bhead);
-    free(ws->btail);
     free(ws);
 }
 
@@ -286,19 +278,18 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
     ws->fan_sgn = malloc(nh * sizeof *ws->fan_sgn);
     ws->fan_total = malloc((nv ? nv : 1) * sizeof *ws->fan_total);
     ws->bhead = malloc(EX_NB * sizeof *ws->bhead);
-    ws->btail = malloc(EX_NB * sizeof *ws->btail);
+
     ws->in_angle = malloc((nv ? nv : 1) * sizeof *ws->in_angle);
     if (!ws->len || !ws->cx || !ws->cy || !ws->across || !ws->flip || !ws->skip || !ws->pseudo ||
         !ws->d || !ws->emitted || !ws->touched || !ws->patch_d || !angle || !ws->angle ||
-        !ws->fan_a0 || !ws->fan_sgn || !ws->fan_total || !ws->in_angle || !ws->bhead ||
-        !ws->btail) {
+        !ws->fan_a0 || !ws->fan_sgn || !ws->fan_total || !ws->in_angle || !ws->bhead) {
         free(angle);
         mfmm_exact_ws_destroy(ws);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
     ws->fixed_bytes = sizeof *ws + nh * (5 * sizeof(double) + sizeof(int32_t) + 2) + nf +
                       nv * (1 + 5 * sizeof(double) + sizeof(int32_t)) +
-                      2 * EX_NB * sizeof(int32_t);
+                      EX_NB * sizeof(int32_t);
     const double *X = mesh->xyz;
     const int32_t *F = mesh->faces;
     for (size_t f = 0; f < nf; f++) {
@@ -388,7 +379,6 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
         mfmm_exact_ws_destroy(ws);
         return st;
     }
-    ws->free_head = -1;
     ws->max_d = INFINITY;
     ws->peak_bytes = ws->fixed_bytes;
     *out = ws;
@@ -402,54 +392,38 @@ mfmm_status mfmm_exact_solver_create(const mfmm_mesh *mesh, mfmm_exact_solver **
 
 /* ----------------------------------------------------------------- queue */
 
-static size_t ex_bytes(const mfmm_exact_ws *ws, int32_t pool_cap, int32_t heap_cap)
+static size_t ex_bytes(const mfmm_exact_ws *ws, int32_t heap_cap)
 {
-    return ws->fixed_bytes + (size_t)pool_cap * sizeof(ex_window) +
-           (size_t)heap_cap * sizeof(ex_entry);
+    return ws->fixed_bytes + (size_t)heap_cap * sizeof(ex_entry);
 }
 
-/* Grows pool or heap (which = 0, 1) by doubling, within memory_limit. */
-static int ex_grow(mfmm_exact_ws *ws, int which)
+/* Grows the entries by doubling, within memory_limit. */
+static int ex_grow(mfmm_exact_ws *ws)
 {
-    int32_t cap = which ? ws->heap_cap : ws->pool_cap;
+    int32_t cap = ws->heap_cap;
     if (cap >= INT32_MAX / 2) {
         ws->failed = MFMM_ERR_MEMORY_LIMIT;
         return 0;
     }
     int32_t ncap = cap ? 2 * cap : 1024;
-    size_t bytes = which ? ex_bytes(ws, ws->pool_cap, ncap) : ex_bytes(ws, ncap, ws->heap_cap);
-    if (ws->memory_limit && bytes > ws->memory_limit) {
+    if (ws->memory_limit && ex_bytes(ws, ncap) > ws->memory_limit) {
         /* the largest size that fits, if it is any larger */
-        size_t room = ws->memory_limit - ex_bytes(ws, which ? ws->pool_cap : 0,
-                                                  which ? 0 : ws->heap_cap);
-        size_t each = which ? sizeof(ex_entry) : sizeof(ex_window);
-        if (ws->memory_limit < ex_bytes(ws, which ? ws->pool_cap : 0, which ? 0 : ws->heap_cap) ||
-            room / each <= (size_t)cap) {
+        size_t room = ws->memory_limit > ws->fixed_bytes ? ws->memory_limit - ws->fixed_bytes : 0;
+        if (room / sizeof(ex_entry) <= (size_t)cap) {
             ws->failed = MFMM_ERR_MEMORY_LIMIT;
             return 0;
         }
-        ncap = (int32_t)(room / each);
-        bytes = which ? ex_bytes(ws, ws->pool_cap, ncap) : ex_bytes(ws, ncap, ws->heap_cap);
+        ncap = (int32_t)(room / sizeof(ex_entry));
     }
-    if (which) {
-        ex_entry *p = realloc(ws->heap, (size_t)ncap * sizeof *p);
-        if (!p) {
-            ws->failed = MFMM_ERR_OUT_OF_MEMORY;
-            return 0;
-        }
-        ws->heap = p;
-        ws->heap_cap = ncap;
-    } else {
-        ex_window *p = realloc(ws->pool, (size_t)ncap * sizeof *p);
-        if (!p) {
-            ws->failed = MFMM_ERR_OUT_OF_MEMORY;
-            return 0;
-        }
-        ws->pool = p;
-        ws->pool_cap = ncap;
+    ex_entry *p = realloc(ws->heap, (size_t)ncap * sizeof *p);
+    if (!p) {
+        ws->failed = MFMM_ERR_OUT_OF_MEMORY;
+        return 0;
     }
-    if (bytes > ws->peak_bytes)
-        ws->peak_bytes = bytes;
+    ws->heap = p;
+    ws->heap_cap = ncap;
+    if (ex_bytes(ws, ncap) > ws->peak_bytes)
+        ws->peak_bytes = ex_bytes(ws, ncap);
     return 1;
 }
 
@@ -477,31 +451,35 @@ static void ex_link(mfmm_exact_ws *ws, int32_t e)
     if (b < ws->cur)
         b = ws->cur;
     if (b >= ws->cur + EX_NB) {
-        ws->heap[e].pad = ws->over;
+        ws->heap[e].next = ws->over;
         ws->over = e;
         return;
     }
     int32_t i = (int32_t)(b & (EX_NB - 1));
-    ws->heap[e].pad = ws->bhead[i];
+    ws->heap[e].next = ws->bhead[i];
     ws->bhead[i] = e;
     ws->n_in++;
 }
 
-static int ex_push(mfmm_exact_ws *ws, double key, int32_t idx)
+/* A free entry (its fields to be filled, then ex_queue), or -1. */
+static int32_t ex_new(mfmm_exact_ws *ws)
 {
     int32_t e = ws->qfree;
     if (e >= 0) {
-        ws->qfree = ws->heap[e].pad;
-    } else {
-        if (ws->heap_used == ws->heap_cap && !ex_grow(ws, 1))
-            return 0;
-        e = ws->heap_used++;
+        ws->qfree = ws->heap[e].next;
+        return e;
     }
-    ws->heap[e].key = key;
-    ws->heap[e].idx = idx;
+    if (ws->heap_used == ws->heap_cap && !ex_grow(ws))
+        return -1;
+    return ws->heap_used++;
+}
+
+static void ex_queue(mfmm_exact_ws *ws, int32_t e)
+{
     ws->heap_n++;
+    if (ws->heap_n > ws->peak_windows)
+        ws->peak_windows = ws->heap_n;
     ex_link(ws, e);
-    return 1;
 }
 
 /* Moves the overflow entries that now fall in the window into it; with
@@ -510,7 +488,7 @@ static void ex_refill(mfmm_exact_ws *ws)
 {
     if (ws->n_in == 0) {
         int64_t lo = INT64_MAX;
-        for (int32_t e = ws->over; e >= 0; e = ws->heap[e].pad) {
+        for (int32_t e = ws->over; e >= 0; e = ws->heap[e].next) {
             int64_t b = ex_bucket(ws, ws->heap[e].key);
             if (b < lo)
                 lo = b;
@@ -522,14 +500,14 @@ static void ex_refill(mfmm_exact_ws *ws)
     int32_t e = ws->over;
     ws->over = -1;
     while (e >= 0) {
-        int32_t next = ws->heap[e].pad;
+        int32_t next = ws->heap[e].next;
         ex_link(ws, e);
         e = next;
     }
 }
 
-/* The next entry (the queue must not be empty). */
-static ex_entry ex_pop(mfmm_exact_ws *ws)
+/* Takes the next entry out of the queue (which must not be empty) into *out. */
+static void ex_pop(mfmm_exact_ws *ws, ex_entry *out)
 {
     for (;;) {
         if (ws->n_in == 0 || ws->cur >= ws->redist + EX_NB)
@@ -540,32 +518,14 @@ static ex_entry ex_pop(mfmm_exact_ws *ws)
             ws->cur++;
             continue;
         }
-        ws->bhead[i] = ws->heap[e].pad;
+        ws->bhead[i] = ws->heap[e].next;
         ws->n_in--;
         ws->heap_n--;
-        ex_entry top = ws->heap[e];
-        ws->heap[e].pad = ws->qfree;
+        *out = ws->heap[e];
+        ws->heap[e].next = ws->qfree;
         ws->qfree = e;
-        return top;
+        return;
     }
-}
-
-static int32_t ex_alloc_window(mfmm_exact_ws *ws)
-{
-    int32_t i = ws->free_head;
-    if (i >= 0) {
-        ws->free_head = ws->pool[i].he;
-        return i;
-    }
-    if (ws->pool_used == ws->pool_cap && !ex_grow(ws, 0))
-        return -1;
-    return ws->pool_used++;
-}
-
-static void ex_free_window(mfmm_exact_ws *ws, int32_t i)
-{
-    ws->pool[i].he = ws->free_head;
-    ws->free_head = i;
 }
 
 /* ------------------------------------------------------------ propagation */
@@ -588,7 +548,12 @@ static int ex_update(mfmm_exact_ws *ws, int32_t v, double dist, int force)
     if (gain)
         ws->in_angle[v] = NAN;
     if ((ws->pseudo[v] || force) && dist <= ws->max_d) {
-        ex_push(ws, dist, -v - 1);
+        int32_t e = ex_new(ws);
+        if (e < 0)
+            return 0;
+        ws->heap[e].key = dist;
+        ws->heap[e].he = -v - 1;
+        ex_queue(ws, e);
         return gain && !force && ws->fan_total[v] == ws->fan_total[v];
     }
     return 0;
@@ -678,10 +643,10 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
     double r0 = (rx - s0) * (rx - s0), r1 = (rx - s1) * (rx - s1);
     if (key > ws->d[vr] + sqrt((r0 > r1 ? r0 : r1) + ry * ry))
         return;
-    int32_t wi = ex_alloc_window(ws);
+    int32_t wi = ex_new(ws);
     if (wi < 0)
         return;
-    ex_window *w = ws->pool + wi;
+    ex_entry *w = ws->heap + wi;
     if (ws->flip[h]) {
         w->b0 = L - s1;
         w->b1 = L - s0;
@@ -694,13 +659,9 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
     w->py = -iy;
     w->sigma = sigma;
     w->he = g;
-    if (!ex_push(ws, key, wi)) {
-        ex_free_window(ws, wi);
-        return;
-    }
+    w->key = key;
+    ex_queue(ws, wi);
     ws->n_windows++;
-    if (ws->heap_n > ws->peak_windows)
-        ws->peak_windows = ws->heap_n;
 }
 
 /* Where the line from I through X = (x, 0) meets the line O + s u (s). */
@@ -718,7 +679,7 @@ static double ex_hit(double ox, double oy, double ux, double uy, double ix, doub
     return s;
 }
 
-static void ex_propagate(mfmm_exact_ws *ws, const ex_window *w)
+static void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
 {
     int32_t h = w->he;
     int32_t f = h / 3;
@@ -869,11 +830,9 @@ static void ex_reset(mfmm_exact_ws *ws)
     ws->redist = ws->cur;
     for (int32_t i = 0; i < EX_NB; i++)
         ws->bhead[i] = -1;
-    ws->pool_used = 0;
-    ws->free_head = -1;
     ws->failed = 0;
     ws->n_windows = ws->n_propagated = ws->n_pseudo = ws->peak_windows = 0;
-    ws->peak_bytes = ex_bytes(ws, ws->pool_cap, ws->heap_cap);
+    ws->peak_bytes = ex_bytes(ws, ws->heap_cap);
 }
 
 /* The propagation from checked sources; d[] holds the result for touched
@@ -917,17 +876,16 @@ static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t
         ex_start_face(ws, s->face, w, s->value);
     }
     while (ws->heap_n > 0 && !ws->failed) {
-        ex_entry e = ex_pop(ws);
-        if (e.idx < 0) {
-            int32_t v = -e.idx - 1;
+        ex_entry e;
+        ex_pop(ws, &e);
+        if (e.he < 0) {
+            int32_t v = -e.he - 1;
             if (e.key != ws->d[v] || !(ws->emitted[v] > e.key))
                 continue;
             ws->emitted[v] = e.key;
             ex_start_vertex(ws, v, e.key);
         } else {
-            ex_window w = ws->pool[e.idx];
-            ex_free_window(ws, e.idx);
-            ex_propagate(ws, &w);
+            ex_propagate(ws, &e);
         }
     }
     return ws->failed ? (mfmm_status)ws->failed : MFMM_OK;
