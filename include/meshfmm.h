@@ -230,9 +230,10 @@ MFMM_API mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources,
 typedef struct mfmm_exact_solver mfmm_exact_solver;
 
 /* A workspace for one mesh and one thread: the mesh's edge geometry (about
- * 100 bytes per face) and per-vertex state (about 20 bytes per vertex),
- * plus a queue of windows that grows as needed and is kept for the next
- * solve. */
+ * 140 bytes per face) and per-vertex state (about 45 bytes per vertex),
+ * plus a queue of windows (56 bytes each) that grows as needed and is kept
+ * for the next solve (mfmm_exact_info.peak_bytes tells the total). Several
+ * exact solvers may share one mesh, one per thread. */
 MFMM_API mfmm_status mfmm_exact_solver_create(const mfmm_mesh *mesh, mfmm_exact_solver **out);
 
 /* Frees an exact solver; NULL is a no-op. */
