@@ -167,6 +167,43 @@ static void test_several_sources(void **state)
     ex_free(&fx);
 }
 
+/* Values far apart (negative, huge) and meshes scaled by 1e-30 and 1e+30:
+ * the same distances, scaled. */
+static void test_values_and_scale(void **state)
+{
+    (void)state;
+    const double scales[3] = {1.0, 1e-30, 1e30};
+    for (int k = 0; k < 3; k++) {
+        mfmm_gen_mesh g = mfmm_gen_sine(12);
+        for (int32_t i = 0; i < 3 * g.nv; i++)
+            g.V[i] *= scales[k];
+        ex_fx fx = ex_make(g);
+        double *ref = malloc((size_t)fx.g.nv * sizeof *ref);
+        assert_non_null(ref);
+        mfmm_source s = tm_vertex_source(40);
+        ex_solve(&fx, &s, 1, NULL);
+        memcpy(ref, fx.d, (size_t)fx.g.nv * sizeof *ref);
+        if (k == 0) {
+            /* a negative value, and a second source too far behind to matter */
+            mfmm_source two[2] = {tm_vertex_source(40), tm_vertex_source(100)};
+            two[0].value = -2.0;
+            two[1].value = 1e12;
+            ex_solve(&fx, two, 2, NULL);
+            for (int32_t v = 0; v < fx.g.nv; v++)
+                tm_assert_close(fx.d[v], ref[v] - 2.0, 1e-12);
+        } else {
+            mfmm_gen_mesh g1 = mfmm_gen_sine(12);
+            ex_fx one = ex_make(g1);
+            ex_solve(&one, &s, 1, NULL);
+            for (int32_t v = 0; v < fx.g.nv; v++)
+                tm_assert_close(ref[v] / scales[k], one.d[v], 1e-12 * (1.0 + one.d[v]));
+            ex_free(&one);
+        }
+        free(ref);
+        ex_free(&fx);
+    }
+}
+
 /* ------------------------------------------------------------ cube, prism */
 
 /* The surface of [0,1]^3, n x n squares a side. */
@@ -608,6 +645,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_plane_exact),
         cmocka_unit_test(test_several_sources),
+        cmocka_unit_test(test_values_and_scale),
         cmocka_unit_test(test_cube),
         cmocka_unit_test(test_cylinder),
         cmocka_unit_test(test_saddle),
