@@ -541,6 +541,11 @@ static void ex_pop(mfmm_exact_ws *ws, ex_entry *out)
             continue;
         }
         ws->bhead[i] = ws->heap[e].next;
+#ifdef __GNUC__
+        /* the next pop's record: a cold line when its bucket filled earlier */
+        if (ws->bhead[i] >= 0)
+            __builtin_prefetch(ws->heap + ws->bhead[i]);
+#endif
         ws->n_in--;
         ws->heap_n--;
         *out = ws->heap[e];
