@@ -584,6 +584,217 @@ static void test_patch(void **state)
     ex_free(&fx);
 }
 
+/* ------------------------------------------------ igl.exact_geodesic data */
+
+#ifdef MFMM_TEST_ZLIB
+#include <stdio.h>
+#include <zlib.h>
+
+static uint32_t rd16(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8;
+}
+
+static uint32_t rd32(const unsigned char *p)
+{
+    return rd16(p) | rd16(p + 2) << 16;
+}
+
+/* The bytes of member `name` of the zip file `buf` (stored or deflated),
+ * found through the central directory; NULL if absent or unreadable. */
+static unsigned char *zip_member(const unsigned char *buf, size_t n, const char *name,
+                                 size_t *out_n)
+{
+    if (n < 22)
+        return NULL;
+    size_t eocd = n - 22;
+    while (eocd > 0 && rd32(buf + eocd) != 0x06054b50u)
+        eocd--;
+    if (rd32(buf + eocd) != 0x06054b50u)
+        return NULL;
+    size_t cd = rd32(buf + eocd + 16), entries = rd16(buf + eocd + 10);
+    for (size_t i = 0; i < entries && cd + 46 <= n; i++) {
+        const unsigned char *c = buf + cd;
+        if (rd32(c) != 0x02014b50u)
+            return NULL;
+        uint32_t method = rd16(c + 10), csize = rd32(c + 20), usize = rd32(c + 24);
+        size_t nlen = rd16(c + 28), elen = rd16(c + 30), klen = rd16(c + 32);
+        size_t local = rd32(c + 42);
+        if (nlen == strlen(name) && !memcmp(c + 46, name, nlen) && local + 30 <= n) {
+            const unsigned char *l = buf + local;
+            size_t data = local + 30 + rd16(l + 26) + rd16(l + 28);
+            unsigned char *out = malloc(usize ? usize : 1);
+            if (!out || data + csize > n) {
+                free(out);
+                return NULL;
+            }
+            if (method == 0 && csize == usize) {
+                memcpy(out, buf + data, usize);
+            } else if (method == 8) {
+                z_stream z;
+                memset(&z, 0, sizeof z);
+                z.next_in = (unsigned char *)(uintptr_t)(buf + data);
+                z.avail_in = csize;
+                z.next_out = out;
+                z.avail_out = usize;
+                if (inflateInit2(&z, -MAX_WBITS) != Z_OK || inflate(&z, Z_FINISH) != Z_STREAM_END) {
+                    inflateEnd(&z);
+                    free(out);
+                    return NULL;
+                }
+                inflateEnd(&z);
+            } else {
+                free(out);
+                return NULL;
+            }
+            *out_n = usize;
+            return out;
+        }
+        cd += 46 + nlen + elen + klen;
+    }
+    return NULL;
+}
+
+/* An .npy array of little-endian f8 (as double) or i4/i8 (converted to
+ * double), C order: the values and the shape (up to 2 dimensions). */
+static double *npy_values(const unsigned char *b, size_t n, int64_t shape[2])
+{
+    if (n < 10 || memcmp(b, "\x93NUMPY", 6))
+        return NULL;
+    size_t hlen = b[6] == 1 ? rd16(b + 8) : rd32(b + 8), off = b[6] == 1 ? 10 : 12;
+    char hdr[512];
+    if (hlen >= sizeof hdr || off + hlen > n)
+        return NULL;
+    memcpy(hdr, b + off, hlen);
+    hdr[hlen] = 0;
+    const char *descr = strstr(hdr, "'descr': '");
+    const char *sh = strstr(hdr, "'shape': (");
+    if (!descr || !sh || strstr(hdr, "'fortran_order': True"))
+        return NULL;
+    descr += 10;
+    shape[0] = shape[1] = 1;
+    char *end;
+    shape[0] = strtoll(sh + 10, &end, 10);
+    if (*end == ',' && end[1] == ' ' && end[2] != ')')
+        shape[1] = strtoll(end + 2, &end, 10);
+    size_t count = (size_t)(shape[0] * shape[1]), item = descr[2] == '8' ? 8 : 4;
+    const unsigned char *data = b + off + hlen;
+    if (descr[0] != '<' || off + hlen + count * item > n)
+        return NULL;
+    double *out = malloc(count * sizeof *out);
+    if (!out)
+        return NULL;
+    for (size_t i = 0; i < count; i++) {
+        if (descr[1] == 'f' && item == 8) {
+            memcpy(out + i, data + 8 * i, 8);
+        } else if (descr[1] == 'i' && item == 4) {
+            int32_t v;
+            memcpy(&v, data + 4 * i, 4);
+            out[i] = v;
+        } else if (descr[1] == 'i' && item == 8) {
+            int64_t v;
+            memcpy(&v, data + 8 * i, 8);
+            out[i] = (double)v;
+        } else {
+            free(out);
+            return NULL;
+        }
+    }
+    return out;
+}
+
+static double *npz_array(const char *path, const char *member, int64_t shape[2])
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    unsigned char *buf = NULL;
+    size_t n = 0, cap = 0, got;
+    do {
+        if (n == cap) {
+            cap = cap ? 2 * cap : 1 << 16;
+            unsigned char *nb = realloc(buf, cap);
+            if (!nb)
+                break;
+            buf = nb;
+        }
+        got = fread(buf + n, 1, cap - n, f);
+        n += got;
+    } while (got > 0);
+    fclose(f);
+    size_t mn = 0;
+    unsigned char *m = buf ? zip_member(buf, n, member, &mn) : NULL;
+    double *out = m ? npy_values(m, mn, shape) : NULL;
+    free(m);
+    free(buf);
+    return out;
+}
+#endif
+
+/* tests/data/reference/NAME.npz: igl.exact_geodesic (Kirsanov's MMP) from
+ * three vertices of tests/data/meshes/NAME; ours equal to 1e-12 relative. */
+static void check_reference(const char *mesh_file, const char *npz_file)
+{
+#ifdef MFMM_TEST_ZLIB
+    char mpath[1024], rpath[1024];
+    snprintf(mpath, sizeof mpath, "%s/meshes/%s", MESHFMM_TEST_DATA_DIR, mesh_file);
+    snprintf(rpath, sizeof rpath, "%s/reference/%s", MESHFMM_TEST_DATA_DIR, npz_file);
+    int64_t ss[2], ds[2];
+    double *src = npz_array(rpath, "sources.npy", ss);
+    double *ref = npz_array(rpath, "distances.npy", ds);
+    double *V = NULL;
+    int32_t *F = NULL, nv = 0, nf = 0;
+    mfmm_error err;
+    if (!src || !ref || mfmm_load_mesh(mpath, &V, &nv, &F, &nf, &err) != MFMM_OK) {
+        free(src);
+        free(ref);
+        skip(); /* the data is not in this checkout */
+    }
+    assert_int_equal(ds[0], ss[0] * ss[1]);
+    assert_int_equal(ds[1], nv);
+    mfmm_gen_mesh g = {nv, nf, V, F};
+    mfmm_mesh *mesh = tm_make(&g);
+    mfmm_exact_solver *solver = NULL;
+    assert_int_equal(mfmm_exact_solver_create(mesh, &solver), MFMM_OK);
+    double *d = malloc((size_t)nv * sizeof *d);
+    assert_non_null(d);
+    for (int64_t i = 0; i < ds[0]; i++) {
+        mfmm_source s = tm_vertex_source((int32_t)src[i]);
+        assert_int_equal(mfmm_solve_exact(solver, &s, 1, NULL, d, NULL, &err), MFMM_OK);
+        for (int32_t v = 0; v < nv; v++) {
+            double r = ref[i * nv + v];
+            if (isinf(r))
+                assert_true(isinf(d[v]));
+            else
+                tm_assert_close(d[v], r, 1e-12 * r);
+        }
+    }
+    free(d);
+    mfmm_exact_solver_destroy(solver);
+    mfmm_mesh_destroy(mesh);
+    mfmm_free(V);
+    mfmm_free(F);
+    free(src);
+    free(ref);
+#else
+    (void)mesh_file;
+    (void)npz_file;
+    skip(); /* built without zlib: the .npz cannot be read */
+#endif
+}
+
+static void test_igl_reference_hand(void **state)
+{
+    (void)state;
+    check_reference("hand_lowres.obj", "hand_lowres.npz");
+}
+
+static void test_igl_reference_spot(void **state)
+{
+    (void)state;
+    check_reference("spot.obj", "spot.npz");
+}
+
 /* --------------------------------------------------------------- bad input */
 
 static void test_bad_input(void **state)
@@ -656,6 +867,8 @@ int main(void)
         cmocka_unit_test(test_memory_limit),
         cmocka_unit_test(test_patch),
         cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_igl_reference_hand),
+        cmocka_unit_test(test_igl_reference_spot),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
