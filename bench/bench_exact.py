@@ -15,7 +15,7 @@ import json
 import os
 import sys
 import time
-from ctypes import POINTER as P, c_double, c_int32, c_int64, c_size_t, c_void_p
+from ctypes import c_double, c_void_p
 from pathlib import Path
 
 import numpy as np
@@ -32,27 +32,6 @@ MESHES = ["hand_lowres.obj", "beetle.obj", "spot.obj", "wingnut.obj", "fertility
           "decimated-max.obj", "camelhead.off", "nefertiti-lowres.obj", "stanford-bunny.obj"]
 
 
-class mfmm_exact_options(ctypes.Structure):
-    _fields_ = [("cost", P(c_double)), ("cost_location", _lib.c_enum),
-                ("max_distance", c_double), ("memory_limit", c_size_t)]
-
-
-class mfmm_exact_info(ctypes.Structure):
-    _fields_ = [("n_windows", c_int64), ("n_propagated", c_int64),
-                ("n_pseudo_sources", c_int64), ("peak_windows", c_int64),
-                ("peak_bytes", c_size_t)]
-
-
-lib = _lib.lib
-lib.mfmm_exact_solver_create.restype = _lib.c_enum
-lib.mfmm_exact_solver_create.argtypes = [c_void_p, P(c_void_p)]
-lib.mfmm_exact_solver_destroy.argtypes = [c_void_p]
-lib.mfmm_exact_options_init.argtypes = [P(mfmm_exact_options)]
-lib.mfmm_solve_exact.restype = _lib.c_enum
-lib.mfmm_solve_exact.argtypes = [c_void_p, P(_lib.mfmm_source), c_int32, P(mfmm_exact_options),
-                                 P(c_double), P(mfmm_exact_info), P(_lib.mfmm_error)]
-
-
 def load(path: Path):
     import igl
     V, F = igl.read_triangle_mesh(str(path))
@@ -64,29 +43,27 @@ class Exact:
         self.V, self.F = V, F
         err = _lib.mfmm_error()
         self.mesh = c_void_p()
-        st = _lib.mfmm_mesh_create(V.ctypes.data_as(P(c_double)), len(V),
-                                   F.ctypes.data_as(P(c_int32)), len(F), None,
+        st = _lib.mfmm_mesh_create(V.ctypes.data, len(V), F.ctypes.data, len(F), None,
                                    ctypes.byref(self.mesh), ctypes.byref(err))
         assert st == 0, err.message
         self.solver = c_void_p()
-        assert lib.mfmm_exact_solver_create(self.mesh, ctypes.byref(self.solver)) == 0
+        assert _lib.mfmm_exact_solver_create(self.mesh, ctypes.byref(self.solver)) == 0
 
     def solve(self, source: int, max_distance=np.inf):
         src = _lib.mfmm_source(source, -1, (c_double * 3)(0, 0, 0), 0.0)
-        opt = mfmm_exact_options()
-        lib.mfmm_exact_options_init(ctypes.byref(opt))
+        opt = _lib.mfmm_exact_options()
+        _lib.mfmm_exact_options_init(ctypes.byref(opt))
         opt.max_distance = max_distance
         out = np.empty(len(self.V))
-        info = mfmm_exact_info()
+        info = _lib.mfmm_exact_info()
         err = _lib.mfmm_error()
-        st = lib.mfmm_solve_exact(self.solver, ctypes.byref(src), 1, ctypes.byref(opt),
-                                  out.ctypes.data_as(P(c_double)), ctypes.byref(info),
-                                  ctypes.byref(err))
+        st = _lib.mfmm_solve_exact(self.solver, ctypes.byref(src), 1, ctypes.byref(opt),
+                                   out.ctypes.data, ctypes.byref(info), ctypes.byref(err))
         assert st == 0, err.message
         return out, info
 
     def close(self):
-        lib.mfmm_exact_solver_destroy(self.solver)
+        _lib.mfmm_exact_solver_destroy(self.solver)
         _lib.mfmm_mesh_destroy(self.mesh)
 
 

@@ -169,6 +169,25 @@ class mfmm_solve_options(Structure):
     ]
 
 
+class mfmm_exact_options(Structure):
+    _fields_ = [
+        ("cost", c_void_p),  # const double *; must be NULL
+        ("cost_location", c_enum),
+        ("max_distance", c_double),
+        ("memory_limit", c_size_t),
+    ]
+
+
+class mfmm_exact_info(Structure):
+    _fields_ = [
+        ("n_windows", c_int64),
+        ("n_propagated", c_int64),
+        ("n_pseudo_sources", c_int64),
+        ("peak_windows", c_int64),
+        ("peak_bytes", c_size_t),
+    ]
+
+
 class mfmm_surface_point(Structure):
     _fields_ = [
         ("face", c_int32),
@@ -344,6 +363,17 @@ mfmm_solve = _proto(
     c_enum,
     # solver, sources (mfmm_source *), n_sources, options, distances (double *), err
     [c_void_p, c_void_p, c_int32, P(mfmm_solve_options), c_void_p, P(mfmm_error)],
+)
+# exact
+mfmm_exact_solver_create = _proto("mfmm_exact_solver_create", c_enum, [c_void_p, P(c_void_p)])
+mfmm_exact_solver_destroy = _proto("mfmm_exact_solver_destroy", None, [c_void_p])
+mfmm_exact_options_init = _proto("mfmm_exact_options_init", None, [P(mfmm_exact_options)])
+mfmm_solve_exact = _proto(
+    "mfmm_solve_exact",
+    c_enum,
+    # solver, sources (mfmm_source *), n_sources, options, distances (double *), info, err
+    [c_void_p, c_void_p, c_int32, P(mfmm_exact_options), c_void_p, P(mfmm_exact_info),
+     P(mfmm_error)],
 )
 # paths
 mfmm_path_options_init = _proto("mfmm_path_options_init", None, [P(mfmm_path_options)])
