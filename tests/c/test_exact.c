@@ -146,6 +146,27 @@ static void test_plane_exact(void **state)
     }
 }
 
+/* Faces of mixed orientation (a third of a grid's faces reversed) change
+ * nothing: edges are matched by their vertices, not their direction. */
+static void test_mixed_orientation(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh g = mfmm_gen_grid(12);
+    for (int32_t f = 0; f < g.nf; f += 3) {
+        int32_t t = g.F[3 * f + 1];
+        g.F[3 * f + 1] = g.F[3 * f + 2];
+        g.F[3 * f + 2] = t;
+    }
+    ex_fx fx = ex_make(g);
+    for (int32_t src = 0; src < fx.g.nv; src += 37) {
+        mfmm_source s = tm_vertex_source(src);
+        ex_solve(&fx, &s, 1, NULL);
+        for (int32_t v = 0; v < fx.g.nv; v++)
+            tm_assert_close(fx.d[v], dist3(fx.g.V + 3 * v, fx.g.V + 3 * src), 1e-12);
+    }
+    ex_free(&fx);
+}
+
 /* Several sources with initial values: T = min_i (value_i + |x - s_i|). */
 static void test_several_sources(void **state)
 {
@@ -351,29 +372,41 @@ static void test_saddle(void **state)
         memcpy(f, t, sizeof t);
         f += 9;
     }
-    ex_fx fx = ex_make(g);
-    double rho[13], phi[13];
-    rho[0] = phi[0] = 0.0;
-    for (int v = 1; v < 13; v++) {
-        rho[v] = dist3(fx.g.V, fx.g.V + 3 * v);
-        phi[v] = 70.0 * ((v - 1) % 6);
-    }
-    int sources[3] = {1, 8, 10};
-    for (int k = 0; k < 3; k++) {
-        int s = sources[k];
-        mfmm_source src = tm_vertex_source(s);
-        ex_solve(&fx, &src, 1, NULL);
-        for (int v = 0; v < 13; v++) {
-            double a = fabs(phi[v] - phi[s]);
-            if (420.0 - a < a)
-                a = 420.0 - a;
-            double want = a < 180.0 ? sqrt(rho[s] * rho[s] + rho[v] * rho[v] -
-                                           2.0 * rho[s] * rho[v] * cos(a * TM_PI / 180.0))
-                                    : rho[s] + rho[v];
-            tm_assert_close(fx.d[v], want, 1e-12);
+    for (int variant = 0; variant < 2; variant++) {
+        /* variant 1: every other face reversed (the fans are walked by vertex) */
+        mfmm_gen_mesh gv = ex_alloc(13, 18);
+        memcpy(gv.V, g.V, 13 * 3 * sizeof(double));
+        memcpy(gv.F, g.F, 18 * 3 * sizeof(int32_t));
+        for (int32_t k = 0; variant && k < 18; k += 2) {
+            int32_t t = gv.F[3 * k];
+            gv.F[3 * k] = gv.F[3 * k + 1];
+            gv.F[3 * k + 1] = t;
         }
+        ex_fx fx = ex_make(gv);
+        double rho[13], phi[13];
+        rho[0] = phi[0] = 0.0;
+        for (int v = 1; v < 13; v++) {
+            rho[v] = dist3(fx.g.V, fx.g.V + 3 * v);
+            phi[v] = 70.0 * ((v - 1) % 6);
+        }
+        int sources[3] = {1, 8, 10};
+        for (int k = 0; k < 3; k++) {
+            int s = sources[k];
+            mfmm_source src = tm_vertex_source(s);
+            ex_solve(&fx, &src, 1, NULL);
+            for (int v = 0; v < 13; v++) {
+                double a = fabs(phi[v] - phi[s]);
+                if (420.0 - a < a)
+                    a = 420.0 - a;
+                double want = a < 180.0 ? sqrt(rho[s] * rho[s] + rho[v] * rho[v] -
+                                               2.0 * rho[s] * rho[v] * cos(a * TM_PI / 180.0))
+                                        : rho[s] + rho[v];
+                tm_assert_close(fx.d[v], want, 1e-12);
+            }
+        }
+        ex_free(&fx);
     }
-    ex_free(&fx);
+    mfmm_gen_free(&g);
 }
 
 /* An L-shaped plane: around the reflex corner (a boundary vertex of angle
@@ -855,6 +888,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_plane_exact),
+        cmocka_unit_test(test_mixed_orientation),
         cmocka_unit_test(test_several_sources),
         cmocka_unit_test(test_values_and_scale),
         cmocka_unit_test(test_cube),
