@@ -4,6 +4,11 @@ igl.exact_geodesic references (Kirsanov's MMP) and against gdist
 
     MESHFMM_LIBRARY=build/libmeshfmm.so python bench/bench_exact.py [mesh ...]
 
+One JSON line per mesh as it finishes, then a table. Times are the least of
+BENCH_REPEAT (3) runs per source, averaged over the reference's 3 sources;
+"max rel err" is against the stored igl reference, "vs gdist" against
+gdist's distances from the same sources.
+
 Meshes: ../shared/meshes (or MESHFMM_SHARED_DIR), references in
 ../shared/reference. gdist is skipped (and said so) when it does not import
 (its wheels are built against numpy 1; numpy 2 refuses them)."""
@@ -200,5 +205,17 @@ def main(names):
     return rows
 
 
+def table(rows):
+    print(f"{'mesh':22s} {'nv':>6s} {'max rel err':>11s} {'vs gdist':>9s} "
+          f"{'ours ms':>9s} {'gdist ms':>9s} {'ratio':>6s} {'windows':>9s} {'peak MB':>8s}")
+    for r in rows:
+        err = "-" if r["max_rel_err"] is None else f"{r['max_rel_err']:.1e}"
+        vs = "-" if r["max_rel_vs_gdist"] is None else f"{r['max_rel_vs_gdist']:.1e}"
+        gd = "-" if r["gdist_s"] is None else f"{1e3 * r['gdist_s']:.2f}"
+        ratio = f"{r['speedup']:.1f}x" if "speedup" in r else "-"
+        print(f"{r['mesh']:22s} {r['nv']:6d} {err:>11s} {vs:>9s} {1e3 * r['ours_s']:9.2f} "
+              f"{gd:>9s} {ratio:>6s} {r['windows']:9d} {r['peak_MB']:8.1f}")
+
+
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    table(main(sys.argv[1:]))
