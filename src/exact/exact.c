@@ -661,14 +661,16 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
     /* pruning against the face the window leaves */
     if (!ex_trim(ix, -iy, sigma, L, ws->d[va], ws->d[vb], &s0, &s1))
         return;
-    double dx0 = ix - s0, dx1 = ix - s1;
-    double D0 = sigma + sqrt(dx0 * dx0 + iy2), D1 = sigma + sqrt(dx1 * dx1 + iy2);
-    double key = (ix >= s0 && ix <= s1) ? sigma + iy : (D0 < D1 ? D0 : D1);
+    /* the least distance: at the foot of I, or at the nearer end */
+    double dx = ix < s0 ? s0 - ix : ix > s1 ? ix - s1 : 0.0;
+    double key = sigma + (dx > 0.0 ? sqrt(dx * dx + iy2) : iy);
     if (key > ws->max_d)
         return;
+    /* key > d(R) + max |R E|, without a square root */
     double rx = ws->cx[h], ry = ws->cy[h];
     double r0 = (rx - s0) * (rx - s0), r1 = (rx - s1) * (rx - s1);
-    if (key > ws->d[vr] + sqrt((r0 > r1 ? r0 : r1) + ry * ry))
+    double gap = key - ws->d[vr];
+    if (gap > 0.0 && gap * gap > (r0 > r1 ? r0 : r1) + ry * ry)
         return;
     int32_t wi = ex_new(ws);
     if (wi < 0)
@@ -734,8 +736,8 @@ static void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
     if (b0 < tc) {
         /* left child: edge C -> A (half-edge 3f+m2), rays through [b0, min(b1, tc)] */
         int32_t hl = 3 * f + m2;
-        double lac = ws->len[hl];
-        double ux = -cx / lac, uy = -cy / lac;
+        double lac = ws->len[hl], il = 1.0 / lac;
+        double ux = -cx * il, uy = -cy * il;
         double s_hi = b0 <= 0.0 ? lac : ex_hit(cx, cy, ux, uy, px, py, b0, lac);
         double s_lo = tc <= b1 ? 0.0 : ex_hit(cx, cy, ux, uy, px, py, b1, lac);
         double qx = px - cx, qy = py - cy;
@@ -745,8 +747,8 @@ static void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
     if (b1 > tc) {
         /* right child: edge B -> C (half-edge 3f+m1), rays through [max(b0, tc), b1] */
         int32_t hr = 3 * f + m1;
-        double lbc = ws->len[hr];
-        double ux = (cx - L) / lbc, uy = cy / lbc;
+        double lbc = ws->len[hr], il = 1.0 / lbc;
+        double ux = (cx - L) * il, uy = cy * il;
         double s_lo = b1 >= L ? 0.0 : ex_hit(L, 0.0, ux, uy, px, py, b1, lbc);
         double s_hi = tc >= b0 ? lbc : ex_hit(L, 0.0, ux, uy, px, py, b0, lbc);
         double qx = px - L, qy = py;
