@@ -48,7 +48,7 @@ static int bench(const char *path, double edges, int n_sources)
     double t0 = now();
     mfmm_solve_exact(ws, &full_src, 1, NULL, d, &info, NULL);
     double t_full = now() - t0;
-    long long total = 0;
+    long long total = 0, windows = 0;
     size_t peak = 0;
     int done = 0;
     t0 = now();
@@ -61,15 +61,16 @@ static int bench(const char *path, double edges, int n_sources)
         if (mfmm_exact_patch(ws, &s, 1, radius, 0, &n, &vs, &ds, &info) != MFMM_OK)
             return 1;
         total += n;
+        windows += info.n_windows;
         if (info.peak_bytes > peak)
             peak = info.peak_bytes;
         done++;
     }
     double t_patch = (now() - t0) / done;
-    printf("%s: nv %d, radius %.3g (%.1f edges): %.1f vertices a patch, %.1f us a patch; "
-           "full solve %.1f ms (%.0f patches); peak %.2f MB\n",
-           path, (int)nv, radius, edges, (double)total / done, 1e6 * t_patch, 1e3 * t_full,
-           t_full / t_patch, peak / 1048576.0);
+    printf("%s: nv %d, radius %.3g (%.1f edges): %.1f vertices and %.0f windows a patch, "
+           "%.1f us a patch; full solve %.1f ms (%.0f patches); peak %.2f MB\n",
+           path, (int)nv, radius, edges, (double)total / done, (double)windows / done,
+           1e6 * t_patch, 1e3 * t_full, t_full / t_patch, peak / 1048576.0);
     mfmm_exact_solver_destroy(ws);
     mfmm_mesh_destroy(mesh);
     mfmm_free(V);
