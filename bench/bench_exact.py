@@ -9,8 +9,8 @@ BENCH_REPEAT (3) runs per source, averaged over the reference's 3 sources;
 "max rel err" is against the stored igl reference, "vs gdist" against
 gdist's distances from the same sources.
 
-Meshes: ../shared/meshes (or MESHFMM_SHARED_DIR), references in
-../shared/reference. gdist is skipped (and said so) when it does not import
+Meshes: tests/data/meshes (or $MESHFMM_DATA_DIR/meshes), references in
+tests/data/reference. gdist is skipped (and said so) when it does not import
 (its wheels are built against numpy 1; numpy 2 refuses them)."""
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from meshfmm import _lib  # noqa: E402
 
 # each solve is timed REPEAT times and the least kept (the machine is shared)
 REPEAT = int(os.environ.get("BENCH_REPEAT", "3"))
-SHARED = Path(os.environ.get("MESHFMM_SHARED_DIR", REPO.parent / "shared"))
+DATA = Path(os.environ.get("MESHFMM_DATA_DIR", REPO / "tests" / "data"))
 MESHES = ["hand_lowres.obj", "beetle.obj", "spot.obj", "wingnut.obj", "fertility_FE_10k.off",
           "decimated-max.obj", "camelhead.off", "nefertiti-lowres.obj", "stanford-bunny.obj"]
 
@@ -147,9 +147,9 @@ def main(names):
         print(f"gdist: {why}")
     rows = []
     for name in names or MESHES:
-        V, F = load(SHARED / "meshes" / name)
+        V, F = load(DATA / "meshes" / name)
         ex = Exact(V, F)
-        ref_path = SHARED / "reference" / (Path(name).stem + ".npz")
+        ref_path = DATA / "reference" / (Path(name).stem + ".npz")
         if ref_path.exists():
             ref = np.load(ref_path)
             sources, refd = [int(s) for s in ref["sources"]], ref["distances"]

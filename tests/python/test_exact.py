@@ -1,5 +1,5 @@
 """mfmm_solve_exact through the C ABI (meshfmm._lib): live against
-igl.exact_geodesic (Kirsanov's MMP) on the smallest shared mesh, from
+igl.exact_geodesic (Kirsanov's MMP) on the smallest test mesh, from
 vertices and from face centroids (igl's face sources), and the refusal of a
 cost. The stored references of all meshes are checked by bench/bench_exact.py
 and tests/c/test_exact.c."""
@@ -11,7 +11,7 @@ import ctypes
 import numpy as np
 import pytest
 
-from conftest import MESHES, need_shared
+from conftest import MESHES, need_data
 from meshfmm import _lib
 
 
@@ -37,7 +37,7 @@ def _solve_exact(V, F, source, options=None):
 
 def test_live_against_igl():
     igl = pytest.importorskip("igl")
-    need_shared()
+    need_data()
     V, F = igl.read_triangle_mesh(str(MESHES / "hand_lowres.obj"))
     F = F.astype(np.int64)
     none = np.array([], dtype=np.int64)
