@@ -232,7 +232,7 @@ MFMM_API mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources,
 typedef struct mfmm_exact_solver mfmm_exact_solver;
 
 /* A workspace for one mesh and one thread: the mesh's edge geometry (about
- * 140 bytes per face) and per-vertex state (about 45 bytes per vertex),
+ * 180 bytes per face) and per-vertex state (about 45 bytes per vertex),
  * plus a queue of windows (56 bytes each) that grows as needed and is kept
  * for the next solve (mfmm_exact_info.peak_bytes tells the total). Several
  * exact solvers may share one mesh, one per thread. */

@@ -65,11 +65,11 @@
  * edges from the 3D vectors (dot and cross products); the law of cosines
  * loses (L / height)^2 eps of a needle's height.
  *
- * Memory: per-mesh tables (edge lengths, each corner in the frame of the
- * opposite edge, corner angles and fan angles, the edge across: about 140
- * bytes per face, 45 per vertex), and the queue's entries (windows and
- * vertex events, 56 bytes each), grown by doubling within memory_limit. No
- * recursion. */
+ * Memory: per-mesh tables (a 128-byte record per face with its edges'
+ * lengths, each corner in the frame of the opposite edge, the edges across
+ * and the vertices; corner and fan angles: about 180 bytes per face, 45 per
+ * vertex), and the queue's entries (windows and vertex events, 56 bytes
+ * each), grown by doubling within memory_limit. No recursion. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -96,6 +96,18 @@
 /* a vertex whose angle sum exceeds 2 pi by this much is a saddle */
 #define EX_SADDLE_TOL 1e-12
 
+/* A face: for each corner k, the edge opposite it (half-edge 3f+k, from
+ * corner k+1 to k+2): its length, corner k in its frame (x along the edge,
+ * y > 0), and the same edge in the face across it (3g+m, -1 at a wall) with
+ * whether it runs the other way there; the corners' vertices; whether the
+ * face has zero area (skipped). 128 bytes, aligned to cache lines. */
+typedef struct ex_face {
+    double len[3], cx[3], cy[3];
+    int32_t v[3], across[3];
+    uint8_t flip[3], skip;
+    uint8_t pad[128 - 9 * sizeof(double) - 6 * sizeof(int32_t) - 4];
+} ex_face;
+
 /* An entry of the queue: a window, or a vertex to start as a pseudo-source. */
 typedef struct ex_entry {
     double key;      /* the least distance of the window; a vertex's distance */
@@ -112,14 +124,11 @@ struct mfmm_exact_solver {
     int32_t nv, nf;
     const int32_t *faces;
     const int32_t *vf_offset, *vf_corner;
-    /* per half-edge 3f+k (the edge opposite corner k of face f, from corner
-     * k+1 to k+2): its length, corner k in its frame (x along the edge,
-     * y > 0), and the same edge in the face across it (3g+m, -1 at a wall)
-     * with whether it runs the other way there */
-    double *len, *cx, *cy;
-    int32_t *across;
-    uint8_t *flip;
-    uint8_t *skip;     /* (nf,) zero-area faces */
+    /* per face, its three half-edges 3f+k (the edge opposite corner k, from
+     * corner k+1 to k+2) in one record, so that crossing a face reads one or
+     * two cache lines: see ex_face */
+    ex_face *fr;
+    void *fr_block;    /* fr's allocation (fr is aligned to 64 bytes in it) */
     uint8_t *pseudo;   /* (nv,) vertices that may bend a path */
     /* the fan of corners around a vertex, by angle: corner 3f+k (at v = f[k])
      * spans the angles between fan_a0 (the direction to f[k+1]) and
@@ -164,12 +173,7 @@ void mfmm_exact_ws_destroy(mfmm_exact_ws *ws)
 {
     if (!ws)
         return;
-    free(ws->len);
-    free(ws->cx);
-    free(ws->cy);
-    free(ws->across);
-    free(ws->flip);
-    free(ws->skip);
+    free(ws->fr_block);
     free(ws->pseudo);
     free(ws->angle);
     free(ws->fan_a0);
@@ -215,7 +219,7 @@ static mfmm_status ex_build_fans(mfmm_exact_ws *ws)
             continue;
         int ok = 1;
         for (int32_t i = ws->vf_offset[v]; i < ws->vf_offset[v + 1]; i++)
-            if (ws->skip[ws->vf_corner[i] / 3])
+            if (ws->fr[ws->vf_corner[i] / 3].skip)
                 ok = 0;
         if (!ok)
             continue;
@@ -241,7 +245,7 @@ static mfmm_status ex_build_fans(mfmm_exact_ws *ws)
             }
             e += ws->angle[c];
             steps++;
-            int32_t nx = ws->across[3 * f + kent];
+            int32_t nx = ws->fr[f].across[kent];
             if (nx < 0 || steps > n_c) {
                 ok = 0;
                 break;
@@ -283,12 +287,11 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
     ws->faces = mesh->faces;
     ws->vf_offset = mesh->vertex_face_offset;
     ws->vf_corner = mesh->vertex_face_corner;
-    ws->len = malloc(nh * sizeof *ws->len);
-    ws->cx = malloc(nh * sizeof *ws->cx);
-    ws->cy = malloc(nh * sizeof *ws->cy);
-    ws->across = malloc(nh * sizeof *ws->across);
-    ws->flip = malloc(nh * sizeof *ws->flip);
-    ws->skip = malloc(nf * sizeof *ws->skip);
+    ws->fr_block = malloc((nf ? nf : 1) * sizeof(ex_face) + 64);
+    if (ws->fr_block) {
+        uintptr_t a = (uintptr_t)ws->fr_block;
+        ws->fr = (ex_face *)(void *)((char *)ws->fr_block + ((64 - a % 64) % 64));
+    }
     ws->pseudo = calloc(nv ? nv : 1, sizeof *ws->pseudo);
     ws->d = malloc((nv ? nv : 1) * sizeof *ws->d);
     ws->emitted = malloc((nv ? nv : 1) * sizeof *ws->emitted);
@@ -302,14 +305,14 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
     ws->bhead = malloc(EX_NB * sizeof *ws->bhead);
 
     ws->in_angle = malloc((nv ? nv : 1) * sizeof *ws->in_angle);
-    if (!ws->len || !ws->cx || !ws->cy || !ws->across || !ws->flip || !ws->skip || !ws->pseudo ||
+    if (!ws->fr_block || !ws->pseudo ||
         !ws->d || !ws->emitted || !ws->touched || !ws->patch_d || !angle || !ws->angle ||
         !ws->fan_a0 || !ws->fan_sgn || !ws->fan_total || !ws->in_angle || !ws->bhead) {
         free(angle);
         mfmm_exact_ws_destroy(ws);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
-    ws->fixed_bytes = sizeof *ws + nh * (5 * sizeof(double) + sizeof(int32_t) + 2) + nf +
+    ws->fixed_bytes = sizeof *ws + nf * sizeof(ex_face) + 64 + nh * (2 * sizeof(double) + 1) +
                       nv * (1 + 5 * sizeof(double) + sizeof(int32_t)) +
                       EX_NB * sizeof(int32_t);
     const double *X = mesh->xyz;
@@ -317,13 +320,17 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
     for (size_t f = 0; f < nf; f++) {
         const int32_t *fv = F + 3 * f;
         int bad = mesh->degenerate[f] != 0;
-        for (int k = 0; k < 3; k++)
-            ws->len[3 * f + k] = vdist(X + 3 * (size_t)fv[(k + 1) % 3], X + 3 * (size_t)fv[(k + 2) % 3]);
+        ex_face *r = ws->fr + f;
+        memset(r, 0, sizeof *r);
+        for (int k = 0; k < 3; k++) {
+            r->len[k] = vdist(X + 3 * (size_t)fv[(k + 1) % 3], X + 3 * (size_t)fv[(k + 2) % 3]);
+            r->v[k] = fv[k];
+        }
         for (int k = 0; k < 3; k++) {
             /* corner k in the frame of the opposite edge, from the vectors
              * (not the law of cosines: that loses about (L / y)^2 eps of y
              * in a needle, 1e-7 for a 1e-6 wide one) */
-            double L = ws->len[3 * f + k];
+            double L = r->len[k];
             const double *a = X + 3 * (size_t)fv[(k + 1) % 3], *b = X + 3 * (size_t)fv[(k + 2) % 3],
                          *c = X + 3 * (size_t)fv[k];
             double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
@@ -332,28 +339,28 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
                             e[0] * w[1] - e[1] * w[0]};
             double x = (e[0] * w[0] + e[1] * w[1] + e[2] * w[2]) / L;
             double y = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]) / L;
-            ws->cx[3 * f + k] = x;
-            ws->cy[3 * f + k] = y;
+            r->cx[k] = x;
+            r->cy[k] = y;
             if (!(L > 0.0) || !(y > 0.0) || !isfinite(x) || !isfinite(y))
                 bad = 1;
         }
-        ws->skip[f] = (uint8_t)bad;
+        r->skip = (uint8_t)bad;
     }
     for (size_t f = 0; f < nf; f++) {
         const int32_t *fv = F + 3 * f;
         for (int k = 0; k < 3; k++) {
             size_t h = 3 * f + k;
             int32_t g = mesh->face_neighbor[h];
-            ws->across[h] = -1;
-            ws->flip[h] = 0;
-            if (g < 0 || ws->skip[f] || ws->skip[g])
+            ws->fr[f].across[k] = -1;
+            ws->fr[f].flip[k] = 0;
+            if (g < 0 || ws->fr[f].skip || ws->fr[g].skip)
                 continue;
             int32_t a = fv[(k + 1) % 3], b = fv[(k + 2) % 3];
             const int32_t *gv = F + 3 * (size_t)g;
             for (int m = 0; m < 3; m++) {
                 if (gv[m] != a && gv[m] != b) {
-                    ws->across[h] = 3 * g + m;
-                    ws->flip[h] = gv[(m + 1) % 3] != a;
+                    ws->fr[f].across[k] = 3 * g + m;
+                    ws->fr[f].flip[k] = gv[(m + 1) % 3] != a;
                 }
             }
         }
@@ -362,18 +369,18 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
      * zero-area faces; unreferenced vertices have nothing to start */
     for (size_t f = 0; f < nf; f++) {
         const int32_t *fv = F + 3 * f;
-        if (ws->skip[f]) {
+        if (ws->fr[f].skip) {
             for (int k = 0; k < 3; k++)
                 ws->pseudo[fv[k]] = 1;
             continue;
         }
         for (int k = 0; k < 3; k++) {
             /* angle at corner k, seen in the frame of the opposite edge */
-            double x = ws->cx[3 * f + k], y = ws->cy[3 * f + k], L = ws->len[3 * f + k];
+            double x = ws->fr[f].cx[k], y = ws->fr[f].cy[k], L = ws->fr[f].len[k];
             double a = atan2(y * L, y * y - x * (L - x));
             ws->angle[3 * f + k] = a;
             angle[fv[k]] += a;
-            if (ws->across[3 * f + k] < 0) {
+            if (ws->fr[f].across[k] < 0) {
                 ws->pseudo[fv[(k + 1) % 3]] = 1;
                 ws->pseudo[fv[(k + 2) % 3]] = 1;
             }
@@ -389,8 +396,8 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
     double sum_len = 0.0;
     size_t n_len = 0;
     for (size_t hh = 0; hh < nh; hh++) {
-        if (!ws->skip[hh / 3]) {
-            sum_len += ws->len[hh];
+        if (!ws->fr[hh / 3].skip) {
+            sum_len += ws->fr[hh / 3].len[hh % 3];
             n_len++;
         }
     }
@@ -639,10 +646,10 @@ static int ex_trim(double px, double py, double sigma, double L, double dA, doub
 static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double ix, double iy,
                     double sigma)
 {
-    const int32_t *fv = ws->faces + 3 * (size_t)(h / 3);
+    const ex_face *r = ws->fr + h / 3;
     int k = h % 3;
-    int32_t va = fv[k == 2 ? 0 : k + 1], vb = fv[k == 0 ? 2 : k - 1], vr = fv[k];
-    double L = ws->len[h];
+    int32_t va = r->v[k == 2 ? 0 : k + 1], vb = r->v[k == 0 ? 2 : k - 1], vr = r->v[k];
+    double L = r->len[k];
     if (s0 < 0.0)
         s0 = 0.0;
     if (s1 > L)
@@ -655,7 +662,7 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
         int32_t c = h - k + (k == 0 ? 2 : k - 1);
         ex_set_in(ws, vb, c, ws->angle[c] - atan2(iy, L - ix));
     }
-    int32_t g = ws->across[h];
+    int32_t g = r->across[k];
     if (g < 0 || !(s1 - s0 > EX_MIN_WIDTH * L))
         return;
     /* pruning against the face the window leaves */
@@ -667,7 +674,7 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
     if (key > ws->max_d)
         return;
     /* key > d(R) + max |R E|, without a square root */
-    double rx = ws->cx[h], ry = ws->cy[h];
+    double rx = r->cx[k], ry = r->cy[k];
     double r0 = (rx - s0) * (rx - s0), r1 = (rx - s1) * (rx - s1);
     double gap = key - ws->d[vr];
     if (gap > 0.0 && gap * gap > (r0 > r1 ? r0 : r1) + ry * ry)
@@ -676,7 +683,7 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
     if (wi < 0)
         return;
     ex_entry *w = ws->heap + wi;
-    if (ws->flip[h]) {
+    if (r->flip[k]) {
         w->b0 = L - s1;
         w->b1 = L - s0;
         w->px = L - ix;
@@ -713,9 +720,9 @@ static void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
     int32_t h = w->he;
     int32_t f = h / 3;
     int m = h % 3;
-    const int32_t *fv = ws->faces + 3 * (size_t)f;
-    int32_t vc = fv[m];
-    double L = ws->len[h], cx = ws->cx[h], cy = ws->cy[h];
+    const ex_face *r = ws->fr + f;
+    int32_t vc = r->v[m];
+    double L = r->len[m], cx = r->cx[m], cy = r->cy[m];
     double b0 = w->b0, b1 = w->b1, px = w->px, py = w->py, sigma = w->sigma;
     /* (checking the window again here, against the face it crosses with the
      * distances known by now, drops almost nothing: 1 window in 10^4 on the
@@ -736,7 +743,7 @@ static void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
     if (b0 < tc) {
         /* left child: edge C -> A (half-edge 3f+m2), rays through [b0, min(b1, tc)] */
         int32_t hl = 3 * f + m2;
-        double lac = ws->len[hl], il = 1.0 / lac;
+        double lac = r->len[m2], il = 1.0 / lac;
         double ux = -cx * il, uy = -cy * il;
         double s_hi = b0 <= 0.0 ? lac : ex_hit(cx, cy, ux, uy, px, py, b0, lac);
         double s_lo = tc <= b1 ? 0.0 : ex_hit(cx, cy, ux, uy, px, py, b1, lac);
@@ -747,7 +754,7 @@ static void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
     if (b1 > tc) {
         /* right child: edge B -> C (half-edge 3f+m1), rays through [max(b0, tc), b1] */
         int32_t hr = 3 * f + m1;
-        double lbc = ws->len[hr], il = 1.0 / lbc;
+        double lbc = r->len[m1], il = 1.0 / lbc;
         double ux = (cx - L) * il, uy = cy * il;
         double s_lo = b1 >= L ? 0.0 : ex_hit(L, 0.0, ux, uy, px, py, b1, lbc);
         double s_hi = tc >= b0 ? lbc : ex_hit(L, 0.0, ux, uy, px, py, b0, lbc);
@@ -779,9 +786,10 @@ static void ex_start_vertex(mfmm_exact_ws *ws, int32_t v, double dv)
     if (!(th == th) || !(total == total)) {
         for (int32_t i = ws->vf_offset[v]; i < ws->vf_offset[v + 1]; i++) {
             int32_t c = ws->vf_corner[i];
-            if (ws->skip[c / 3])
+            const ex_face *r = ws->fr + c / 3;
+            if (r->skip)
                 continue;
-            ex_emit(ws, c, 0.0, ws->len[c], ws->cx[c], ws->cy[c], dv);
+            ex_emit(ws, c, 0.0, r->len[c % 3], r->cx[c % 3], r->cy[c % 3], dv);
         }
         return;
     }
@@ -813,7 +821,8 @@ static void ex_start_vertex(mfmm_exact_ws *ws, int32_t v, double dv)
                 p0 = f1 - b;
                 p1 = f1 - a;
             }
-            double L = ws->len[c], cx = ws->cx[c], cy = ws->cy[c];
+            const ex_face *r = ws->fr + c / 3;
+            double L = r->len[c % 3], cx = r->cx[c % 3], cy = r->cy[c % 3];
             double s0 = p0 <= 0.0 ? 0.0 : ex_ray_x(cx, cy, p0, L);
             double s1 = p1 >= ang ? L : ex_ray_x(cx, cy, p1, L);
             ex_emit(ws, c, s0, s1, cx, cy, dv);
@@ -829,9 +838,10 @@ static void ex_start_face(mfmm_exact_ws *ws, int32_t f, const double *w, double 
     for (int k = 0; k < 3; k++) {
         int32_t h = 3 * f + k;
         /* corners k+1 at (0,0), k+2 at (L,0), k at (cx,cy) */
-        double ix = w[(k + 2) % 3] * ws->len[h] + w[k] * ws->cx[h];
-        double iy = w[k] * ws->cy[h];
-        ex_emit(ws, h, 0.0, ws->len[h], ix, iy, value);
+        const ex_face *r = ws->fr + f;
+        double ix = w[(k + 2) % 3] * r->len[k] + w[k] * r->cx[k];
+        double iy = w[k] * r->cy[k];
+        ex_emit(ws, h, 0.0, r->len[k], ix, iy, value);
     }
 }
 
@@ -933,7 +943,7 @@ static mfmm_status ex_check_sources(const mfmm_exact_ws *ws, const mfmm_source *
         mfmm_status st = mfmm_check_source(ws->mesh, sources + i, i, err);
         if (st != MFMM_OK)
             return st;
-        if (sources[i].face >= 0 && ws->skip[sources[i].face])
+        if (sources[i].face >= 0 && ws->fr[sources[i].face].skip)
             return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, i,
                              "source %ld lies on face %ld, which has zero area", (long)i,
                              (long)sources[i].face);
