@@ -248,10 +248,11 @@ typedef struct mfmm_exact_options {
     mfmm_cost_location cost_location;
     double max_distance;  /* vertices farther are +inf and the propagation stops
                              there (cost grows with the area reached). Default +inf */
-    size_t memory_limit;  /* bytes the solver may hold in all, its per-mesh tables
-                             and the queue it kept from earlier solves included;
-                             needing more returns MFMM_ERR_MEMORY_LIMIT.
-                             0 (default): no limit */
+    size_t memory_limit;  /* bytes the solver may hold in all during this solve,
+                             its per-mesh tables included (a larger queue kept
+                             from an earlier solve is released first); needing
+                             more returns MFMM_ERR_MEMORY_LIMIT. 0 (default): no
+                             limit */
 } mfmm_exact_options;
 
 /* Fills `options` with the defaults: no cost, no limit on distance or memory. */

@@ -878,6 +878,13 @@ static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t
     ws->memory_limit = memory_limit;
     if (memory_limit && ws->fixed_bytes > memory_limit)
         return MFMM_ERR_MEMORY_LIMIT;
+    if (memory_limit && ex_bytes(ws, ws->heap_cap) > memory_limit) {
+        /* the queue an earlier solve grew is empty now: give it back */
+        free(ws->heap);
+        ws->heap = NULL;
+        ws->heap_cap = 0;
+        ws->peak_bytes = ex_bytes(ws, 0);
+    }
     for (int32_t i = 0; i < n_sources; i++) {
         const mfmm_source *s = sources + i;
         if (s->face < 0) {

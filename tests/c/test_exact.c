@@ -5,6 +5,7 @@
  * walls at non-manifold edges and other components, the memory limit, the
  * patch API, and every bad input. */
 #include <math.h>
+#include <pthread.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -576,6 +577,69 @@ static void test_memory_limit(void **state)
     assert_int_equal(mfmm_solve_exact(small, &s, 1, &o, fx.d, &info, &err), MFMM_OK);
     assert_true(info.peak_bytes <= need);
     mfmm_exact_solver_destroy(small);
+    /* a solver whose queue grew in an unlimited solve gives it back for a
+     * limited one that needs less: a source in a corner, within 0.2 */
+    o.memory_limit = need - need / 8;
+    o.max_distance = 0.2;
+    mfmm_source corner = tm_vertex_source(0);
+    assert_int_equal(mfmm_solve_exact(fx.solver, &corner, 1, &o, fx.d, &info, &err), MFMM_OK);
+    assert_true(info.peak_bytes <= o.memory_limit);
+    tm_assert_close(fx.d[1], 1.0 / 30.0, 1e-15);
+    ex_free(&fx);
+}
+
+/* ---------------------------------------------------------------- threads */
+
+typedef struct ex_job {
+    const mfmm_mesh *mesh;
+    int32_t nv, first;
+    double *out; /* 4 rows of nv */
+    int ok;
+} ex_job;
+
+static void *ex_worker(void *arg)
+{
+    ex_job *job = arg;
+    mfmm_exact_solver *solver = NULL;
+    job->ok = mfmm_exact_solver_create(job->mesh, &solver) == MFMM_OK;
+    for (int i = 0; job->ok && i < 4; i++) {
+        mfmm_source s = tm_vertex_source(job->first + 13 * i);
+        job->ok = mfmm_solve_exact(solver, &s, 1, NULL, job->out + (size_t)i * job->nv, NULL,
+                                   NULL) == MFMM_OK;
+    }
+    mfmm_exact_solver_destroy(solver);
+    return NULL;
+}
+
+/* Solvers of one mesh in several threads at once (no shared mutable state):
+ * the same rows as one thread alone. */
+static void test_threads(void **state)
+{
+    (void)state;
+    ex_fx fx = ex_make(mfmm_gen_sine(24));
+    enum { NT = 3 };
+    pthread_t th[NT];
+    ex_job jobs[NT];
+    for (int t = 0; t < NT; t++) {
+        jobs[t].mesh = fx.mesh;
+        jobs[t].nv = fx.g.nv;
+        jobs[t].first = 5 + 101 * t;
+        jobs[t].out = malloc(4 * (size_t)fx.g.nv * sizeof(double));
+        assert_non_null(jobs[t].out);
+        assert_int_equal(pthread_create(&th[t], NULL, ex_worker, &jobs[t]), 0);
+    }
+    for (int t = 0; t < NT; t++)
+        assert_int_equal(pthread_join(th[t], NULL), 0);
+    for (int t = 0; t < NT; t++) {
+        assert_true(jobs[t].ok);
+        for (int i = 0; i < 4; i++) {
+            mfmm_source s = tm_vertex_source(jobs[t].first + 13 * i);
+            ex_solve(&fx, &s, 1, NULL);
+            assert_memory_equal(fx.d, jobs[t].out + (size_t)i * fx.g.nv,
+                                (size_t)fx.g.nv * sizeof(double));
+        }
+        free(jobs[t].out);
+    }
     ex_free(&fx);
 }
 
@@ -899,6 +963,7 @@ int main(void)
         cmocka_unit_test(test_nonmanifold_components),
         cmocka_unit_test(test_degenerate_face),
         cmocka_unit_test(test_memory_limit),
+        cmocka_unit_test(test_threads),
         cmocka_unit_test(test_patch),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_igl_reference_hand),
