@@ -144,7 +144,7 @@ struct mfmm_exact_solver {
     int32_t n_touched;
     double *patch_d;   /* (nv,) distances of mfmm_exact_patch */
     /* the queue */
-    ex_entry *heap;    /* the entries of the bucket queue, linked by pad */
+    ex_entry *heap;    /* the entries of the bucket queue, linked by next */
     int32_t heap_cap, heap_n, heap_used, qfree;
     int32_t *bhead;    /* (EX_NB,) LIFO lists of the buckets in the window */
     int32_t over;      /* entries beyond the window, unsorted */
@@ -275,7 +275,7 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
     *out = NULL;
     if (!mesh)
         return MFMM_ERR_NULL_POINTER;
-    if (mesh->nf > INT32_MAX / 3 - 1)
+    if (mesh->nf > INT32_MAX / 3 - 1 || (size_t)mesh->nf > (SIZE_MAX - 64) / sizeof(ex_face))
         return MFMM_ERR_BAD_COUNT;
     mfmm_exact_ws *ws = calloc(1, sizeof *ws);
     if (!ws)
@@ -303,7 +303,6 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
     ws->fan_sgn = malloc(nh * sizeof *ws->fan_sgn);
     ws->fan_total = malloc((nv ? nv : 1) * sizeof *ws->fan_total);
     ws->bhead = malloc(EX_NB * sizeof *ws->bhead);
-
     ws->in_angle = malloc((nv ? nv : 1) * sizeof *ws->in_angle);
     if (!ws->fr_block || !ws->pseudo ||
         !ws->d || !ws->emitted || !ws->touched || !ws->patch_d || !angle || !ws->angle ||
@@ -456,7 +455,7 @@ static int ex_grow(mfmm_exact_ws *ws)
     return 1;
 }
 
-/* The queue: buckets of keys (width about a tenth of an edge) in a
+/* The queue: buckets of keys (a quarter of a mean edge wide) in a
  * circular window of EX_NB buckets, LIFO inside a bucket, entries beyond
  * the window in one overflow list that is sorted in when the window moves
  * on. Pops come in key order to within a bucket's width (as the "fast
@@ -1023,7 +1022,10 @@ mfmm_status mfmm_exact_patch(mfmm_exact_ws *ws, const mfmm_source *sources, int3
         return MFMM_ERR_BAD_COUNT;
     if (isnan(radius) || radius < 0.0)
         return MFMM_ERR_BAD_ARGUMENT;
-    mfmm_status st = ex_run(ws, sources, n_sources, radius, memory_limit);
+    mfmm_status st = ex_check_sources(ws, sources, n_sources, NULL);
+    if (st != MFMM_OK)
+        return st;
+    st = ex_run(ws, sources, n_sources, radius, memory_limit);
     ex_fill_info(ws, info);
     if (st != MFMM_OK)
         return st;

@@ -19,10 +19,13 @@ void mfmm_exact_ws_destroy(mfmm_exact_ws *ws);
 /* Exact distances from point sources within `radius` only: the "exact
  * start" of a march. Propagation stops once every window and pseudo-source
  * left is farther than radius, so the cost grows with the patch, not the
- * mesh. Sources must be valid (mfmm_check_source); value is added as usual.
- *   n_vertices: receives the number of vertices with distance <= radius.
+ * mesh (about 0.2 ms for 150 vertices on the 35k-vertex test meshes).
+ * Sources as for mfmm_solve_exact (checked: MFMM_ERR_BAD_SOURCE and the
+ * like); T = value + distance, and the patch is where T <= radius.
+ *   n_vertices: receives the number of vertices with T <= radius.
  *   vertices, distances: receive arrays of that length owned by ws, valid
- *   until its next call (vertex ids, and their exact distances).
+ *   until its next call (vertex ids, and their exact T), in no particular
+ *   order.
  *   memory_limit: bytes ws may hold in all (0: no limit).
  *   info: may be NULL.
  * Reuses ws's buffers: after the first calls have grown them, a call

@@ -678,6 +678,18 @@ static void test_patch(void **state)
     assert_int_equal(mfmm_exact_patch(NULL, &s, 1, 0.1, 0, &n, &vs, &ds, NULL), MFMM_ERR_NULL_POINTER);
     assert_int_equal(mfmm_exact_patch(fx.solver, &s, 0, 0.1, 0, &n, &vs, &ds, NULL), MFMM_ERR_BAD_COUNT);
     assert_int_equal(mfmm_exact_patch(fx.solver, &s, 1, NAN, 0, &n, &vs, &ds, NULL), MFMM_ERR_BAD_ARGUMENT);
+    mfmm_source bad = tm_vertex_source(fx.g.nv);
+    assert_int_equal(mfmm_exact_patch(fx.solver, &bad, 1, 0.1, 0, &n, &vs, &ds, NULL), MFMM_ERR_BAD_SOURCE);
+    /* a point source in a face, with a value: T = value + distance <= radius */
+    mfmm_source fs = {0, 1000, {0.2, 0.3, 0.5}, 0.05};
+    double p[3] = {0.0, 0.0, 0.0};
+    for (int k = 0; k < 3; k++)
+        for (int e = 0; e < 3; e++)
+            p[e] += fs.bary[k] * fx.g.V[3 * fx.g.F[3000 + k] + e];
+    assert_int_equal(mfmm_exact_patch(fx.solver, &fs, 1, 0.15, 0, &n, &vs, &ds, NULL), MFMM_OK);
+    assert_true(n > 10);
+    for (int32_t i = 0; i < n; i++)
+        tm_assert_close(ds[i], 0.05 + dist3(fx.g.V + 3 * vs[i], p), 1e-12);
     ex_free(&fx);
 }
 
