@@ -2,7 +2,7 @@
 igl.exact_geodesic references (Kirsanov's MMP) and against gdist
 (gdist.compute_gdist, also Kirsanov's MMP), timed per source in one run.
 
-    MESHFMM_LIBRARY=build/libmeshfmm.so python bench/bench_exact.py [mesh ...]
+    MESHFMM_LIBRARY=build/libmeshfmm.so python bench/bench_exact.py [--json OUT] [mesh ...]
 
 One JSON line per mesh as it finishes, then a table. Times are the least of
 BENCH_REPEAT (3) runs per source, averaged over the reference's 3 sources;
@@ -218,4 +218,19 @@ def table(rows):
 
 
 if __name__ == "__main__":
-    table(main(sys.argv[1:]))
+    args = sys.argv[1:]
+    out = None
+    if "--json" in args:
+        i = args.index("--json")
+        out = Path(args[i + 1])
+        del args[i:i + 2]
+    rows = main(args)
+    table(rows)
+    if out:
+        sys.path.insert(0, str(REPO / "bench"))
+        import benchlib
+        gd = os.environ.get("GDIST_PYTHON")
+        out.write_text(json.dumps({
+            "machine": benchlib.machine_info(), "versions": benchlib.versions(),
+            "gdist_python": gd, "repeat": REPEAT, "rows": rows}, indent=1) + "\n")
+        print(f"written to {out}")
