@@ -476,7 +476,7 @@ def make_error(status: int, err: Optional[mfmm_error] = None, *, mesh: bool = Fa
         message = f"{context}: {message}"
     name = STATUS_NAMES[status] if 0 <= status < MFMM_STATUS_COUNT else f"status {status}"
     exc: BaseException
-    if status == MFMM_ERR_OUT_OF_MEMORY:
+    if status in (MFMM_ERR_OUT_OF_MEMORY, MFMM_ERR_MEMORY_LIMIT):
         exc = MemoryError(message)
     elif status in _OPENCL_STATUSES:
         exc = OpenCLError(message)
