@@ -76,6 +76,7 @@ typedef enum mfmm_status {
     MFMM_ERR_CANCELLED,           /* a callback asked to stop */
     MFMM_ERR_IO,                  /* a file could not be opened, read or written */
     MFMM_ERR_PARSE,               /* a mesh file is malformed */
+    MFMM_ERR_MEMORY_LIMIT,        /* a computation needed more memory than its memory_limit */
     MFMM_STATUS_COUNT
 } mfmm_status;
 
@@ -216,6 +217,77 @@ MFMM_API void mfmm_solve_options_init(mfmm_solve_options *options);
 MFMM_API mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources,
                                 int32_t n_sources, const mfmm_solve_options *options,
                                 double *distances, mfmm_error *err);
+
+/* ----------------------------------------------------------------- exact */
+
+/* Exact polyhedral geodesic distance (F = 1): the length of the shortest
+ * path on the surface of the piecewise-flat mesh, by window propagation
+ * (Chen & Han with the pruning of Xin & Wang, "ICH"; saddles start windows
+ * only in their shadow; see src/exact/exact.c). Equal to Kirsanov's MMP
+ * (igl.exact_geodesic, gdist) to rounding (about 1e-14 relative), several
+ * times faster than gdist. Boundaries and non-manifold edges are walls a
+ * path may run along but not cross; paths may pass through saddle,
+ * boundary and non-manifold vertices; zero-area faces are skipped (a vertex
+ * on no other face is +inf). Not for a cost: see mfmm_solve. */
+typedef struct mfmm_exact_solver mfmm_exact_solver;
+
+/* A workspace for one mesh and one thread: the mesh's edge geometry (about
+ * 180 bytes per face) and per-vertex state (about 45 bytes per vertex),
+ * plus a queue of windows (56 bytes each) that grows as needed and is kept
+ * for the next solve (mfmm_exact_info.peak_bytes tells the total). Several
+ * exact solvers may share one mesh, one per thread. */
+MFMM_API mfmm_status mfmm_exact_solver_create(const mfmm_mesh *mesh, mfmm_exact_solver **out);
+
+/* Frees an exact solver; NULL is a no-op. */
+MFMM_API void mfmm_exact_solver_destroy(mfmm_exact_solver *solver);
+
+typedef struct mfmm_exact_options {
+    /* Must be NULL: exact distances are for F = 1 (a cost is refused with
+     * MFMM_ERR_BAD_ARGUMENT; use mfmm_solve for weighted distances). */
+    const double *cost;
+    mfmm_cost_location cost_location;
+    double max_distance;  /* vertices farther are +inf and the propagation stops
+                             there (cost grows with the area reached). Default +inf */
+    size_t memory_limit;  /* bytes the solver may hold in all during this solve,
+                             its per-mesh tables included (a larger queue kept
+                             from an earlier solve is released first); needing
+                             more returns MFMM_ERR_MEMORY_LIMIT. 0 (default): no
+                             limit */
+} mfmm_exact_options;
+
+/* Fills `options` with the defaults: no cost, no limit on distance or memory. */
+MFMM_API void mfmm_exact_options_init(mfmm_exact_options *options);
+
+/* What one exact solve did. */
+typedef struct mfmm_exact_info {
+    int64_t n_windows;        /* windows created */
+    int64_t n_propagated;     /* windows taken from the queue and carried across their face */
+    int64_t n_pseudo_sources; /* vertex sources and saddle / boundary vertices that
+                                 started windows */
+    int64_t peak_windows;     /* most windows queued at once */
+    size_t peak_bytes;        /* most bytes the solver held (tables + queue) */
+} mfmm_exact_info;
+
+/* Exact geodesic distances from the sources to every vertex.
+ *   solver:    from mfmm_exact_solver_create for the mesh.
+ *   sources:   n_sources >= 1 sources, as for mfmm_solve: a vertex, or a point
+ *              in a face by barycentric coordinates (on an edge or at a corner
+ *              when some are 0), each with an initial value; the result is
+ *              min over sources of value + geodesic distance.
+ *   options:   NULL for defaults; cost must be NULL.
+ *   distances: (nv,) float64 out. Vertices in no component a source reaches,
+ *              unreferenced vertices and vertices beyond max_distance are
+ *              +inf (never NaN).
+ *   info:      (out) may be NULL.
+ * Errors: MFMM_ERR_NULL_POINTER, MFMM_ERR_BAD_COUNT (n_sources < 1),
+ * MFMM_ERR_BAD_SOURCE / MFMM_ERR_BAD_BARYCENTRIC / MFMM_ERR_DEGENERATE_SOURCE
+ * (err->index is the source), MFMM_ERR_BAD_ARGUMENT (a cost given, or
+ * max_distance NaN or < 0), MFMM_ERR_MEMORY_LIMIT, MFMM_ERR_OUT_OF_MEMORY;
+ * on error distances are all +inf. */
+MFMM_API mfmm_status mfmm_solve_exact(mfmm_exact_solver *solver, const mfmm_source *sources,
+                                      int32_t n_sources, const mfmm_exact_options *options,
+                                      double *distances, mfmm_exact_info *info,
+                                      mfmm_error *err);
 
 /* ----------------------------------------------------------------- paths */
 

@@ -29,6 +29,7 @@ static const char *const status_strings[MFMM_STATUS_COUNT] = {
     [MFMM_ERR_CANCELLED] = "cancelled by the caller",
     [MFMM_ERR_IO] = "a file could not be opened, read or written",
     [MFMM_ERR_PARSE] = "the mesh file is malformed",
+    [MFMM_ERR_MEMORY_LIMIT] = "the computation needed more memory than its memory limit",
 };
 
 const char *mfmm_status_string(mfmm_status status)

@@ -20,6 +20,8 @@ STRUCTS = {
     "mfmm_mesh_info": _lib.mfmm_mesh_info,
     "mfmm_source": _lib.mfmm_source,
     "mfmm_solve_options": _lib.mfmm_solve_options,
+    "mfmm_exact_options": _lib.mfmm_exact_options,
+    "mfmm_exact_info": _lib.mfmm_exact_info,
     "mfmm_surface_point": _lib.mfmm_surface_point,
     "mfmm_path_options": _lib.mfmm_path_options,
     "mfmm_matrix_options": _lib.mfmm_matrix_options,

@@ -64,7 +64,8 @@ MFMM_ERR_OPENCL_RUNTIME = 17
 MFMM_ERR_CANCELLED = 18
 MFMM_ERR_IO = 19
 MFMM_ERR_PARSE = 20
-MFMM_STATUS_COUNT = 21
+MFMM_ERR_MEMORY_LIMIT = 21
+MFMM_STATUS_COUNT = 22
 
 STATUS_NAMES = (
     "MFMM_OK",
@@ -88,6 +89,7 @@ STATUS_NAMES = (
     "MFMM_ERR_CANCELLED",
     "MFMM_ERR_IO",
     "MFMM_ERR_PARSE",
+    "MFMM_ERR_MEMORY_LIMIT",
 )
 assert len(STATUS_NAMES) == MFMM_STATUS_COUNT
 
@@ -164,6 +166,25 @@ class mfmm_solve_options(Structure):
         ("targets", c_void_p),  # const int32_t *
         ("n_targets", c_int32),
         ("unfolding", c_int32),
+    ]
+
+
+class mfmm_exact_options(Structure):
+    _fields_ = [
+        ("cost", c_void_p),  # const double *; must be NULL
+        ("cost_location", c_enum),
+        ("max_distance", c_double),
+        ("memory_limit", c_size_t),
+    ]
+
+
+class mfmm_exact_info(Structure):
+    _fields_ = [
+        ("n_windows", c_int64),
+        ("n_propagated", c_int64),
+        ("n_pseudo_sources", c_int64),
+        ("peak_windows", c_int64),
+        ("peak_bytes", c_size_t),
     ]
 
 
@@ -343,6 +364,17 @@ mfmm_solve = _proto(
     # solver, sources (mfmm_source *), n_sources, options, distances (double *), err
     [c_void_p, c_void_p, c_int32, P(mfmm_solve_options), c_void_p, P(mfmm_error)],
 )
+# exact
+mfmm_exact_solver_create = _proto("mfmm_exact_solver_create", c_enum, [c_void_p, P(c_void_p)])
+mfmm_exact_solver_destroy = _proto("mfmm_exact_solver_destroy", None, [c_void_p])
+mfmm_exact_options_init = _proto("mfmm_exact_options_init", None, [P(mfmm_exact_options)])
+mfmm_solve_exact = _proto(
+    "mfmm_solve_exact",
+    c_enum,
+    # solver, sources (mfmm_source *), n_sources, options, distances (double *), info, err
+    [c_void_p, c_void_p, c_int32, P(mfmm_exact_options), c_void_p, P(mfmm_exact_info),
+     P(mfmm_error)],
+)
 # paths
 mfmm_path_options_init = _proto("mfmm_path_options_init", None, [P(mfmm_path_options)])
 mfmm_trace_path = _proto(
@@ -444,7 +476,7 @@ def make_error(status: int, err: Optional[mfmm_error] = None, *, mesh: bool = Fa
         message = f"{context}: {message}"
     name = STATUS_NAMES[status] if 0 <= status < MFMM_STATUS_COUNT else f"status {status}"
     exc: BaseException
-    if status == MFMM_ERR_OUT_OF_MEMORY:
+    if status in (MFMM_ERR_OUT_OF_MEMORY, MFMM_ERR_MEMORY_LIMIT):
         exc = MemoryError(message)
     elif status in _OPENCL_STATUSES:
         exc = OpenCLError(message)

@@ -1,0 +1,1046 @@
+/* src/exact/README -- exact polyhedral geodesic distances.
+ *
+ * Algorithm: window propagation of Chen & Han ("Shortest paths on a
+ * polyhedron", SoCG 1990 / IJCGA 1996) with the pruning of Xin & Wang
+ * ("Improving Chen and Han's algorithm on the discrete geodesic problem",
+ * ACM TOG 28(4), 2009; "ICH"). Windows are not kept on edges and never
+ * intersected with each other (unlike Mitchell, Mount & Papadimitriou /
+ * Surazhsky et al. 2005, "MMP", which Kirsanov's library -- libigl's
+ * exact_geodesic, gdist -- implements); instead every window is checked
+ * against the best distances known at the vertices of its triangle and
+ * trimmed or dropped where a path through one of them is shorter. Windows
+ * and vertex events share one queue ordered by least distance (ICH's
+ * priority queue, kept here as buckets: see the queue below).
+ *
+ * A window lies on an edge, seen from the face it is about to cross: an
+ * interval [b0, b1] of the edge, its pseudo-source I unfolded into the
+ * edge's plane (px, py), py <= 0 on the far side from that face, and sigma,
+ * the distance from the sources to I. The distance it gives a point X of
+ * the interval is D(X) = sigma + |I X|. Crossing the face it may see the
+ * opposite vertex C (then d(C) <= sigma + |I C|) and splits into at most two
+ * children on the face's other edges. A vertex through which a shortest
+ * path may bend (a source, a saddle with angle sum > 2 pi, a boundary or
+ * non-manifold vertex, a vertex of a zero-area face) becomes a
+ * pseudo-source when its distance improves: it starts windows on the
+ * opposite edges of the faces around it.
+ *
+ * Pruning and trimming (sound; derived for this code). For a new window on
+ * edge PQ of the face PQR it leaves:
+ *   - |I X| - |P X| does not increase as X moves away from P along the
+ *     edge, so the part where D(X) > d(P) + |P X| is an interval at P's
+ *     end, found by solving one quadratic: the window is trimmed to the
+ *     rest (likewise from Q); ICH drops the whole window when its far end
+ *     is beaten, this keeps the part that is not;
+ *   - for R: dropped when min D > d(R) + max(|R E0|, |R E1|).
+ * Dropping or trimming is safe in any order: every point removed has a
+ * shorter path through a vertex, so no shortest path crosses it.
+ *
+ * Saddle shadows (from the geometry of geodesics through a vertex, as in
+ * Mitchell-Mount-Papadimitriou and Surazhsky et al.): a shortest path that
+ * reaches an interior saddle v from direction th can go on through v only
+ * into directions at angle >= pi from th on both sides, the "shadow"
+ * [th + pi, th + total - pi]; every other direction is reached more briefly
+ * by the windows passing beside v. So an interior saddle starts windows only
+ * in its shadow (with 1e-7 rad to spare), th being the direction of the path
+ * that gave v its distance (any one of several equal ones will do; a gain
+ * within rounding keeps the earlier direction, since rays grazing a vertex
+ * along an edge report directions that are not theirs). Sources, boundary,
+ * non-manifold and zero-area-face vertices start windows all around. This
+ * is what makes the method fast: about a third of ICH's windows remain.
+ *
+ * Queue: buckets a quarter of a mean edge wide (the "fast wavefront
+ * propagation" idea of Xu et al. 2015), LIFO inside a bucket. Pops come in
+ * order to within a bucket; pruning tolerates it, and a saddle started
+ * before its distance was final is started again when it improves, so the
+ * result does not depend on it.
+ *
+ * Sources: a vertex source is a pseudo-source with its value; a point in a
+ * face (on an edge too) starts a window on each edge of its face; a point
+ * within 1e-12 of a corner is that corner. Boundary and non-manifold edges
+ * (face_neighbor -1) and edges of zero-area faces are walls. max_distance
+ * (and the radius of mfmm_exact_patch) drops every window and event beyond
+ * it, so the work grows with the area reached.
+ *
+ * Geometry: each face's corners are laid out in the frame of each of its
+ * edges from the 3D vectors (dot and cross products); the law of cosines
+ * loses (L / height)^2 eps of a needle's height.
+ *
+ * Memory: per-mesh tables (a 128-byte record per face with its edges'
+ * lengths, each corner in the frame of the opposite edge, the edges across
+ * and the vertices; corner and fan angles: about 180 bytes per face, 45 per
+ * vertex), and the queue's entries (windows and vertex events, 56 bytes
+ * each), grown by doubling within memory_limit. No recursion. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "exact/exact.h"
+#include "core/mesh.h"
+#include "core/solve.h"
+
+#define EX_PI 3.14159265358979323846264338328
+#define EX_TWO_PI 6.283185307179586476925286766559
+/* the shadow of a saddle is widened by this angle on each side */
+#define EX_SHADOW_MARGIN 1e-7
+/* distances equal to this relative amount are ties */
+#define EX_TIE 1e-12
+/* buckets in the queue's window (a power of 2), and their width in mean
+ * edge lengths */
+#define EX_NB 4096
+#define EX_BUCKET_WIDTH 0.25
+/* a window narrower than this fraction of its edge is dropped */
+#define EX_MIN_WIDTH 1e-13
+/* a point of an edge this close (relative) to a window's end is in it */
+#define EX_POS_TOL 1e-12
+/* a vertex whose angle sum exceeds 2 pi by this much is a saddle */
+#define EX_SADDLE_TOL 1e-12
+
+/* A face: for each corner k, the edge opposite it (half-edge 3f+k, from
+ * corner k+1 to k+2): its length, corner k in its frame (x along the edge,
+ * y > 0), and the same edge in the face across it (3g+m, -1 at a wall) with
+ * whether it runs the other way there; the corners' vertices; whether the
+ * face has zero area (skipped). 128 bytes, aligned to cache lines. */
+typedef struct ex_face {
+    double len[3], cx[3], cy[3];
+    int32_t v[3], across[3];
+    uint8_t flip[3], skip;
+    uint8_t pad[128 - 9 * sizeof(double) - 6 * sizeof(int32_t) - 4];
+} ex_face;
+
+/* An entry of the queue: a window, or a vertex to start as a pseudo-source. */
+typedef struct ex_entry {
+    double key;      /* the least distance of the window; a vertex's distance */
+    double b0, b1;   /* interval on the edge, from its first vertex */
+    double px, py;   /* pseudo-source in the edge's frame, py <= 0 */
+    double sigma;    /* distance at the pseudo-source */
+    int32_t he;      /* >= 0: 3 f + k, the edge opposite corner k of face f, the
+                        window about to cross f; < 0: vertex -he-1 */
+    int32_t next;    /* the next entry in its bucket or in the free list */
+} ex_entry;
+
+struct mfmm_exact_solver {
+    const mfmm_mesh *mesh;
+    int32_t nv, nf;
+    const int32_t *faces;
+    const int32_t *vf_offset, *vf_corner;
+    /* per face, its three half-edges 3f+k (the edge opposite corner k, from
+     * corner k+1 to k+2) in one record, so that crossing a face reads one or
+     * two cache lines: see ex_face */
+    ex_face *fr;
+    void *fr_block;    /* fr's allocation (fr is aligned to 64 bytes in it) */
+    uint8_t *pseudo;   /* (nv,) vertices that may bend a path */
+    /* the fan of corners around a vertex, by angle: corner 3f+k (at v = f[k])
+     * spans the angles between fan_a0 (the direction to f[k+1]) and
+     * fan_a0 + fan_sgn * angle (to f[k+2]); fan_total (nv) is the angle sum,
+     * NaN where the fan is not one closed disk (walls, zero-area faces,
+     * non-manifold vertices): those start windows in every direction */
+    double *angle, *fan_a0, *fan_total;
+    int8_t *fan_sgn;
+    double *in_angle;  /* (nv,) direction (fan angle) back along the path that gave d */
+    double *d;         /* (nv,) best distance so far, +inf untouched */
+    double *emitted;   /* (nv,) the distance a pseudo-source was started with */
+    int32_t *touched;  /* vertices with finite d, in order of first touch */
+    int32_t n_touched;
+    double *patch_d;   /* (nv,) distances of mfmm_exact_patch */
+    /* the queue */
+    ex_entry *heap;    /* the entries of the bucket queue, linked by next */
+    int32_t heap_cap, heap_n, heap_used, qfree;
+    int32_t *bhead;    /* (EX_NB,) LIFO lists of the buckets in the window */
+    int32_t over;      /* entries beyond the window, unsorted */
+    int64_t cur, redist; /* current bucket; where the window was last refilled */
+    int32_t n_in;      /* entries in the window's buckets */
+    double inv_w;      /* 1 / bucket width */
+    size_t fixed_bytes, memory_limit, peak_bytes;
+    double max_d;
+    int failed; /* MFMM_ERR_MEMORY_LIMIT or MFMM_ERR_OUT_OF_MEMORY once a growth fails */
+    int64_t n_windows, n_propagated, n_pseudo, peak_windows;
+};
+
+/* ------------------------------------------------------------- workspace */
+
+void mfmm_exact_options_init(mfmm_exact_options *options)
+{
+    if (!options)
+        return;
+    options->cost = NULL;
+    options->cost_location = MFMM_COST_NONE;
+    options->max_distance = INFINITY;
+    options->memory_limit = 0;
+}
+
+void mfmm_exact_ws_destroy(mfmm_exact_ws *ws)
+{
+    if (!ws)
+        return;
+    free(ws->fr_block);
+    free(ws->pseudo);
+    free(ws->angle);
+    free(ws->fan_a0);
+    free(ws->fan_total);
+    free(ws->fan_sgn);
+    free(ws->in_angle);
+    free(ws->d);
+    free(ws->emitted);
+    free(ws->touched);
+    free(ws->patch_d);
+    free(ws->heap);
+    free(ws->bhead);
+    free(ws);
+}
+
+void mfmm_exact_solver_destroy(mfmm_exact_solver *solver)
+{
+    mfmm_exact_ws_destroy(solver);
+}
+
+static double vdist(const double *p, const double *q)
+{
+    double a = p[0] - q[0], b = p[1] - q[1], c = p[2] - q[2];
+    return sqrt(a * a + b * b + c * c);
+}
+
+static int ex_corner_of(const int32_t *fv, int32_t v)
+{
+    return fv[0] == v ? 0 : fv[1] == v ? 1 : fv[2] == v ? 2 : -1;
+}
+
+/* Walks the fan of every vertex through the faces across its edges, giving
+ * each corner its angles (fan_a0, fan_sgn) and each vertex its angle sum;
+ * NaN for vertices whose corners do not form one closed disk. */
+static mfmm_status ex_build_fans(mfmm_exact_ws *ws)
+{
+    const int32_t *F = ws->faces;
+    for (int32_t v = 0; v < ws->nv; v++) {
+        int32_t n_c = ws->vf_offset[v + 1] - ws->vf_offset[v];
+        ws->fan_total[v] = NAN;
+        ws->in_angle[v] = NAN;
+        if (n_c < 3)
+            continue;
+        int ok = 1;
+        for (int32_t i = ws->vf_offset[v]; i < ws->vf_offset[v + 1]; i++)
+            if (ws->fr[ws->vf_corner[i] / 3].skip)
+                ok = 0;
+        if (!ok)
+            continue;
+        int32_t c0 = ws->vf_corner[ws->vf_offset[v]];
+        int32_t f = c0 / 3, k = c0 % 3;
+        int32_t ent = F[3 * (size_t)f + (k + 1) % 3];
+        double e = 0.0;
+        int32_t steps = 0;
+        for (;;) {
+            const int32_t *fv = F + 3 * (size_t)f;
+            int32_t c = 3 * f + k, far;
+            int kent;
+            if (fv[(k + 1) % 3] == ent) {
+                ws->fan_a0[c] = e;
+                ws->fan_sgn[c] = 1;
+                far = fv[(k + 2) % 3];
+                kent = (k + 1) % 3;
+            } else {
+                ws->fan_a0[c] = e + ws->angle[c];
+                ws->fan_sgn[c] = -1;
+                far = fv[(k + 1) % 3];
+                kent = (k + 2) % 3;
+            }
+            e += ws->angle[c];
+            steps++;
+            int32_t nx = ws->fr[f].across[kent];
+            if (nx < 0 || steps > n_c) {
+                ok = 0;
+                break;
+            }
+            f = nx / 3;
+            k = ex_corner_of(F + 3 * (size_t)f, v);
+            ent = far;
+            if (k < 0) {
+                ok = 0;
+                break;
+            }
+            if (3 * f + k == c0) {
+                ok = steps == n_c && F[3 * (size_t)f + (k + 1) % 3] == ent;
+                break;
+            }
+        }
+        if (ok)
+            ws->fan_total[v] = e;
+    }
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
+{
+    if (!out)
+        return MFMM_ERR_NULL_POINTER;
+    *out = NULL;
+    if (!mesh)
+        return MFMM_ERR_NULL_POINTER;
+    if (mesh->nf > INT32_MAX / 3 - 1 || (size_t)mesh->nf > (SIZE_MAX - 64) / sizeof(ex_face))
+        return MFMM_ERR_BAD_COUNT;
+    mfmm_exact_ws *ws = calloc(1, sizeof *ws);
+    if (!ws)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    size_t nv = (size_t)mesh->nv, nf = (size_t)mesh->nf, nh = 3 * nf;
+    ws->mesh = mesh;
+    ws->nv = mesh->nv;
+    ws->nf = mesh->nf;
+    ws->faces = mesh->faces;
+    ws->vf_offset = mesh->vertex_face_offset;
+    ws->vf_corner = mesh->vertex_face_corner;
+    ws->fr_block = malloc((nf ? nf : 1) * sizeof(ex_face) + 64);
+    if (ws->fr_block) {
+        uintptr_t a = (uintptr_t)ws->fr_block;
+        ws->fr = (ex_face *)(void *)((char *)ws->fr_block + ((64 - a % 64) % 64));
+    }
+    ws->pseudo = calloc(nv ? nv : 1, sizeof *ws->pseudo);
+    ws->d = malloc((nv ? nv : 1) * sizeof *ws->d);
+    ws->emitted = malloc((nv ? nv : 1) * sizeof *ws->emitted);
+    ws->touched = malloc((nv ? nv : 1) * sizeof *ws->touched);
+    ws->patch_d = malloc((nv ? nv : 1) * sizeof *ws->patch_d);
+    double *angle = calloc(nv ? nv : 1, sizeof *angle);
+    ws->angle = malloc(nh * sizeof *ws->angle);
+    ws->fan_a0 = malloc(nh * sizeof *ws->fan_a0);
+    ws->fan_sgn = malloc(nh * sizeof *ws->fan_sgn);
+    ws->fan_total = malloc((nv ? nv : 1) * sizeof *ws->fan_total);
+    ws->bhead = malloc(EX_NB * sizeof *ws->bhead);
+    ws->in_angle = malloc((nv ? nv : 1) * sizeof *ws->in_angle);
+    if (!ws->fr_block || !ws->pseudo ||
+        !ws->d || !ws->emitted || !ws->touched || !ws->patch_d || !angle || !ws->angle ||
+        !ws->fan_a0 || !ws->fan_sgn || !ws->fan_total || !ws->in_angle || !ws->bhead) {
+        free(angle);
+        mfmm_exact_ws_destroy(ws);
+        return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    ws->fixed_bytes = sizeof *ws + nf * sizeof(ex_face) + 64 + nh * (2 * sizeof(double) + 1) +
+                      nv * (1 + 5 * sizeof(double) + sizeof(int32_t)) +
+                      EX_NB * sizeof(int32_t);
+    const double *X = mesh->xyz;
+    const int32_t *F = mesh->faces;
+    for (size_t f = 0; f < nf; f++) {
+        const int32_t *fv = F + 3 * f;
+        int bad = mesh->degenerate[f] != 0;
+        ex_face *r = ws->fr + f;
+        memset(r, 0, sizeof *r);
+        for (int k = 0; k < 3; k++) {
+            r->len[k] = vdist(X + 3 * (size_t)fv[(k + 1) % 3], X + 3 * (size_t)fv[(k + 2) % 3]);
+            r->v[k] = fv[k];
+        }
+        for (int k = 0; k < 3; k++) {
+            /* corner k in the frame of the opposite edge, from the vectors
+             * (not the law of cosines: that loses about (L / y)^2 eps of y
+             * in a needle, 1e-7 for a 1e-6 wide one) */
+            double L = r->len[k];
+            const double *a = X + 3 * (size_t)fv[(k + 1) % 3], *b = X + 3 * (size_t)fv[(k + 2) % 3],
+                         *c = X + 3 * (size_t)fv[k];
+            double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+            double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+            double cr[3] = {e[1] * w[2] - e[2] * w[1], e[2] * w[0] - e[0] * w[2],
+                            e[0] * w[1] - e[1] * w[0]};
+            double x = (e[0] * w[0] + e[1] * w[1] + e[2] * w[2]) / L;
+            double y = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]) / L;
+            r->cx[k] = x;
+            r->cy[k] = y;
+            if (!(L > 0.0) || !(y > 0.0) || !isfinite(x) || !isfinite(y))
+                bad = 1;
+        }
+        r->skip = (uint8_t)bad;
+    }
+    for (size_t f = 0; f < nf; f++) {
+        const int32_t *fv = F + 3 * f;
+        for (int k = 0; k < 3; k++) {
+            size_t h = 3 * f + k;
+            int32_t g = mesh->face_neighbor[h];
+            ws->fr[f].across[k] = -1;
+            ws->fr[f].flip[k] = 0;
+            if (g < 0 || ws->fr[f].skip || ws->fr[g].skip)
+                continue;
+            int32_t a = fv[(k + 1) % 3], b = fv[(k + 2) % 3];
+            const int32_t *gv = F + 3 * (size_t)g;
+            for (int m = 0; m < 3; m++) {
+                if (gv[m] != a && gv[m] != b) {
+                    ws->fr[f].across[k] = 3 * g + m;
+                    ws->fr[f].flip[k] = gv[(m + 1) % 3] != a;
+                }
+            }
+        }
+    }
+    /* pseudo-source candidates: saddles, vertices at a wall, and vertices of
+     * zero-area faces; unreferenced vertices have nothing to start */
+    for (size_t f = 0; f < nf; f++) {
+        const int32_t *fv = F + 3 * f;
+        if (ws->fr[f].skip) {
+            for (int k = 0; k < 3; k++)
+                ws->pseudo[fv[k]] = 1;
+            continue;
+        }
+        for (int k = 0; k < 3; k++) {
+            /* angle at corner k, seen in the frame of the opposite edge */
+            double x = ws->fr[f].cx[k], y = ws->fr[f].cy[k], L = ws->fr[f].len[k];
+            double a = atan2(y * L, y * y - x * (L - x));
+            ws->angle[3 * f + k] = a;
+            angle[fv[k]] += a;
+            if (ws->fr[f].across[k] < 0) {
+                ws->pseudo[fv[(k + 1) % 3]] = 1;
+                ws->pseudo[fv[(k + 2) % 3]] = 1;
+            }
+        }
+    }
+    for (size_t v = 0; v < nv; v++) {
+        if (angle[v] > EX_TWO_PI + EX_SADDLE_TOL)
+            ws->pseudo[v] = 1;
+        ws->d[v] = INFINITY;
+        ws->emitted[v] = INFINITY;
+    }
+    free(angle);
+    double sum_len = 0.0;
+    size_t n_len = 0;
+    for (size_t hh = 0; hh < nh; hh++) {
+        if (!ws->fr[hh / 3].skip) {
+            sum_len += ws->fr[hh / 3].len[hh % 3];
+            n_len++;
+        }
+    }
+    double width = n_len ? EX_BUCKET_WIDTH * sum_len / (double)n_len : 1.0;
+    ws->inv_w = width > 0.0 && isfinite(1.0 / width) ? 1.0 / width : 1.0;
+    mfmm_status st = ex_build_fans(ws);
+    if (st != MFMM_OK) {
+        mfmm_exact_ws_destroy(ws);
+        return st;
+    }
+    ws->max_d = INFINITY;
+    ws->peak_bytes = ws->fixed_bytes;
+    *out = ws;
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_exact_solver_create(const mfmm_mesh *mesh, mfmm_exact_solver **out)
+{
+    return mfmm_exact_ws_create(mesh, out);
+}
+
+/* ----------------------------------------------------------------- queue */
+
+static size_t ex_bytes(const mfmm_exact_ws *ws, int32_t heap_cap)
+{
+    return ws->fixed_bytes + (size_t)heap_cap * sizeof(ex_entry);
+}
+
+/* Grows the entries by doubling, within memory_limit. */
+static int ex_grow(mfmm_exact_ws *ws)
+{
+    int32_t cap = ws->heap_cap;
+    if (cap >= INT32_MAX / 2) {
+        ws->failed = MFMM_ERR_MEMORY_LIMIT;
+        return 0;
+    }
+    int32_t ncap = cap ? 2 * cap : 1024;
+    if (ws->memory_limit && ex_bytes(ws, ncap) > ws->memory_limit) {
+        /* the largest size that fits, if it is any larger */
+        size_t room = ws->memory_limit > ws->fixed_bytes ? ws->memory_limit - ws->fixed_bytes : 0;
+        if (room / sizeof(ex_entry) <= (size_t)cap) {
+            ws->failed = MFMM_ERR_MEMORY_LIMIT;
+            return 0;
+        }
+        ncap = (int32_t)(room / sizeof(ex_entry));
+    }
+    ex_entry *p = realloc(ws->heap, (size_t)ncap * sizeof *p);
+    if (!p) {
+        ws->failed = MFMM_ERR_OUT_OF_MEMORY;
+        return 0;
+    }
+    ws->heap = p;
+    ws->heap_cap = ncap;
+    if (ex_bytes(ws, ncap) > ws->peak_bytes)
+        ws->peak_bytes = ex_bytes(ws, ncap);
+    return 1;
+}
+
+/* The queue: buckets of keys (a quarter of a mean edge wide) in a
+ * circular window of EX_NB buckets, LIFO inside a bucket, entries beyond
+ * the window in one overflow list that is sorted in when the window moves
+ * on. Pops come in key order to within a bucket's width (as the "fast
+ * wavefront propagation" of Xu et al. 2015 does for MMP and CH): enough for
+ * the pruning, and the result does not depend on it (a pseudo-source
+ * started before its distance was final is started again when it
+ * improves). */
+static int64_t ex_bucket(const mfmm_exact_ws *ws, double key)
+{
+    double b = floor(key * ws->inv_w);
+    if (!(b > -1e18))
+        b = -1e18;
+    if (b > 1e18)
+        b = 1e18;
+    return (int64_t)b;
+}
+
+static void ex_link(mfmm_exact_ws *ws, int32_t e)
+{
+    int64_t b = ex_bucket(ws, ws->heap[e].key);
+    if (b < ws->cur)
+        b = ws->cur;
+    if (b >= ws->cur + EX_NB) {
+        ws->heap[e].next = ws->over;
+        ws->over = e;
+        return;
+    }
+    int32_t i = (int32_t)(b & (EX_NB - 1));
+    ws->heap[e].next = ws->bhead[i];
+    ws->bhead[i] = e;
+    ws->n_in++;
+}
+
+/* A free entry (its fields to be filled, then ex_queue), or -1. */
+static int32_t ex_new(mfmm_exact_ws *ws)
+{
+    int32_t e = ws->qfree;
+    if (e >= 0) {
+        ws->qfree = ws->heap[e].next;
+        return e;
+    }
+    if (ws->heap_used == ws->heap_cap && !ex_grow(ws))
+        return -1;
+    return ws->heap_used++;
+}
+
+static void ex_queue(mfmm_exact_ws *ws, int32_t e)
+{
+    ws->heap_n++;
+    if (ws->heap_n > ws->peak_windows)
+        ws->peak_windows = ws->heap_n;
+    ex_link(ws, e);
+}
+
+/* Moves the overflow entries that now fall in the window into it; with
+ * the window empty, first moves the window to the least of them. */
+static void ex_refill(mfmm_exact_ws *ws)
+{
+    if (ws->n_in == 0) {
+        int64_t lo = INT64_MAX;
+        for (int32_t e = ws->over; e >= 0; e = ws->heap[e].next) {
+            int64_t b = ex_bucket(ws, ws->heap[e].key);
+            if (b < lo)
+                lo = b;
+        }
+        if (lo > ws->cur)
+            ws->cur = lo;
+    }
+    ws->redist = ws->cur;
+    int32_t e = ws->over;
+    ws->over = -1;
+    while (e >= 0) {
+        int32_t next = ws->heap[e].next;
+        ex_link(ws, e);
+        e = next;
+    }
+}
+
+/* Takes the next entry out of the queue (which must not be empty) into *out. */
+static void ex_pop(mfmm_exact_ws *ws, ex_entry *out)
+{
+    for (;;) {
+        if (ws->n_in == 0 || ws->cur >= ws->redist + EX_NB)
+            ex_refill(ws);
+        int32_t i = (int32_t)(ws->cur & (EX_NB - 1));
+        int32_t e = ws->bhead[i];
+        if (e < 0) {
+            ws->cur++;
+            continue;
+        }
+        ws->bhead[i] = ws->heap[e].next;
+#ifdef __GNUC__
+        /* the next pop's record: a cold line when its bucket filled earlier */
+        if (ws->bhead[i] >= 0)
+            __builtin_prefetch(ws->heap + ws->bhead[i]);
+#endif
+        ws->n_in--;
+        ws->heap_n--;
+        *out = ws->heap[e];
+        ws->heap[e].next = ws->qfree;
+        ws->qfree = e;
+        return;
+    }
+}
+
+/* ------------------------------------------------------------ propagation */
+
+/* Lowers d(v) to dist if that is less. Returns 1 when v is then a
+ * pseudo-source to start, with a known fan, and the new distance is less
+ * by more than rounding: the caller then gives the direction it came from
+ * (ex_set_in). A gain within rounding keeps the direction of the path it
+ * ties with: rays that graze a vertex along an edge reach it again from
+ * faces they do not cross, with directions that are not theirs. */
+static int ex_update(mfmm_exact_ws *ws, int32_t v, double dist, int force)
+{
+    double old = ws->d[v];
+    if (!(dist < old))
+        return 0;
+    if (old == INFINITY)
+        ws->touched[ws->n_touched++] = v;
+    ws->d[v] = dist;
+    int gain = !(dist >= old - EX_TIE * old);
+    if (gain)
+        ws->in_angle[v] = NAN;
+    if ((ws->pseudo[v] || force) && dist <= ws->max_d) {
+        int32_t e = ex_new(ws);
+        if (e < 0)
+            return 0;
+        ws->heap[e].key = dist;
+        ws->heap[e].he = -v - 1;
+        ex_queue(ws, e);
+        return gain && !force && ws->fan_total[v] == ws->fan_total[v];
+    }
+    return 0;
+}
+
+/* in_angle of v = corner c's vertex from the angle psi inside the corner,
+ * measured from the direction to the corner's first vertex. */
+static void ex_set_in(mfmm_exact_ws *ws, int32_t v, int32_t c, double psi)
+{
+    /* a direction outside the corner (rounding at a grazing ray) is not
+     * trusted: in_angle stays NaN and v starts windows all around */
+    if (!(psi >= -1e-9 && psi <= ws->angle[c] + 1e-9))
+        return;
+    if (psi < 0.0)
+        psi = 0.0;
+    if (psi > ws->angle[c])
+        psi = ws->angle[c];
+    ws->in_angle[v] = ws->fan_a0[c] + ws->fan_sgn[c] * psi;
+}
+
+/* Trims the interval [*b0, *b1] of an edge of length L (in the frame where
+ * its pseudo-source is (px, py) at distance sigma) to the part where it is
+ * shorter than the paths through the edge's ends, with distances dA (at 0)
+ * and dB (at L). sigma + |I X| - (dA + t) does not increase with t, so the
+ * part beaten by A is [0, t*), t* the root of
+ * sigma + sqrt((t - px)^2 + py^2) = dA + t; likewise from B. Returns 0 when
+ * too little is left. */
+static int ex_trim(double px, double py, double sigma, double L, double dA, double dB,
+                   double *b0, double *b1)
+{
+    double py2 = py * py;
+    double a = dA - sigma;
+    if (a < INFINITY) {
+        if (px + a <= 0.0)
+            return 0;
+        double t = (px * px + py2 - a * a) / (2.0 * (px + a));
+        if (t > *b0)
+            *b0 = t;
+    }
+    a = dB - sigma;
+    if (a < INFINITY) {
+        double qx = L - px;
+        if (qx + a <= 0.0)
+            return 0;
+        double t = L - (qx * qx + py2 - a * a) / (2.0 * (qx + a));
+        if (t < *b1)
+            *b1 = t;
+    }
+    return *b1 - *b0 > EX_MIN_WIDTH * L;
+}
+
+/* A window on half-edge h = 3f+k in f's frame (I on f's side: iy >= 0),
+ * interval [s0, s1], leaving f: updates the vertices it reaches, checks it
+ * against f's vertices, and queues it in the face across, in that face's
+ * frame. */
+static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double ix, double iy,
+                    double sigma)
+{
+    const ex_face *r = ws->fr + h / 3;
+    int k = h % 3;
+    int32_t va = r->v[k == 2 ? 0 : k + 1], vb = r->v[k == 0 ? 2 : k - 1], vr = r->v[k];
+    double L = r->len[k];
+    if (s0 < 0.0)
+        s0 = 0.0;
+    if (s1 > L)
+        s1 = L;
+    double iy2 = iy * iy;
+    if (s0 <= EX_POS_TOL * L && ex_update(ws, va, sigma + sqrt(ix * ix + iy2), 0))
+        ex_set_in(ws, va, h - k + (k == 2 ? 0 : k + 1), atan2(iy, ix));
+    if (s1 >= L - EX_POS_TOL * L &&
+        ex_update(ws, vb, sigma + sqrt((ix - L) * (ix - L) + iy2), 0)) {
+        int32_t c = h - k + (k == 0 ? 2 : k - 1);
+        ex_set_in(ws, vb, c, ws->angle[c] - atan2(iy, L - ix));
+    }
+    int32_t g = r->across[k];
+    if (g < 0 || !(s1 - s0 > EX_MIN_WIDTH * L))
+        return;
+    /* pruning against the face the window leaves */
+    if (!ex_trim(ix, -iy, sigma, L, ws->d[va], ws->d[vb], &s0, &s1))
+        return;
+    /* the least distance: at the foot of I, or at the nearer end */
+    double dx = ix < s0 ? s0 - ix : ix > s1 ? ix - s1 : 0.0;
+    double key = sigma + (dx > 0.0 ? sqrt(dx * dx + iy2) : iy);
+    if (key > ws->max_d)
+        return;
+    /* key > d(R) + max |R E|, without a square root */
+    double rx = r->cx[k], ry = r->cy[k];
+    double r0 = (rx - s0) * (rx - s0), r1 = (rx - s1) * (rx - s1);
+    double gap = key - ws->d[vr];
+    if (gap > 0.0 && gap * gap > (r0 > r1 ? r0 : r1) + ry * ry)
+        return;
+    int32_t wi = ex_new(ws);
+    if (wi < 0)
+        return;
+    ex_entry *w = ws->heap + wi;
+    if (r->flip[k]) {
+        w->b0 = L - s1;
+        w->b1 = L - s0;
+        w->px = L - ix;
+    } else {
+        w->b0 = s0;
+        w->b1 = s1;
+        w->px = ix;
+    }
+    w->py = -iy;
+    w->sigma = sigma;
+    w->he = g;
+    w->key = key;
+    ex_queue(ws, wi);
+    ws->n_windows++;
+}
+
+/* Where the line from I through X = (x, 0) meets the line O + s u (s). */
+static double ex_hit(double ox, double oy, double ux, double uy, double ix, double iy, double x,
+                     double len)
+{
+    double xx = x - ox, xy = -oy, jx = ix - ox, jy = iy - oy;
+    double num = xx * jy - xy * jx;
+    double den = (xx - jx) * uy - (xy - jy) * ux;
+    double s = num / den;
+    if (!(s >= 0.0))
+        s = 0.0;
+    if (!(s <= len))
+        s = len;
+    return s;
+}
+
+static void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
+{
+    int32_t h = w->he;
+    int32_t f = h / 3;
+    int m = h % 3;
+    const ex_face *r = ws->fr + f;
+    int32_t vc = r->v[m];
+    double L = r->len[m], cx = r->cx[m], cy = r->cy[m];
+    double b0 = w->b0, b1 = w->b1, px = w->px, py = w->py, sigma = w->sigma;
+    /* (checking the window again here, against the face it crosses with the
+     * distances known by now, drops almost nothing: 1 window in 10^4 on the
+     * bunny, for 15% of the time) */
+    ws->n_propagated++;
+    /* where the ray from I through C crosses the edge */
+    double tc = px + (cx - px) * (-py) / (cy - py);
+    double tol = EX_POS_TOL * L;
+    if (tc >= b0 - tol && tc <= b1 + tol) {
+        double ex = cx - px, ey = cy - py;
+        if (ex_update(ws, vc, sigma + sqrt(ex * ex + ey * ey), 0)) {
+            /* angle at C between C -> A = (-cx, -cy) and C -> I = (-ex, -ey) */
+            double cr = cx * ey - cy * ex, dt = cx * ex + cy * ey;
+            ex_set_in(ws, vc, h, atan2(fabs(cr), dt));
+        }
+    }
+    int m1 = m == 2 ? 0 : m + 1, m2 = m == 0 ? 2 : m - 1;
+    if (b0 < tc) {
+        /* left child: edge C -> A (half-edge 3f+m2), rays through [b0, min(b1, tc)] */
+        int32_t hl = 3 * f + m2;
+        double lac = r->len[m2], il = 1.0 / lac;
+        double ux = -cx * il, uy = -cy * il;
+        double s_hi = b0 <= 0.0 ? lac : ex_hit(cx, cy, ux, uy, px, py, b0, lac);
+        double s_lo = tc <= b1 ? 0.0 : ex_hit(cx, cy, ux, uy, px, py, b1, lac);
+        double qx = px - cx, qy = py - cy;
+        double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
+        ex_emit(ws, hl, s_lo, s_hi, ix, iy > 0.0 ? iy : 0.0, sigma);
+    }
+    if (b1 > tc) {
+        /* right child: edge B -> C (half-edge 3f+m1), rays through [max(b0, tc), b1] */
+        int32_t hr = 3 * f + m1;
+        double lbc = r->len[m1], il = 1.0 / lbc;
+        double ux = (cx - L) * il, uy = cy * il;
+        double s_lo = b1 >= L ? 0.0 : ex_hit(L, 0.0, ux, uy, px, py, b1, lbc);
+        double s_hi = tc >= b0 ? lbc : ex_hit(L, 0.0, ux, uy, px, py, b0, lbc);
+        double qx = px - L, qy = py;
+        double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
+        ex_emit(ws, hr, s_lo, s_hi, ix, iy > 0.0 ? iy : 0.0, sigma);
+    }
+}
+
+/* Where the ray from C = (cx, cy) at angle psi from C -> (0,0), turning
+ * towards (L, 0), meets the x axis, clamped to [0, L]. */
+static double ex_ray_x(double cx, double cy, double psi, double L)
+{
+    double r = sqrt(cx * cx + cy * cy);
+    double ux = -cx / r, uy = -cy / r, c = cos(psi), sn = sin(psi);
+    double dx = ux * c - uy * sn, dy = ux * sn + uy * c;
+    if (!(dy < 0.0))
+        return dx < 0.0 ? 0.0 : L;
+    double x = cx + (-cy / dy) * dx;
+    return x < 0.0 ? 0.0 : x > L ? L : x;
+}
+
+/* A pseudo-source at v with distance dv: a window on the far edge of every
+ * face around v. */
+static void ex_start_vertex(mfmm_exact_ws *ws, int32_t v, double dv)
+{
+    ws->n_pseudo++;
+    double th = ws->in_angle[v], total = ws->fan_total[v];
+    if (!(th == th) || !(total == total)) {
+        for (int32_t i = ws->vf_offset[v]; i < ws->vf_offset[v + 1]; i++) {
+            int32_t c = ws->vf_corner[i];
+            const ex_face *r = ws->fr + c / 3;
+            if (r->skip)
+                continue;
+            ex_emit(ws, c, 0.0, r->len[c % 3], r->cx[c % 3], r->cy[c % 3], dv);
+        }
+        return;
+    }
+    /* A shortest path that arrived from direction th can go on through v
+     * only where both angles it makes there are >= pi (else cutting the
+     * corner is shorter): the "shadow" [th + pi, th + total - pi], modulo
+     * total. Elsewhere the windows passing v already carry the distance. */
+    double lo = th + EX_PI - EX_SHADOW_MARGIN, hi = th + total - EX_PI + EX_SHADOW_MARGIN;
+    if (!(hi > lo))
+        return;
+    for (int32_t i = ws->vf_offset[v]; i < ws->vf_offset[v + 1]; i++) {
+        int32_t c = ws->vf_corner[i];
+        double ang = ws->angle[c];
+        double f0 = ws->fan_sgn[c] > 0 ? ws->fan_a0[c] : ws->fan_a0[c] - ang, f1 = f0 + ang;
+        for (int wrap = -1; wrap <= 1; wrap++) {
+            double a = lo + wrap * total, b = hi + wrap * total;
+            if (a < f0)
+                a = f0;
+            if (b > f1)
+                b = f1;
+            if (!(b > a))
+                continue;
+            /* psi: angles from the direction to the corner's first vertex */
+            double p0, p1;
+            if (ws->fan_sgn[c] > 0) {
+                p0 = a - f0;
+                p1 = b - f0;
+            } else {
+                p0 = f1 - b;
+                p1 = f1 - a;
+            }
+            const ex_face *r = ws->fr + c / 3;
+            double L = r->len[c % 3], cx = r->cx[c % 3], cy = r->cy[c % 3];
+            double s0 = p0 <= 0.0 ? 0.0 : ex_ray_x(cx, cy, p0, L);
+            double s1 = p1 >= ang ? L : ex_ray_x(cx, cy, p1, L);
+            ex_emit(ws, c, s0, s1, cx, cy, dv);
+        }
+    }
+}
+
+/* A point source in face f (barycentric w, not at a corner): a window on
+ * each of f's edges. */
+static void ex_start_face(mfmm_exact_ws *ws, int32_t f, const double *w, double value)
+{
+    ws->n_pseudo++;
+    for (int k = 0; k < 3; k++) {
+        int32_t h = 3 * f + k;
+        /* corners k+1 at (0,0), k+2 at (L,0), k at (cx,cy) */
+        const ex_face *r = ws->fr + f;
+        double ix = w[(k + 2) % 3] * r->len[k] + w[k] * r->cx[k];
+        double iy = w[k] * r->cy[k];
+        ex_emit(ws, h, 0.0, r->len[k], ix, iy, value);
+    }
+}
+
+/* Clears the previous run's vertex state (only what it touched). */
+static void ex_reset(mfmm_exact_ws *ws)
+{
+    for (int32_t i = 0; i < ws->n_touched; i++) {
+        int32_t v = ws->touched[i];
+        ws->d[v] = INFINITY;
+        ws->emitted[v] = INFINITY;
+    }
+    ws->n_touched = 0;
+    ws->heap_n = 0;
+    ws->heap_used = 0;
+    ws->qfree = -1;
+    ws->over = -1;
+    ws->n_in = 0;
+    ws->cur = -((int64_t)1 << 62);
+    ws->redist = ws->cur;
+    for (int32_t i = 0; i < EX_NB; i++)
+        ws->bhead[i] = -1;
+    ws->failed = 0;
+    ws->n_windows = ws->n_propagated = ws->n_pseudo = ws->peak_windows = 0;
+    ws->peak_bytes = ex_bytes(ws, ws->heap_cap);
+}
+
+/* The propagation from checked sources; d[] holds the result for touched
+ * vertices (values > max_d are not final). */
+static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t n_sources,
+                          double max_d, size_t memory_limit)
+{
+    ex_reset(ws);
+    ws->max_d = max_d;
+    ws->memory_limit = memory_limit;
+    if (memory_limit && ws->fixed_bytes > memory_limit)
+        return MFMM_ERR_MEMORY_LIMIT;
+    if (memory_limit && ex_bytes(ws, ws->heap_cap) > memory_limit) {
+        /* the queue an earlier solve grew is empty now: give it back */
+        free(ws->heap);
+        ws->heap = NULL;
+        ws->heap_cap = 0;
+        ws->peak_bytes = ex_bytes(ws, 0);
+    }
+    for (int32_t i = 0; i < n_sources; i++) {
+        const mfmm_source *s = sources + i;
+        if (s->face < 0) {
+            ex_update(ws, s->vertex, s->value, 1);
+            continue;
+        }
+        const int32_t *fv = ws->faces + 3 * (size_t)s->face;
+        double w[3], sum = 0.0;
+        for (int k = 0; k < 3; k++) {
+            w[k] = s->bary[k] > 0.0 ? s->bary[k] : 0.0;
+            sum += w[k];
+        }
+        int corner = -1;
+        for (int k = 0; k < 3; k++) {
+            w[k] /= sum;
+            if (w[k] >= 1.0 - 1e-12)
+                corner = k;
+        }
+        if (corner >= 0) {
+            /* at a corner: a vertex source, offset by the (tiny) distance */
+            const double *X = ws->mesh->xyz;
+            double p[3] = {0.0, 0.0, 0.0};
+            for (int k = 0; k < 3; k++)
+                for (int e = 0; e < 3; e++)
+                    p[e] += w[k] * X[3 * (size_t)fv[k] + e];
+            ex_update(ws, fv[corner], s->value + vdist(p, X + 3 * (size_t)fv[corner]), 1);
+            continue;
+        }
+        ex_start_face(ws, s->face, w, s->value);
+    }
+    while (ws->heap_n > 0 && !ws->failed) {
+        ex_entry e;
+        ex_pop(ws, &e);
+        if (e.he < 0) {
+            int32_t v = -e.he - 1;
+            if (e.key != ws->d[v] || !(ws->emitted[v] > e.key))
+                continue;
+            ws->emitted[v] = e.key;
+            ex_start_vertex(ws, v, e.key);
+        } else {
+            ex_propagate(ws, &e);
+        }
+    }
+    return ws->failed ? (mfmm_status)ws->failed : MFMM_OK;
+}
+
+static void ex_fill_info(const mfmm_exact_ws *ws, mfmm_exact_info *info)
+{
+    if (!info)
+        return;
+    info->n_windows = ws->n_windows;
+    info->n_propagated = ws->n_propagated;
+    info->n_pseudo_sources = ws->n_pseudo;
+    info->peak_windows = ws->peak_windows;
+    info->peak_bytes = ws->peak_bytes;
+}
+
+/* Sources as mfmm_solve checks them, and not in a face this solver skips. */
+static mfmm_status ex_check_sources(const mfmm_exact_ws *ws, const mfmm_source *sources,
+                                    int32_t n_sources, mfmm_error *err)
+{
+    for (int32_t i = 0; i < n_sources; i++) {
+        mfmm_status st = mfmm_check_source(ws->mesh, sources + i, i, err);
+        if (st != MFMM_OK)
+            return st;
+        if (sources[i].face >= 0 && ws->fr[sources[i].face].skip)
+            return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, i,
+                             "source %ld lies on face %ld, which has zero area", (long)i,
+                             (long)sources[i].face);
+    }
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_solve_exact(mfmm_exact_solver *solver, const mfmm_source *sources,
+                             int32_t n_sources, const mfmm_exact_options *options,
+                             double *distances, mfmm_exact_info *info, mfmm_error *err)
+{
+    mfmm_ok(err);
+    if (info)
+        memset(info, 0, sizeof *info);
+    if (!solver || !distances)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "%s is NULL",
+                         !solver ? "solver" : "distances");
+    for (int32_t v = 0; v < solver->nv; v++)
+        distances[v] = INFINITY;
+    if (!sources)
+        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "sources is NULL");
+    if (n_sources < 1)
+        return mfmm_fail(err, MFMM_ERR_BAD_COUNT, -1, "n_sources is %ld; at least one is needed",
+                         (long)n_sources);
+    mfmm_exact_options defaults;
+    if (!options) {
+        mfmm_exact_options_init(&defaults);
+        options = &defaults;
+    }
+    if (options->cost)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "mfmm_solve_exact computes geodesic distance (F = 1) and takes no cost; "
+                         "use mfmm_solve for weighted distances");
+    double max_d = options->max_distance;
+    if (isnan(max_d) || max_d < 0.0)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "max_distance is %g; it must be >= 0",
+                         max_d);
+    mfmm_status st = ex_check_sources(solver, sources, n_sources, err);
+    if (st != MFMM_OK)
+        return st;
+    st = ex_run(solver, sources, n_sources, max_d, options->memory_limit);
+    ex_fill_info(solver, info);
+    if (st != MFMM_OK) {
+        if (st == MFMM_ERR_MEMORY_LIMIT)
+            return mfmm_fail(err, st, -1,
+                             "the exact solve needed more than memory_limit = %zu bytes "
+                             "(%lld windows queued)",
+                             options->memory_limit, (long long)solver->heap_n);
+        return mfmm_fail(err, st, -1, "out of memory for the window queue");
+    }
+    for (int32_t i = 0; i < solver->n_touched; i++) {
+        int32_t v = solver->touched[i];
+        double dv = solver->d[v];
+        distances[v] = dv <= max_d ? dv : INFINITY;
+    }
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_exact_patch(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t n_sources,
+                             double radius, size_t memory_limit, int32_t *n_vertices,
+                             const int32_t **vertices, const double **distances,
+                             mfmm_exact_info *info)
+{
+    if (!ws || !sources || !n_vertices || !vertices || !distances)
+        return MFMM_ERR_NULL_POINTER;
+    *n_vertices = 0;
+    *vertices = ws->touched;
+    *distances = ws->patch_d;
+    if (n_sources < 1)
+        return MFMM_ERR_BAD_COUNT;
+    if (isnan(radius) || radius < 0.0)
+        return MFMM_ERR_BAD_ARGUMENT;
+    mfmm_status st = ex_check_sources(ws, sources, n_sources, NULL);
+    if (st != MFMM_OK)
+        return st;
+    st = ex_run(ws, sources, n_sources, radius, memory_limit);
+    ex_fill_info(ws, info);
+    if (st != MFMM_OK)
+        return st;
+    /* touched vertices within the radius, moved to the front of touched
+     * (the rest stay behind them, so the next reset still clears them) */
+    int32_t n = 0;
+    for (int32_t i = 0; i < ws->n_touched; i++) {
+        int32_t v = ws->touched[i];
+        if (ws->d[v] <= radius) {
+            ws->touched[i] = ws->touched[n];
+            ws->touched[n] = v;
+            ws->patch_d[n] = ws->d[v];
+            n++;
+        }
+    }
+    *n_vertices = n;
+    return MFMM_OK;
+}

@@ -1,0 +1,985 @@
+/* mfmm_solve_exact and mfmm_exact_patch: exact polyhedral distances on
+ * surfaces whose distances are known in closed form (planes with needle and
+ * obtuse triangles, a cube, a prism, a saddle cone, an L-shaped domain),
+ * face, edge and corner sources, several sources with values, max_distance,
+ * walls at non-manifold edges and other components, the memory limit, the
+ * patch API, and every bad input. */
+#include <math.h>
+#include <pthread.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "testutil.h"
+#include "exact/exact.h"
+
+/* ---------------------------------------------------------------- helpers */
+
+typedef struct ex_fx {
+    mfmm_gen_mesh g;
+    mfmm_mesh *mesh;
+    mfmm_exact_solver *solver;
+    double *d;
+} ex_fx;
+
+static ex_fx ex_make(mfmm_gen_mesh g)
+{
+    ex_fx fx;
+    fx.g = g;
+    fx.mesh = tm_make(&g);
+    assert_int_equal(mfmm_exact_solver_create(fx.mesh, &fx.solver), MFMM_OK);
+    fx.d = malloc((size_t)g.nv * sizeof *fx.d);
+    assert_non_null(fx.d);
+    return fx;
+}
+
+static void ex_free(ex_fx *fx)
+{
+    free(fx->d);
+    mfmm_exact_solver_destroy(fx->solver);
+    mfmm_mesh_destroy(fx->mesh);
+    mfmm_gen_free(&fx->g);
+}
+
+static void ex_solve(ex_fx *fx, const mfmm_source *s, int32_t n, const mfmm_exact_options *o)
+{
+    mfmm_error err;
+    mfmm_status st = mfmm_solve_exact(fx->solver, s, n, o, fx->d, NULL, &err);
+    if (st != MFMM_OK)
+        fail_msg("mfmm_solve_exact: %s", err.message);
+}
+
+static mfmm_gen_mesh ex_alloc(int32_t nv, int32_t nf)
+{
+    mfmm_gen_mesh m = {nv, nf, malloc((size_t)nv * 3 * sizeof(double)),
+                       malloc((size_t)nf * 3 * sizeof(int32_t))};
+    assert_true(m.V && m.F);
+    return m;
+}
+
+static double dist3(const double *p, const double *q)
+{
+    return sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                (p[2] - q[2]) * (p[2] - q[2]));
+}
+
+/* A rectangle [0, X] x [0, Y] cut by the columns xs[0..nx] and rows
+ * ys[0..ny], each cell split along a diagonal chosen by `pattern`; the
+ * inner vertices of odd rows moved right by `shift` of their cell. Thin
+ * columns make needles; short rows with shifted vertices obtuse corners. */
+static mfmm_gen_mesh ex_plane(const double *xs, int nx, const double *ys, int ny, int pattern,
+                              double shift)
+{
+    mfmm_gen_mesh m = ex_alloc((nx + 1) * (ny + 1), 2 * nx * ny);
+    for (int j = 0; j <= ny; j++)
+        for (int i = 0; i <= nx; i++) {
+            double *p = m.V + 3 * (j * (nx + 1) + i);
+            p[0] = xs[i] + (i > 0 && i < nx && j % 2 ? shift * (xs[i + 1] - xs[i]) : 0.0);
+            p[1] = ys[j];
+            p[2] = 0.0;
+        }
+    int32_t *f = m.F;
+    for (int j = 0; j < ny; j++)
+        for (int i = 0; i < nx; i++) {
+            int32_t a = j * (nx + 1) + i, b = a + 1, c = a + nx + 1, d = c + 1;
+            int diag = pattern == 0 ? 0 : pattern == 1 ? (i + j) % 2 : (i * 7 + j * 3) % 5 < 2;
+            if (diag) {
+                int32_t t[6] = {a, b, d, a, d, c};
+                memcpy(f, t, sizeof t);
+            } else {
+                int32_t t[6] = {a, b, c, b, d, c};
+                memcpy(f, t, sizeof t);
+            }
+            f += 6;
+        }
+    return m;
+}
+
+/* ------------------------------------------------------------------ plane */
+
+/* Every planar triangulation of a convex domain: distances are Euclidean,
+ * to 1e-12, from a vertex and from points in a face, on an edge and at a
+ * corner, with needles (columns 1e-6 wide) and obtuse corners (up to
+ * about 179 degrees). */
+static void test_plane_exact(void **state)
+{
+    (void)state;
+    double xs[32], ys[32];
+    for (int layout = 0; layout < 3; layout++) {
+        int nx = 24, ny = layout == 2 ? 6 : 20;
+        double x = 0.0;
+        for (int i = 0; i <= nx; i++) {
+            xs[i] = x;
+            /* layout 1: needle columns; layout 2: wide cells, short rows */
+            double w = layout == 1 && i % 5 == 2 ? 1e-6 : 1.0 / nx * (1.0 + 0.3 * sin(3.0 * i));
+            x += w;
+        }
+        for (int j = 0; j <= ny; j++)
+            ys[j] = layout == 2 ? 0.01 * j + 0.002 * (j % 2) : (double)j / ny;
+        ex_fx fx = ex_make(ex_plane(xs, nx, ys, ny, layout, layout == 2 ? 0.45 : 0.0));
+        mfmm_mesh_info mi;
+        mfmm_mesh_get_info(fx.mesh, &mi);
+        if (layout == 2 && mi.n_obtuse_corners < nx * ny)
+            fail_msg("%d obtuse corners", (int)mi.n_obtuse_corners);
+        int32_t src_v = (ny / 2) * (nx + 1) + nx / 3;
+        mfmm_source s = tm_vertex_source(src_v);
+        ex_solve(&fx, &s, 1, NULL);
+        for (int32_t v = 0; v < fx.g.nv; v++)
+            tm_assert_close(fx.d[v], dist3(fx.g.V + 3 * v, fx.g.V + 3 * src_v), 1e-12);
+        /* points in a face, on an edge, at a corner */
+        const double bary[4][3] = {{0.2, 0.3, 0.5}, {0.0, 0.25, 0.75}, {0.6, 0.0, 0.4}, {1.0, 0.0, 0.0}};
+        for (int b = 0; b < 4; b++) {
+            int32_t f = fx.g.nf / 2 + 3 * b + 1;
+            mfmm_source fs = {0, f, {bary[b][0], bary[b][1], bary[b][2]}, 0.0};
+            double p[3] = {0.0, 0.0, 0.0};
+            for (int k = 0; k < 3; k++)
+                for (int e = 0; e < 3; e++)
+                    p[e] += bary[b][k] * fx.g.V[3 * fx.g.F[3 * f + k] + e];
+            ex_solve(&fx, &fs, 1, NULL);
+            for (int32_t v = 0; v < fx.g.nv; v++)
+                tm_assert_close(fx.d[v], dist3(fx.g.V + 3 * v, p), 1e-12);
+        }
+        ex_free(&fx);
+    }
+}
+
+/* Faces of mixed orientation (a third of a grid's faces reversed) change
+ * nothing: edges are matched by their vertices, not their direction. */
+static void test_mixed_orientation(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh g = mfmm_gen_grid(12);
+    for (int32_t f = 0; f < g.nf; f += 3) {
+        int32_t t = g.F[3 * f + 1];
+        g.F[3 * f + 1] = g.F[3 * f + 2];
+        g.F[3 * f + 2] = t;
+    }
+    ex_fx fx = ex_make(g);
+    for (int32_t src = 0; src < fx.g.nv; src += 37) {
+        mfmm_source s = tm_vertex_source(src);
+        ex_solve(&fx, &s, 1, NULL);
+        for (int32_t v = 0; v < fx.g.nv; v++)
+            tm_assert_close(fx.d[v], dist3(fx.g.V + 3 * v, fx.g.V + 3 * src), 1e-12);
+    }
+    ex_free(&fx);
+}
+
+/* Several sources with initial values: T = min_i (value_i + |x - s_i|). */
+static void test_several_sources(void **state)
+{
+    (void)state;
+    ex_fx fx = ex_make(mfmm_gen_grid(16));
+    mfmm_source s[3] = {tm_vertex_source(0), tm_vertex_source(17 * 17 - 1),
+                        {0, 100, {0.5, 0.25, 0.25}, 0.3}};
+    s[1].value = 0.5;
+    double p[3] = {0.0, 0.0, 0.0};
+    for (int k = 0; k < 3; k++)
+        for (int e = 0; e < 3; e++)
+            p[e] += s[2].bary[k] * fx.g.V[3 * fx.g.F[300 + k] + e];
+    ex_solve(&fx, s, 3, NULL);
+    for (int32_t v = 0; v < fx.g.nv; v++) {
+        double want = fmin(dist3(fx.g.V + 3 * v, fx.g.V), 0.5 + dist3(fx.g.V + 3 * v, fx.g.V + 3 * (17 * 17 - 1)));
+        want = fmin(want, 0.3 + dist3(fx.g.V + 3 * v, p));
+        tm_assert_close(fx.d[v], want, 1e-12);
+    }
+    ex_free(&fx);
+}
+
+/* Values far apart (negative, huge) and meshes scaled by 1e-30 and 1e+30:
+ * the same distances, scaled. */
+static void test_values_and_scale(void **state)
+{
+    (void)state;
+    const double scales[3] = {1.0, 1e-30, 1e30};
+    for (int k = 0; k < 3; k++) {
+        mfmm_gen_mesh g = mfmm_gen_sine(12);
+        for (int32_t i = 0; i < 3 * g.nv; i++)
+            g.V[i] *= scales[k];
+        ex_fx fx = ex_make(g);
+        double *ref = malloc((size_t)fx.g.nv * sizeof *ref);
+        assert_non_null(ref);
+        mfmm_source s = tm_vertex_source(40);
+        ex_solve(&fx, &s, 1, NULL);
+        memcpy(ref, fx.d, (size_t)fx.g.nv * sizeof *ref);
+        if (k == 0) {
+            /* a negative value, and a second source too far behind to matter */
+            mfmm_source two[2] = {tm_vertex_source(40), tm_vertex_source(100)};
+            two[0].value = -2.0;
+            two[1].value = 1e12;
+            ex_solve(&fx, two, 2, NULL);
+            for (int32_t v = 0; v < fx.g.nv; v++)
+                tm_assert_close(fx.d[v], ref[v] - 2.0, 1e-12);
+        } else {
+            mfmm_gen_mesh g1 = mfmm_gen_sine(12);
+            ex_fx one = ex_make(g1);
+            ex_solve(&one, &s, 1, NULL);
+            for (int32_t v = 0; v < fx.g.nv; v++)
+                tm_assert_close(ref[v] / scales[k], one.d[v], 1e-12 * (1.0 + one.d[v]));
+            ex_free(&one);
+        }
+        free(ref);
+        ex_free(&fx);
+    }
+}
+
+/* ------------------------------------------------------------ cube, prism */
+
+/* The surface of [0,1]^3, n x n squares a side. */
+static mfmm_gen_mesh ex_cube(int n)
+{
+    int w = n + 1;
+    int32_t *id = malloc((size_t)w * w * w * sizeof *id);
+    assert_non_null(id);
+    int32_t nv = 0;
+    for (int i = 0; i < w * w * w; i++) {
+        int x = i % w, y = (i / w) % w, z = i / (w * w);
+        id[i] = (x == 0 || x == n || y == 0 || y == n || z == 0 || z == n) ? nv++ : -1;
+    }
+    mfmm_gen_mesh m = ex_alloc(nv, 12 * n * n);
+    for (int i = 0; i < w * w * w; i++)
+        if (id[i] >= 0) {
+            m.V[3 * id[i]] = (double)(i % w) / n;
+            m.V[3 * id[i] + 1] = (double)((i / w) % w) / n;
+            m.V[3 * id[i] + 2] = (double)(i / (w * w)) / n;
+        }
+    int32_t *f = m.F;
+    for (int axis = 0; axis < 3; axis++)
+        for (int side = 0; side <= n; side += n)
+            for (int a = 0; a < n; a++)
+                for (int b = 0; b < n; b++) {
+                    int32_t q[4];
+                    for (int c = 0; c < 4; c++) {
+                        int u = a + (c == 1 || c == 2), v = b + (c >= 2);
+                        int xyz[3];
+                        xyz[axis] = side;
+                        xyz[(axis + 1) % 3] = u;
+                        xyz[(axis + 2) % 3] = v;
+                        q[c] = id[xyz[0] + w * (xyz[1] + w * xyz[2])];
+                    }
+                    int32_t t[6] = {q[0], q[1], q[2], q[0], q[2], q[3]};
+                    memcpy(f, t, sizeof t);
+                    f += 6;
+                }
+    free(id);
+    return m;
+}
+
+/* From the centre of the top face: Euclidean on the top, unfolded across
+ * the edge on the sides, 2 at the centre of the bottom. */
+static void test_cube(void **state)
+{
+    (void)state;
+    int n = 6;
+    ex_fx fx = ex_make(ex_cube(n));
+    int32_t src = -1, bottom = -1;
+    for (int32_t v = 0; v < fx.g.nv; v++) {
+        const double *p = fx.g.V + 3 * v;
+        if (fabs(p[0] - 0.5) < 1e-12 && fabs(p[1] - 0.5) < 1e-12)
+            *(p[2] > 0.5 ? &src : &bottom) = v;
+    }
+    assert_true(src >= 0 && bottom >= 0);
+    mfmm_source s = tm_vertex_source(src);
+    ex_solve(&fx, &s, 1, NULL);
+    int checked = 0;
+    for (int32_t v = 0; v < fx.g.nv; v++) {
+        const double *p = fx.g.V + 3 * v;
+        double want = NAN;
+        if (p[2] == 1.0)
+            want = hypot(p[0] - 0.5, p[1] - 0.5);
+        else if (p[1] == 0.0 && p[0] > 0.0 && p[0] < 1.0)
+            want = hypot(p[0] - 0.5, 1.5 - p[2]);
+        else if (p[0] == 1.0 && p[1] > 0.0 && p[1] < 1.0)
+            want = hypot(p[1] - 0.5, 1.5 - p[2]);
+        if (want == want) {
+            tm_assert_close(fx.d[v], want, 1e-12);
+            checked++;
+        }
+    }
+    assert_true(checked > 60);
+    tm_assert_close(fx.d[bottom], 2.0, 1e-12);
+    ex_free(&fx);
+}
+
+/* An open prism over a regular m-gon (a polyhedral cylinder), rows of
+ * height 1/rows: it unrolls into a flat strip, so the distance is
+ * Euclidean in the strip, going around the shorter way. */
+static void test_cylinder(void **state)
+{
+    (void)state;
+    int m = 16, rows = 7;
+    double r = 0.4, chord = 2.0 * r * sin(TM_PI / m);
+    mfmm_gen_mesh g = ex_alloc(m * (rows + 1), 2 * m * rows);
+    for (int j = 0; j <= rows; j++)
+        for (int i = 0; i < m; i++) {
+            double *p = g.V + 3 * (j * m + i);
+            p[0] = r * cos(2.0 * TM_PI * i / m);
+            p[1] = r * sin(2.0 * TM_PI * i / m);
+            p[2] = (double)j / rows;
+        }
+    int32_t *f = g.F;
+    for (int j = 0; j < rows; j++)
+        for (int i = 0; i < m; i++) {
+            int32_t a = j * m + i, b = j * m + (i + 1) % m, c = a + m, d = b + m;
+            int32_t t[6] = {a, b, d, a, d, c};
+            if ((i + j) % 2) {
+                int32_t u[6] = {a, b, c, b, d, c};
+                memcpy(t, u, sizeof t);
+            }
+            memcpy(f, t, sizeof t);
+            f += 6;
+        }
+    ex_fx fx = ex_make(g);
+    int32_t src = 2 * m + 3;
+    mfmm_source s = tm_vertex_source(src);
+    ex_solve(&fx, &s, 1, NULL);
+    for (int32_t v = 0; v < fx.g.nv; v++) {
+        int di = abs(v % m - src % m);
+        if (m - di < di)
+            di = m - di;
+        double dz = fx.g.V[3 * v + 2] - fx.g.V[3 * src + 2];
+        tm_assert_close(fx.d[v], hypot(di * chord, dz), 1e-12);
+    }
+    ex_free(&fx);
+}
+
+/* ------------------------------------------------------------------ saddle */
+
+/* A cone of total angle 6 x 70 = 420 degrees (a saddle: the six faces at
+ * the apex alternate up and down), two rings, each outer triangle in the
+ * plane of its apex triangle. Unrolled, a vertex is at polar (rho, phi); two
+ * points apart by less than 180 degrees (the shorter way round) see each
+ * other, others are joined through the apex: rho1 + rho2. */
+static void test_saddle(void **state)
+{
+    (void)state;
+    double c70 = cos(70.0 * TM_PI / 180.0), h = sqrt((0.5 - c70) / (1.0 + c70));
+    mfmm_gen_mesh g = ex_alloc(13, 18);
+    g.V[0] = g.V[1] = g.V[2] = 0.0;
+    for (int ring = 1; ring <= 2; ring++)
+        for (int i = 0; i < 6; i++) {
+            double *p = g.V + 3 * (1 + (ring - 1) * 6 + i);
+            p[0] = ring * cos(TM_PI / 3.0 * i);
+            p[1] = ring * sin(TM_PI / 3.0 * i);
+            p[2] = ring * (i % 2 ? -h : h);
+        }
+    int32_t *f = g.F;
+    for (int i = 0; i < 6; i++) {
+        int32_t a = 1 + i, b = 1 + (i + 1) % 6, c = 7 + i, d = 7 + (i + 1) % 6;
+        int32_t t[9] = {0, a, b, a, c, d, a, d, b};
+        memcpy(f, t, sizeof t);
+        f += 9;
+    }
+    for (int variant = 0; variant < 2; variant++) {
+        /* variant 1: every other face reversed (the fans are walked by vertex) */
+        mfmm_gen_mesh gv = ex_alloc(13, 18);
+        memcpy(gv.V, g.V, 13 * 3 * sizeof(double));
+        memcpy(gv.F, g.F, 18 * 3 * sizeof(int32_t));
+        for (int32_t k = 0; variant && k < 18; k += 2) {
+            int32_t t = gv.F[3 * k];
+            gv.F[3 * k] = gv.F[3 * k + 1];
+            gv.F[3 * k + 1] = t;
+        }
+        ex_fx fx = ex_make(gv);
+        double rho[13], phi[13];
+        rho[0] = phi[0] = 0.0;
+        for (int v = 1; v < 13; v++) {
+            rho[v] = dist3(fx.g.V, fx.g.V + 3 * v);
+            phi[v] = 70.0 * ((v - 1) % 6);
+        }
+        int sources[3] = {1, 8, 10};
+        for (int k = 0; k < 3; k++) {
+            int s = sources[k];
+            mfmm_source src = tm_vertex_source(s);
+            ex_solve(&fx, &src, 1, NULL);
+            for (int v = 0; v < 13; v++) {
+                double a = fabs(phi[v] - phi[s]);
+                if (420.0 - a < a)
+                    a = 420.0 - a;
+                double want = a < 180.0 ? sqrt(rho[s] * rho[s] + rho[v] * rho[v] -
+                                               2.0 * rho[s] * rho[v] * cos(a * TM_PI / 180.0))
+                                        : rho[s] + rho[v];
+                tm_assert_close(fx.d[v], want, 1e-12);
+            }
+        }
+        ex_free(&fx);
+    }
+    mfmm_gen_free(&g);
+}
+
+/* An L-shaped plane: around the reflex corner (a boundary vertex of angle
+ * 270 degrees) the geodesic bends at the corner. */
+static void test_reflex_corner(void **state)
+{
+    (void)state;
+    int n = 8; /* [0,2]^2 minus (1,2]^2, cells of 1/4 */
+    double xs[9], ys[9];
+    for (int i = 0; i <= n; i++)
+        xs[i] = ys[i] = 2.0 * i / n;
+    mfmm_gen_mesh full = ex_plane(xs, n, ys, n, 1, 0.0);
+    /* keep the faces whose centroid is outside (1,2]^2 */
+    int32_t nf = 0;
+    for (int32_t f = 0; f < full.nf; f++) {
+        double cx = 0.0, cy = 0.0;
+        for (int k = 0; k < 3; k++) {
+            cx += full.V[3 * full.F[3 * f + k]] / 3.0;
+            cy += full.V[3 * full.F[3 * f + k] + 1] / 3.0;
+        }
+        if (!(cx > 1.0 && cy > 1.0)) {
+            memmove(full.F + 3 * nf, full.F + 3 * f, 3 * sizeof(int32_t));
+            nf++;
+        }
+    }
+    full.nf = nf;
+    ex_fx fx = ex_make(full); /* the unreferenced vertices of (1,2]^2 stay +inf */
+    int32_t src = 1 * (n + 1) + 7; /* (1.75, 0.25) */
+    const double corner[2] = {1.0, 1.0};
+    const double *s = fx.g.V + 3 * src;
+    mfmm_source so = tm_vertex_source(src);
+    ex_solve(&fx, &so, 1, NULL);
+    for (int32_t v = 0; v < fx.g.nv; v++) {
+        const double *p = fx.g.V + 3 * v;
+        if (p[0] > 1.0 && p[1] > 1.0) {
+            assert_true(isinf(fx.d[v]));
+            continue;
+        }
+        /* visible when the segment stays out of (1,2]^2: it does unless it
+         * crosses the line y = 1 at x > 1 going up into x < 1 ... i.e. the
+         * corner is to the left of s -> p */
+        double cr = (p[0] - s[0]) * (corner[1] - s[1]) - (p[1] - s[1]) * (corner[0] - s[0]);
+        int hidden = p[1] > 1.0 && cr > 0.0;
+        double want = hidden ? hypot(s[0] - 1.0, s[1] - 1.0) + hypot(p[0] - 1.0, p[1] - 1.0)
+                             : hypot(p[0] - s[0], p[1] - s[1]);
+        tm_assert_close(fx.d[v], want, 1e-12);
+    }
+    ex_free(&fx);
+}
+
+/* ------------------------------------------------- limits and components */
+
+static void test_max_distance(void **state)
+{
+    (void)state;
+    ex_fx fx = ex_make(mfmm_gen_grid(20));
+    mfmm_exact_options o;
+    mfmm_exact_options_init(&o);
+    o.max_distance = 0.3;
+    int32_t c = 10 * 21 + 10;
+    mfmm_source s = tm_vertex_source(c);
+    mfmm_exact_info full, part;
+    mfmm_error err;
+    assert_int_equal(mfmm_solve_exact(fx.solver, &s, 1, NULL, fx.d, &full, &err), MFMM_OK);
+    assert_int_equal(mfmm_solve_exact(fx.solver, &s, 1, &o, fx.d, &part, &err), MFMM_OK);
+    for (int32_t v = 0; v < fx.g.nv; v++) {
+        double e = dist3(fx.g.V + 3 * v, fx.g.V + 3 * c);
+        if (e <= 0.3 - 1e-12)
+            tm_assert_close(fx.d[v], e, 1e-12);
+        else if (e > 0.3 + 1e-12)
+            assert_true(isinf(fx.d[v]) && fx.d[v] > 0);
+    }
+    assert_true(part.n_windows < full.n_windows / 2);
+    assert_true(full.peak_bytes > 0 && full.peak_windows > 0 && full.n_pseudo_sources >= 1);
+    ex_free(&fx);
+}
+
+/* Two components and a non-manifold edge: a unit square cut along its
+ * diagonal (1,0)-(0,1), and a fin on that diagonal, and a copy of the
+ * square far away. The diagonal, shared by three faces, is a wall: from
+ * (0,0) the far corner is reached round an end of the wall. */
+static void test_nonmanifold_components(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh g = ex_alloc(9, 5);
+    const double V[27] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0.5, 0.5, 1,
+                          5, 0, 0, 6, 0, 0, 5, 1, 0, 6, 1, 0};
+    const int32_t F[15] = {0, 1, 2, 1, 3, 2, 1, 2, 4, 5, 6, 7, 6, 8, 7};
+    memcpy(g.V, V, sizeof V);
+    memcpy(g.F, F, sizeof F);
+    ex_fx fx = ex_make(g);
+    mfmm_source s = tm_vertex_source(0);
+    ex_solve(&fx, &s, 1, NULL);
+    tm_assert_close(fx.d[0], 0.0, 0.0);
+    tm_assert_close(fx.d[1], 1.0, 1e-15);
+    tm_assert_close(fx.d[2], 1.0, 1e-15);
+    tm_assert_close(fx.d[3], 2.0, 1e-15);
+    tm_assert_close(fx.d[4], 1.0 + sqrt(1.5), 1e-15);
+    for (int v = 5; v < 9; v++)
+        assert_true(isinf(fx.d[v]) && fx.d[v] > 0);
+    /* a source inside the fin */
+    mfmm_source fs = {0, 2, {0.25, 0.25, 0.5}, 0.0};
+    ex_solve(&fx, &fs, 1, NULL);
+    double p[3] = {0.25 + 0.25, 0.25 + 0.25, 0.5};
+    tm_assert_close(fx.d[1], dist3(p, V + 3), 1e-15);
+    tm_assert_close(fx.d[0], dist3(p, V + 3) + 1.0, 1e-15);
+    for (int v = 5; v < 9; v++)
+        assert_true(isinf(fx.d[v]));
+    ex_free(&fx);
+}
+
+/* A zero-area face is skipped (and refuses a source); the rest is exact. */
+static void test_degenerate_face(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh grid = mfmm_gen_grid(6);
+    mfmm_gen_mesh g = ex_alloc(grid.nv + 1, grid.nf + 1);
+    memcpy(g.V, grid.V, (size_t)grid.nv * 3 * sizeof(double));
+    memcpy(g.F, grid.F, (size_t)grid.nf * 3 * sizeof(int32_t));
+    /* a sliver on the boundary edge 0-1: its third vertex on the edge */
+    g.V[3 * grid.nv] = 0.5 * (g.V[0] + g.V[3]);
+    g.V[3 * grid.nv + 1] = 0.0;
+    g.V[3 * grid.nv + 2] = 0.0;
+    g.F[3 * grid.nf] = 0;
+    g.F[3 * grid.nf + 1] = grid.nv;
+    g.F[3 * grid.nf + 2] = 1;
+    mfmm_gen_free(&grid);
+    ex_fx fx = ex_make(g);
+    mfmm_source s = tm_vertex_source(20);
+    ex_solve(&fx, &s, 1, NULL);
+    for (int32_t v = 0; v < fx.g.nv - 1; v++)
+        tm_assert_close(fx.d[v], dist3(fx.g.V + 3 * v, fx.g.V + 60), 1e-12);
+    assert_true(isinf(fx.d[fx.g.nv - 1])); /* only on the skipped face */
+    mfmm_source bad = {0, fx.g.nf - 1, {0.3, 0.3, 0.4}, 0.0};
+    mfmm_error err;
+    assert_int_equal(mfmm_solve_exact(fx.solver, &bad, 1, NULL, fx.d, NULL, &err),
+                     MFMM_ERR_DEGENERATE_SOURCE);
+    assert_int_equal(err.index, 0);
+    ex_free(&fx);
+}
+
+static void test_memory_limit(void **state)
+{
+    (void)state;
+    ex_fx fx = ex_make(mfmm_gen_grid(30));
+    mfmm_source s = tm_vertex_source(15 * 31 + 15);
+    mfmm_exact_info info;
+    mfmm_error err;
+    assert_int_equal(mfmm_solve_exact(fx.solver, &s, 1, NULL, fx.d, &info, &err), MFMM_OK);
+    size_t need = info.peak_bytes;
+    mfmm_exact_options o;
+    mfmm_exact_options_init(&o);
+    o.memory_limit = need / 2;
+    /* a fresh solver: the first keeps the buffers it grew */
+    mfmm_exact_solver *small = NULL;
+    assert_int_equal(mfmm_exact_solver_create(fx.mesh, &small), MFMM_OK);
+    assert_int_equal(mfmm_solve_exact(small, &s, 1, &o, fx.d, NULL, &err), MFMM_ERR_MEMORY_LIMIT);
+    assert_int_equal(err.status, MFMM_ERR_MEMORY_LIMIT);
+    assert_true(strstr(err.message, "memory_limit") != NULL);
+    for (int32_t v = 0; v < fx.g.nv; v++)
+        assert_true(isinf(fx.d[v]));
+    o.memory_limit = 1000; /* less than the tables */
+    assert_int_equal(mfmm_solve_exact(small, &s, 1, &o, fx.d, NULL, &err), MFMM_ERR_MEMORY_LIMIT);
+    o.memory_limit = need;
+    mfmm_exact_solver_destroy(small);
+    assert_int_equal(mfmm_exact_solver_create(fx.mesh, &small), MFMM_OK);
+    assert_int_equal(mfmm_solve_exact(small, &s, 1, &o, fx.d, &info, &err), MFMM_OK);
+    assert_true(info.peak_bytes <= need);
+    mfmm_exact_solver_destroy(small);
+    /* a solver whose queue grew in an unlimited solve gives it back for a
+     * limited one that needs less: a source in a corner, within 0.2 */
+    o.memory_limit = need - need / 8;
+    o.max_distance = 0.2;
+    mfmm_source corner = tm_vertex_source(0);
+    assert_int_equal(mfmm_solve_exact(fx.solver, &corner, 1, &o, fx.d, &info, &err), MFMM_OK);
+    assert_true(info.peak_bytes <= o.memory_limit);
+    tm_assert_close(fx.d[1], 1.0 / 30.0, 1e-15);
+    ex_free(&fx);
+}
+
+/* ---------------------------------------------------------------- threads */
+
+typedef struct ex_job {
+    const mfmm_mesh *mesh;
+    int32_t nv, first;
+    double *out; /* 4 rows of nv */
+    int ok;
+} ex_job;
+
+static void *ex_worker(void *arg)
+{
+    ex_job *job = arg;
+    mfmm_exact_solver *solver = NULL;
+    job->ok = mfmm_exact_solver_create(job->mesh, &solver) == MFMM_OK;
+    for (int i = 0; job->ok && i < 4; i++) {
+        mfmm_source s = tm_vertex_source(job->first + 13 * i);
+        job->ok = mfmm_solve_exact(solver, &s, 1, NULL, job->out + (size_t)i * job->nv, NULL,
+                                   NULL) == MFMM_OK;
+    }
+    mfmm_exact_solver_destroy(solver);
+    return NULL;
+}
+
+/* Solvers of one mesh in several threads at once (no shared mutable state):
+ * the same rows as one thread alone. */
+static void test_threads(void **state)
+{
+    (void)state;
+    ex_fx fx = ex_make(mfmm_gen_sine(24));
+    enum { NT = 3 };
+    pthread_t th[NT];
+    ex_job jobs[NT];
+    for (int t = 0; t < NT; t++) {
+        jobs[t].mesh = fx.mesh;
+        jobs[t].nv = fx.g.nv;
+        jobs[t].first = 5 + 101 * t;
+        jobs[t].out = malloc(4 * (size_t)fx.g.nv * sizeof(double));
+        assert_non_null(jobs[t].out);
+        assert_int_equal(pthread_create(&th[t], NULL, ex_worker, &jobs[t]), 0);
+    }
+    for (int t = 0; t < NT; t++)
+        assert_int_equal(pthread_join(th[t], NULL), 0);
+    for (int t = 0; t < NT; t++) {
+        assert_true(jobs[t].ok);
+        for (int i = 0; i < 4; i++) {
+            mfmm_source s = tm_vertex_source(jobs[t].first + 13 * i);
+            ex_solve(&fx, &s, 1, NULL);
+            assert_memory_equal(fx.d, jobs[t].out + (size_t)i * fx.g.nv,
+                                (size_t)fx.g.nv * sizeof(double));
+        }
+        free(jobs[t].out);
+    }
+    ex_free(&fx);
+}
+
+/* ------------------------------------------------------------ patch API */
+
+static void test_patch(void **state)
+{
+    (void)state;
+    ex_fx fx = ex_make(mfmm_gen_grid(40));
+    mfmm_exact_info full, part;
+    int32_t c = 20 * 41 + 20;
+    mfmm_source s = tm_vertex_source(c);
+    assert_int_equal(mfmm_solve_exact(fx.solver, &s, 1, NULL, fx.d, &full, NULL), MFMM_OK);
+    for (int round = 0; round < 3; round++) {
+        int32_t src = round == 1 ? 3 * 41 + 5 : c;
+        mfmm_source ps = tm_vertex_source(src);
+        int32_t n = -1;
+        const int32_t *vs = NULL;
+        const double *ds = NULL;
+        double r = 0.1;
+        assert_int_equal(mfmm_exact_patch(fx.solver, &ps, 1, r, 0, &n, &vs, &ds, &part), MFMM_OK);
+        int32_t want = 0;
+        for (int32_t v = 0; v < fx.g.nv; v++)
+            want += dist3(fx.g.V + 3 * v, fx.g.V + 3 * src) <= r + 1e-12;
+        assert_true(n >= want - 4 && n <= want + 4); /* ties at the radius */
+        for (int32_t i = 0; i < n; i++) {
+            tm_assert_close(ds[i], dist3(fx.g.V + 3 * vs[i], fx.g.V + 3 * src), 1e-12);
+            assert_true(ds[i] <= r);
+        }
+        assert_true(part.n_windows * 10 < full.n_windows);
+    }
+    /* NULLs and bad counts */
+    int32_t n;
+    const int32_t *vs;
+    const double *ds;
+    assert_int_equal(mfmm_exact_patch(NULL, &s, 1, 0.1, 0, &n, &vs, &ds, NULL), MFMM_ERR_NULL_POINTER);
+    assert_int_equal(mfmm_exact_patch(fx.solver, &s, 0, 0.1, 0, &n, &vs, &ds, NULL), MFMM_ERR_BAD_COUNT);
+    assert_int_equal(mfmm_exact_patch(fx.solver, &s, 1, NAN, 0, &n, &vs, &ds, NULL), MFMM_ERR_BAD_ARGUMENT);
+    mfmm_source bad = tm_vertex_source(fx.g.nv);
+    assert_int_equal(mfmm_exact_patch(fx.solver, &bad, 1, 0.1, 0, &n, &vs, &ds, NULL), MFMM_ERR_BAD_SOURCE);
+    /* a point source in a face, with a value: T = value + distance <= radius */
+    mfmm_source fs = {0, 1000, {0.2, 0.3, 0.5}, 0.05};
+    double p[3] = {0.0, 0.0, 0.0};
+    for (int k = 0; k < 3; k++)
+        for (int e = 0; e < 3; e++)
+            p[e] += fs.bary[k] * fx.g.V[3 * fx.g.F[3000 + k] + e];
+    assert_int_equal(mfmm_exact_patch(fx.solver, &fs, 1, 0.15, 0, &n, &vs, &ds, NULL), MFMM_OK);
+    assert_true(n > 10);
+    for (int32_t i = 0; i < n; i++)
+        tm_assert_close(ds[i], 0.05 + dist3(fx.g.V + 3 * vs[i], p), 1e-12);
+    ex_free(&fx);
+}
+
+/* ------------------------------------------------ igl.exact_geodesic data */
+
+#ifdef MFMM_TEST_ZLIB
+#include <stdio.h>
+#include <zlib.h>
+
+static uint32_t rd16(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8;
+}
+
+static uint32_t rd32(const unsigned char *p)
+{
+    return rd16(p) | rd16(p + 2) << 16;
+}
+
+/* The bytes of member `name` of the zip file `buf` (stored or deflated),
+ * found through the central directory; NULL if absent or unreadable. */
+static unsigned char *zip_member(const unsigned char *buf, size_t n, const char *name,
+                                 size_t *out_n)
+{
+    if (n < 22)
+        return NULL;
+    size_t eocd = n - 22;
+    while (eocd > 0 && rd32(buf + eocd) != 0x06054b50u)
+        eocd--;
+    if (rd32(buf + eocd) != 0x06054b50u)
+        return NULL;
+    size_t cd = rd32(buf + eocd + 16), entries = rd16(buf + eocd + 10);
+    for (size_t i = 0; i < entries && cd + 46 <= n; i++) {
+        const unsigned char *c = buf + cd;
+        if (rd32(c) != 0x02014b50u)
+            return NULL;
+        uint32_t method = rd16(c + 10), csize = rd32(c + 20), usize = rd32(c + 24);
+        size_t nlen = rd16(c + 28), elen = rd16(c + 30), klen = rd16(c + 32);
+        size_t local = rd32(c + 42);
+        if (nlen == strlen(name) && !memcmp(c + 46, name, nlen) && local + 30 <= n) {
+            const unsigned char *l = buf + local;
+            size_t data = local + 30 + rd16(l + 26) + rd16(l + 28);
+            unsigned char *out = malloc(usize ? usize : 1);
+            if (!out || data + csize > n) {
+                free(out);
+                return NULL;
+            }
+            if (method == 0 && csize == usize) {
+                memcpy(out, buf + data, usize);
+            } else if (method == 8) {
+                z_stream z;
+                memset(&z, 0, sizeof z);
+                z.next_in = (unsigned char *)(uintptr_t)(buf + data);
+                z.avail_in = csize;
+                z.next_out = out;
+                z.avail_out = usize;
+                if (inflateInit2(&z, -MAX_WBITS) != Z_OK || inflate(&z, Z_FINISH) != Z_STREAM_END) {
+                    inflateEnd(&z);
+                    free(out);
+                    return NULL;
+                }
+                inflateEnd(&z);
+            } else {
+                free(out);
+                return NULL;
+            }
+            *out_n = usize;
+            return out;
+        }
+        cd += 46 + nlen + elen + klen;
+    }
+    return NULL;
+}
+
+/* An .npy array of little-endian f8 (as double) or i4/i8 (converted to
+ * double), C order: the values and the shape (up to 2 dimensions). */
+static double *npy_values(const unsigned char *b, size_t n, int64_t shape[2])
+{
+    if (n < 10 || memcmp(b, "\x93NUMPY", 6))
+        return NULL;
+    size_t hlen = b[6] == 1 ? rd16(b + 8) : rd32(b + 8), off = b[6] == 1 ? 10 : 12;
+    char hdr[512];
+    if (hlen >= sizeof hdr || off + hlen > n)
+        return NULL;
+    memcpy(hdr, b + off, hlen);
+    hdr[hlen] = 0;
+    const char *descr = strstr(hdr, "'descr': '");
+    const char *sh = strstr(hdr, "'shape': (");
+    if (!descr || !sh || strstr(hdr, "'fortran_order': True"))
+        return NULL;
+    descr += 10;
+    shape[0] = shape[1] = 1;
+    char *end;
+    shape[0] = strtoll(sh + 10, &end, 10);
+    if (*end == ',' && end[1] == ' ' && end[2] != ')')
+        shape[1] = strtoll(end + 2, &end, 10);
+    size_t count = (size_t)(shape[0] * shape[1]), item = descr[2] == '8' ? 8 : 4;
+    const unsigned char *data = b + off + hlen;
+    if (descr[0] != '<' || off + hlen + count * item > n)
+        return NULL;
+    double *out = malloc(count * sizeof *out);
+    if (!out)
+        return NULL;
+    for (size_t i = 0; i < count; i++) {
+        if (descr[1] == 'f' && item == 8) {
+            memcpy(out + i, data + 8 * i, 8);
+        } else if (descr[1] == 'i' && item == 4) {
+            int32_t v;
+            memcpy(&v, data + 4 * i, 4);
+            out[i] = v;
+        } else if (descr[1] == 'i' && item == 8) {
+            int64_t v;
+            memcpy(&v, data + 8 * i, 8);
+            out[i] = (double)v;
+        } else {
+            free(out);
+            return NULL;
+        }
+    }
+    return out;
+}
+
+static double *npz_array(const char *path, const char *member, int64_t shape[2])
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    unsigned char *buf = NULL;
+    size_t n = 0, cap = 0, got;
+    do {
+        if (n == cap) {
+            cap = cap ? 2 * cap : 1 << 16;
+            unsigned char *nb = realloc(buf, cap);
+            if (!nb)
+                break;
+            buf = nb;
+        }
+        got = fread(buf + n, 1, cap - n, f);
+        n += got;
+    } while (got > 0);
+    fclose(f);
+    size_t mn = 0;
+    unsigned char *m = buf ? zip_member(buf, n, member, &mn) : NULL;
+    double *out = m ? npy_values(m, mn, shape) : NULL;
+    free(m);
+    free(buf);
+    return out;
+}
+#endif
+
+/* tests/data/reference/NAME.npz: igl.exact_geodesic (Kirsanov's MMP) from
+ * three vertices of tests/data/meshes/NAME; ours equal to 1e-12 relative. */
+static void check_reference(const char *mesh_file, const char *npz_file)
+{
+#ifdef MFMM_TEST_ZLIB
+    char mpath[1024], rpath[1024];
+    snprintf(mpath, sizeof mpath, "%s/meshes/%s", MESHFMM_TEST_DATA_DIR, mesh_file);
+    snprintf(rpath, sizeof rpath, "%s/reference/%s", MESHFMM_TEST_DATA_DIR, npz_file);
+    int64_t ss[2], ds[2];
+    double *src = npz_array(rpath, "sources.npy", ss);
+    double *ref = npz_array(rpath, "distances.npy", ds);
+    double *V = NULL;
+    int32_t *F = NULL, nv = 0, nf = 0;
+    mfmm_error err;
+    if (!src || !ref || mfmm_load_mesh(mpath, &V, &nv, &F, &nf, &err) != MFMM_OK) {
+        free(src);
+        free(ref);
+        skip(); /* the data is not in this checkout */
+    }
+    assert_int_equal(ds[0], ss[0] * ss[1]);
+    assert_int_equal(ds[1], nv);
+    mfmm_gen_mesh g = {nv, nf, V, F};
+    mfmm_mesh *mesh = tm_make(&g);
+    mfmm_exact_solver *solver = NULL;
+    assert_int_equal(mfmm_exact_solver_create(mesh, &solver), MFMM_OK);
+    double *d = malloc((size_t)nv * sizeof *d);
+    assert_non_null(d);
+    for (int64_t i = 0; i < ds[0]; i++) {
+        mfmm_source s = tm_vertex_source((int32_t)src[i]);
+        assert_int_equal(mfmm_solve_exact(solver, &s, 1, NULL, d, NULL, &err), MFMM_OK);
+        for (int32_t v = 0; v < nv; v++) {
+            double r = ref[i * nv + v];
+            if (isinf(r))
+                assert_true(isinf(d[v]));
+            else
+                tm_assert_close(d[v], r, 1e-12 * r);
+        }
+    }
+    free(d);
+    mfmm_exact_solver_destroy(solver);
+    mfmm_mesh_destroy(mesh);
+    mfmm_free(V);
+    mfmm_free(F);
+    free(src);
+    free(ref);
+#else
+    (void)mesh_file;
+    (void)npz_file;
+    skip(); /* built without zlib: the .npz cannot be read */
+#endif
+}
+
+static void test_igl_reference_hand(void **state)
+{
+    (void)state;
+    check_reference("hand_lowres.obj", "hand_lowres.npz");
+}
+
+static void test_igl_reference_spot(void **state)
+{
+    (void)state;
+    check_reference("spot.obj", "spot.npz");
+}
+
+/* --------------------------------------------------------------- bad input */
+
+static void test_bad_input(void **state)
+{
+    (void)state;
+    ex_fx fx = ex_make(mfmm_gen_grid(4));
+    mfmm_source ok = tm_vertex_source(0);
+    mfmm_error err;
+    mfmm_exact_solver *sv = (mfmm_exact_solver *)1;
+    assert_int_equal(mfmm_exact_solver_create(NULL, &sv), MFMM_ERR_NULL_POINTER);
+    assert_null(sv);
+    assert_int_equal(mfmm_exact_solver_create(fx.mesh, NULL), MFMM_ERR_NULL_POINTER);
+    mfmm_exact_solver_destroy(NULL);
+    mfmm_exact_options_init(NULL);
+    assert_int_equal(mfmm_solve_exact(NULL, &ok, 1, NULL, fx.d, NULL, &err), MFMM_ERR_NULL_POINTER);
+    assert_int_equal(mfmm_solve_exact(fx.solver, NULL, 1, NULL, fx.d, NULL, &err), MFMM_ERR_NULL_POINTER);
+    assert_int_equal(mfmm_solve_exact(fx.solver, &ok, 1, NULL, NULL, NULL, &err), MFMM_ERR_NULL_POINTER);
+    assert_int_equal(mfmm_solve_exact(fx.solver, &ok, 0, NULL, fx.d, NULL, &err), MFMM_ERR_BAD_COUNT);
+    mfmm_source s = tm_vertex_source(fx.g.nv);
+    assert_int_equal(mfmm_solve_exact(fx.solver, &s, 1, NULL, fx.d, NULL, &err), MFMM_ERR_BAD_SOURCE);
+    assert_int_equal(err.index, 0);
+    mfmm_source two[2] = {ok, {0, fx.g.nf, {0.3, 0.3, 0.4}, 0.0}};
+    assert_int_equal(mfmm_solve_exact(fx.solver, two, 2, NULL, fx.d, NULL, &err), MFMM_ERR_BAD_SOURCE);
+    assert_int_equal(err.index, 1);
+    two[1].face = 2;
+    two[1].bary[0] = -0.2;
+    two[1].bary[2] = 0.9;
+    assert_int_equal(mfmm_solve_exact(fx.solver, two, 2, NULL, fx.d, NULL, &err),
+                     MFMM_ERR_BAD_BARYCENTRIC);
+    s = ok;
+    s.value = INFINITY;
+    assert_int_equal(mfmm_solve_exact(fx.solver, &s, 1, NULL, fx.d, NULL, &err), MFMM_ERR_BAD_ARGUMENT);
+    double cost[32];
+    for (int i = 0; i < 32; i++)
+        cost[i] = 1.0;
+    mfmm_exact_options o;
+    mfmm_exact_options_init(&o);
+    o.cost = cost;
+    o.cost_location = MFMM_COST_PER_FACE;
+    assert_int_equal(mfmm_solve_exact(fx.solver, &ok, 1, &o, fx.d, NULL, &err), MFMM_ERR_BAD_ARGUMENT);
+    assert_true(strstr(err.message, "cost") != NULL);
+    for (int32_t v = 0; v < fx.g.nv; v++)
+        assert_true(isinf(fx.d[v]));
+    mfmm_exact_options_init(&o);
+    o.max_distance = -1.0;
+    assert_int_equal(mfmm_solve_exact(fx.solver, &ok, 1, &o, fx.d, NULL, &err), MFMM_ERR_BAD_ARGUMENT);
+    o.max_distance = NAN;
+    assert_int_equal(mfmm_solve_exact(fx.solver, &ok, 1, &o, fx.d, NULL, &err), MFMM_ERR_BAD_ARGUMENT);
+    assert_string_equal(mfmm_status_string(MFMM_ERR_MEMORY_LIMIT),
+                        "the computation needed more memory than its memory limit");
+    /* after errors the solver still works */
+    ex_solve(&fx, &ok, 1, NULL);
+    tm_assert_close(fx.d[fx.g.nv - 1], sqrt(2.0), 1e-15);
+    ex_free(&fx);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_plane_exact),
+        cmocka_unit_test(test_mixed_orientation),
+        cmocka_unit_test(test_several_sources),
+        cmocka_unit_test(test_values_and_scale),
+        cmocka_unit_test(test_cube),
+        cmocka_unit_test(test_cylinder),
+        cmocka_unit_test(test_saddle),
+        cmocka_unit_test(test_reflex_corner),
+        cmocka_unit_test(test_max_distance),
+        cmocka_unit_test(test_nonmanifold_components),
+        cmocka_unit_test(test_degenerate_face),
+        cmocka_unit_test(test_memory_limit),
+        cmocka_unit_test(test_threads),
+        cmocka_unit_test(test_patch),
+        cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_igl_reference_hand),
+        cmocka_unit_test(test_igl_reference_spot),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

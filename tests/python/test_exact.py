@@ -1,0 +1,70 @@
+"""mfmm_solve_exact through the C ABI (meshfmm._lib): live against
+igl.exact_geodesic (Kirsanov's MMP) on the smallest test mesh, from
+vertices and from face centroids (igl's face sources), and the refusal of a
+cost. The stored references of all meshes are checked by bench/bench_exact.py
+and tests/c/test_exact.c."""
+
+from __future__ import annotations
+
+import ctypes
+
+import numpy as np
+import pytest
+
+from conftest import MESHES, need_data
+from meshfmm import _lib
+
+
+def _solve_exact(V, F, source, options=None):
+    err = _lib.mfmm_error()
+    mesh, solver = ctypes.c_void_p(), ctypes.c_void_p()
+    V = np.ascontiguousarray(V, dtype=np.float64)
+    F = np.ascontiguousarray(F, dtype=np.int32)
+    assert _lib.mfmm_mesh_create(V.ctypes.data, len(V), F.ctypes.data, len(F), None,
+                                 ctypes.byref(mesh), ctypes.byref(err)) == 0, err.message
+    try:
+        assert _lib.mfmm_exact_solver_create(mesh, ctypes.byref(solver)) == 0
+        out = np.empty(len(V))
+        info = _lib.mfmm_exact_info()
+        st = _lib.mfmm_solve_exact(solver, ctypes.byref(source), 1,
+                                   ctypes.byref(options) if options else None,
+                                   out.ctypes.data, ctypes.byref(info), ctypes.byref(err))
+        return st, out, info, err
+    finally:
+        _lib.mfmm_exact_solver_destroy(solver)
+        _lib.mfmm_mesh_destroy(mesh)
+
+
+def test_live_against_igl():
+    igl = pytest.importorskip("igl")
+    need_data()
+    V, F = igl.read_triangle_mesh(str(MESHES / "hand_lowres.obj"))
+    F = F.astype(np.int64)
+    none = np.array([], dtype=np.int64)
+    every = np.arange(len(V), dtype=np.int64)
+    for v in (3, 400):
+        ref = igl.exact_geodesic(V, F, np.array([v]), none, every, none)
+        st, d, info, err = _solve_exact(V, F, _lib.mfmm_source(v, -1, (0.0, 0.0, 0.0), 0.0))
+        assert st == 0, err.message
+        np.testing.assert_allclose(d, ref, rtol=1e-12, atol=0)
+        assert info.n_windows > 0 and info.peak_bytes > 0
+    for f in (7, 1000):
+        ref = igl.exact_geodesic(V, F, none, np.array([f]), every, none)
+        third = 1.0 / 3.0
+        st, d, _, err = _solve_exact(V, F, _lib.mfmm_source(0, f, (third, third, third), 0.0))
+        assert st == 0, err.message
+        np.testing.assert_allclose(d, ref, rtol=1e-12, atol=0)
+
+
+def test_cost_refused():
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=np.float64)
+    F = np.array([[0, 1, 2]], dtype=np.int32)
+    cost = np.ones(1)
+    opt = _lib.mfmm_exact_options()
+    _lib.mfmm_exact_options_init(ctypes.byref(opt))
+    opt.cost = cost.ctypes.data
+    opt.cost_location = _lib.MFMM_COST_PER_FACE
+    st, d, _, err = _solve_exact(V, F, _lib.mfmm_source(0, -1, (0.0, 0.0, 0.0), 0.0), opt)
+    assert st == _lib.MFMM_ERR_BAD_ARGUMENT
+    assert b"cost" in err.message
+    assert np.isinf(d).all()
