@@ -242,6 +242,7 @@ MFMM_API mfmm_status mfmm_exact_solver_create(const mfmm_mesh *mesh, mfmm_exact_
 MFMM_API void mfmm_exact_solver_destroy(mfmm_exact_solver *solver);
 
 typedef struct mfmm_exact_options {
+    size_t struct_size;   /* sizeof(mfmm_exact_options), set by the _init function */
     /* Must be NULL: exact distances are for F = 1 (a cost is refused with
      * MFMM_ERR_BAD_ARGUMENT; use mfmm_solve for weighted distances). */
     const double *cost;

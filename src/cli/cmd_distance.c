@@ -12,12 +12,14 @@ static void help(FILE *out)
             "usage: meshfmm distance MESH --source I [--source J ...]\n"
             "                        [--face-source F W0 W1 W2 ...] [--max-distance X]\n"
             "                        [--no-unfolding] [--cost FILE [--cost-per-face]]\n"
-            "                        -o OUT\n\n"
+            "                        [--exact] -o OUT\n\n"
             "Geodesic distance (Fast Marching) from the sources to every vertex of MESH.\n\n"
             "  --source I              a vertex source (0-based id); repeatable\n"
             "  --face-source F W0 W1 W2  a point in face F with barycentric coordinates\n"
             "  --max-distance X        stop past X; farther vertices get inf\n"
             "  --no-unfolding          plain stencils at obtuse corners (for comparison)\n"
+            "  --exact                 exact polyhedral geodesic distance (window\n"
+            "                          propagation) instead of Fast Marching; no --cost\n"
             "  --cost FILE             slowness F (.npy float64/float32 or .txt), one value\n"
             "                          per vertex (default) or per face (--cost-per-face)\n"
             "  -o, --output OUT        .npy (float64, shape (nv,)) or .txt (one value per\n"
@@ -39,13 +41,45 @@ static int write_txt(const char *path, const double *d, int32_t n)
     return cli_output_close(&out, bad);
 }
 
+/* Exact polyhedral distances (mfmm_solve_exact) from the parsed sources. */
+static double *solve_exact(const mfmm_mesh *mesh, const cli_sources_and_cost *o, double max_d)
+{
+    int32_t nv = mfmm_mesh_vertex_count(mesh);
+    double *dist = malloc((size_t)nv * sizeof *dist);
+    mfmm_exact_solver *solver = NULL;
+    if (!dist) {
+        cli_error("out of memory");
+        return NULL;
+    }
+    mfmm_error err;
+    mfmm_status st = mfmm_exact_solver_create(mesh, &solver);
+    if (st != MFMM_OK) {
+        cli_error("%s", mfmm_status_string(st));
+        free(dist);
+        return NULL;
+    }
+    mfmm_exact_options eo;
+    mfmm_exact_options_init(&eo);
+    eo.max_distance = max_d;
+    st = mfmm_solve_exact(solver, o->src, o->n_src, &eo, dist, NULL, &err);
+    mfmm_exact_solver_destroy(solver);
+    if (st != MFMM_OK) {
+        cli_error("%s", err.message);
+        free(dist);
+        return NULL;
+    }
+    return dist;
+}
+
 int cmd_distance(int argc, char **argv)
 {
     static const struct option longopts[] = {
         CLI_SHARED_LONG_OPTIONS,
         {"max-distance", required_argument, NULL, OPT_MAX_DISTANCE},
         {"no-unfolding", no_argument, NULL, OPT_NO_UNFOLDING},
+        {"exact", no_argument, NULL, OPT_EXACT},
         {NULL, 0, NULL, 0}};
+    int exact = 0;
     int rc = CLI_FAIL;
     mfmm_solve_options opt;
     mfmm_solve_options_init(&opt);
@@ -64,9 +98,16 @@ int cmd_distance(int argc, char **argv)
             }
         } else if (c == OPT_NO_UNFOLDING) {
             opt.unfolding = 0;
+        } else if (c == OPT_EXACT) {
+            exact = 1;
         } else if ((rc = cli_sources_and_cost_opt(&o, c, argc, argv)) != CLI_OK || o.help_shown) {
             goto done;
         }
+    }
+    if (exact && (o.cost_path || !opt.unfolding)) {
+        rc = cli_usage_error("distance", "--exact computes geodesic distance: it takes no "
+                                         "--cost and no --no-unfolding");
+        goto done;
     }
     int is_txt;
     if ((rc = cli_sources_and_cost_positional(&o, argc, argv)) != CLI_OK ||
@@ -80,7 +121,7 @@ int cmd_distance(int argc, char **argv)
     if (!mesh || cli_sources_and_cost_load(&o, mesh, 1, &opt))
         goto done;
     int32_t nv = mfmm_mesh_vertex_count(mesh);
-    dist = cli_solve_distances(mesh, &o, &opt);
+    dist = exact ? solve_exact(mesh, &o, opt.max_distance) : cli_solve_distances(mesh, &o, &opt);
     if (!dist || cli_interrupted())
         goto done;
     if (!is_txt) {

@@ -163,6 +163,7 @@ void mfmm_exact_options_init(mfmm_exact_options *options)
 {
     if (!options)
         return;
+    options->struct_size = sizeof *options;
     options->cost = NULL;
     options->cost_location = MFMM_COST_NONE;
     options->max_distance = INFINITY;
@@ -979,6 +980,8 @@ mfmm_status mfmm_solve_exact(mfmm_exact_solver *solver, const mfmm_source *sourc
         mfmm_exact_options_init(&defaults);
         options = &defaults;
     }
+    if (mfmm_check_struct_size(options, sizeof *options, "mfmm_exact_options", err) != MFMM_OK)
+        return MFMM_ERR_BAD_ARGUMENT;
     if (options->cost)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
                          "mfmm_solve_exact computes geodesic distance (F = 1) and takes no cost; "

@@ -68,3 +68,64 @@ def test_cost_refused():
     assert st == _lib.MFMM_ERR_BAD_ARGUMENT
     assert b"cost" in err.message
     assert np.isinf(d).all()
+
+
+@pytest.mark.parametrize("name", ["hand_lowres", "spot", "wingnut", "fertility_FE_10k",
+                                  "decimated-max", "camelhead"])
+def test_mesh_distance_method_exact_equals_stored_igl(name, reference_dir):
+    """Mesh.distance(method="exact") against the stored igl.exact_geodesic rows
+    (1e-9 relative; the larger meshes are checked by bench/bench_exact.py)."""
+    import meshfmm
+    from conftest import load
+
+    ext = {"fertility_FE_10k": ".off", "camelhead": ".off"}.get(name, ".obj")
+    mesh = meshfmm.Mesh(*load(name + ext))
+    ref = np.load(reference_dir / f"{name}.npz")
+    for s, e in zip(ref["sources"], ref["distances"]):
+        d = mesh.distance(int(s), method="exact")
+        fin = np.isfinite(e)
+        assert np.array_equal(np.isfinite(d), fin)
+        pos = fin & (e > 0)
+        assert np.max(np.abs(d[pos] - e[pos]) / e[pos]) < 1e-9
+        assert d[int(s)] == 0.0
+
+
+def test_mesh_distance_method_exact_refuses_what_it_cannot_do():
+    import meshfmm
+    from conftest import load
+
+    mesh = meshfmm.Mesh(*load("hand_lowres.obj"))
+    with pytest.raises(ValueError, match="no cost"):
+        mesh.distance(0, cost=np.ones(mesh.n_vertices), method="exact")
+    with pytest.raises(ValueError, match="method"):
+        mesh.distance(0, method="mmp")
+    with pytest.raises(ValueError, match="max_distance"):
+        mesh.distance(0, method="exact", max_distance=-1.0)
+    d = mesh.distance(0, method="exact", max_distance=0.05)
+    full = mesh.distance(0, method="exact")
+    near = full <= 0.05
+    assert np.array_equal(d[near], full[near]) and np.all(np.isinf(d[~near]))
+
+
+def test_cli_distance_exact(tmp_path, reference_dir):
+    """`meshfmm distance --exact` equals the stored igl.exact_geodesic row;
+    with --cost it is refused with a sentence and status 2."""
+    import os
+    import subprocess
+
+    cli = os.environ.get("MESHFMM_CLI")
+    if not cli:
+        pytest.skip("MESHFMM_CLI is not set (scripts/test.sh sets it to build/meshfmm)")
+    ref = np.load(reference_dir / "spot.npz")
+    out = tmp_path / "d.npy"
+    r = subprocess.run([cli, "distance", str(MESHES / "spot.obj"), f"--source={ref['sources'][1]}",
+                        "--exact", "-o", str(out)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    d, e = np.load(out), ref["distances"][1]
+    pos = e > 0
+    assert np.max(np.abs(d[pos] - e[pos]) / e[pos]) < 1e-9
+    np.save(tmp_path / "c.npy", np.ones(len(d)))
+    r = subprocess.run([cli, "distance", str(MESHES / "spot.obj"), "--source", "0", "--exact",
+                        "--cost", str(tmp_path / "c.npy"), "-o", str(tmp_path / "x.npy")],
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and "--exact" in r.stderr

@@ -171,6 +171,7 @@ class mfmm_solve_options(Structure):
 
 class mfmm_exact_options(Structure):
     _fields_ = [
+        ("struct_size", c_size_t),
         ("cost", c_void_p),  # const double *; must be NULL
         ("cost_location", c_enum),
         ("max_distance", c_double),

@@ -295,6 +295,7 @@ class Mesh:
         self._lock = threading.Lock()
         self._active = 0
         self._solvers: List[int] = []
+        self._exact_solvers: List[int] = []
         #: Name of the backend that ran the last :meth:`distance_matrix` call
         #: ("serial", "threads" or "opencl"), None before the first.
         self.backend_used: Optional[str] = None
@@ -388,8 +389,11 @@ class Mesh:
                 raise RuntimeError("Mesh.close(): another thread is still computing on this mesh")
             ptr, self._ptr = self._ptr, None
             solvers, self._solvers = self._solvers, []
+            exact, self._exact_solvers = self._exact_solvers, []
         for s in solvers:
             _lib.mfmm_solver_destroy(s)
+        for s in exact:
+            _lib.mfmm_exact_solver_destroy(s)
         _lib.mfmm_mesh_destroy(ptr)
 
     @property
@@ -472,6 +476,7 @@ class Mesh:
         targets: Any = None,
         unfolding: bool = True,
         cost_location: Optional[str] = None,
+        method: str = "fmm",
     ) -> np.ndarray:
         """Distance from the nearest source to every vertex, float64 (n_vertices,).
 
@@ -485,10 +490,20 @@ class Mesh:
         targets: vertex ids; the march stops once all of them are settled
             (then only settled vertices are final, the rest may be +inf).
         unfolding: False uses plain stencils at obtuse corners (for comparison).
+        method: "fmm" (the Fast Marching Method, the default) or "exact":
+            exact polyhedral geodesic distances by window propagation
+            (mfmm_solve_exact; no cost, targets or unfolding options).
 
         Unreached vertices (other components, beyond max_distance) are +inf.
         Raises ValueError (bad source, barycentric coordinates, cost, ...).
         """
+        if method == "exact":
+            if cost is not None or targets is not None or not unfolding:
+                raise ValueError("method='exact' computes geodesic distance: it takes no cost, "
+                                 "targets or unfolding")
+            return self._distance_exact(sources, max_distance)
+        if method != "fmm":
+            raise ValueError(f"method must be 'fmm' or 'exact', not {method!r}")
         if _is_int(sources):  # the common case, kept cheap (see bench_python.py)
             one = _lib.mfmm_source(_as_index(sources, "source"), -1)
             src_addr, n_src = ctypes.addressof(one), 1
@@ -522,6 +537,34 @@ class Mesh:
         finally:
             if solver is not None:
                 self._solvers.append(solver)
+            self._leave()
+        if status:
+            raise _lib.make_error(status, err)
+        return out
+
+    def _distance_exact(self, sources: SourceLike, max_distance: Optional[float]) -> np.ndarray:
+        src = _source_records(sources)
+        opts = _lib.mfmm_exact_options()
+        _lib.mfmm_exact_options_init(byref(opts))
+        if max_distance is not None:
+            opts.max_distance = _max_distance(max_distance)
+        out = np.empty(self._nv, dtype=np.float64)
+        err = _lib.mfmm_error()
+        info = _lib.mfmm_exact_info()
+        solver = None
+        mesh_ptr = self._enter()
+        try:
+            try:
+                solver = self._exact_solvers.pop()
+            except IndexError:
+                ptr = ctypes.c_void_p()
+                _lib.check(_lib.mfmm_exact_solver_create(mesh_ptr, byref(ptr)))
+                solver = ptr.value
+            status = _lib.mfmm_solve_exact(solver, _addr(src), src.shape[0], byref(opts),
+                                           _addr(out), byref(info), byref(err))
+        finally:
+            if solver is not None:
+                self._exact_solvers.append(solver)
             self._leave()
         if status:
             raise _lib.make_error(status, err)
