@@ -38,6 +38,8 @@ inline void mfmm_row_march(int nv, __global const int *update_offset,
     s.unfolding = unfolding;
     s.targets_left = 0;
     s.uniform = uniform;
+    s.touched = 0; /* no list: the per-item workspace resets all nv */
+    s.n_touched = 0;
     mfmm_march_reset(&s, nv);
     mfmm_march_seed(&s, source, 0.0);
     mfmm_march_run(&s, &m);
