@@ -366,6 +366,16 @@ typedef enum mfmm_dtype {
 typedef int (*mfmm_rows_callback)(void *user, int32_t first_row, int32_t n_rows,
                                   const void *rows);
 
+/* Receives finished rows as a CSR block (sparse output, see
+ * mfmm_matrix_options.on_sparse): rows [first_row, first_row + n_rows);
+ * row i's entries are indices[indptr[i] .. indptr[i+1]) (column ids,
+ * ascending) with values[same range] of the requested dtype. indptr has
+ * n_rows + 1 entries and starts at 0 for each block. Valid during the call;
+ * rows arrive in order. Return 0 to go on, non-zero to cancel. */
+typedef int (*mfmm_sparse_callback)(void *user, int32_t first_row, int32_t n_rows,
+                                    const int64_t *indptr, const int32_t *indices,
+                                    const void *values);
+
 typedef struct mfmm_matrix_options {
     size_t struct_size;              /* sizeof(mfmm_matrix_options), set by the _init function */
     mfmm_backend backend;            /* default MFMM_BACKEND_AUTO */
@@ -388,12 +398,32 @@ typedef struct mfmm_matrix_options {
     char fallback_reason[256];       /* out: with backend AUTO, why threads ran instead of
                                         OpenCL (the OpenCL error, or that OpenCL could not
                                         keep every core busy); "" when OpenCL ran */
+    /* Rectangular and sparse jobs (appended fields). */
+    const int32_t *targets;          /* NULL: every vertex is a column (rows nv wide).
+                                        Else n_targets >= 1 vertex ids: rows are n_targets
+                                        wide, column j the distance to targets[j] (any
+                                        order, duplicates allowed), and each row's march
+                                        stops once all its targets are settled */
+    int32_t n_targets;
+    int64_t vertices_settled;        /* out: vertices settled over all rows by the serial and
+                                        threads backends (the work done); 0 from OpenCL */
+    /* Sparse output: rows go to on_sparse as CSR blocks holding only the
+     * finite entries (distance <= max_distance; the source's own 0 is an
+     * explicit entry), built from each march's touched list, so memory and
+     * time follow the entries, never n_sources x nv. out and on_rows must be
+     * NULL. Serial and threads backends; OPENCL fails with
+     * MFMM_ERR_BAD_ARGUMENT, AUTO runs threads. */
+    mfmm_sparse_callback on_sparse;
 } mfmm_matrix_options;
 
 MFMM_API void mfmm_matrix_options_init(mfmm_matrix_options *options);
 
 /* One row per source: row i holds the distances from vertex sources[i] to
- * every vertex (equal to mfmm_solve's). sources NULL: all vertices, in order
+ * every vertex (equal to mfmm_solve's), or to options->targets (an
+ * n_sources x n_targets matrix, see mfmm_matrix_options.targets), densely
+ * (out, on_rows) or sparsely (on_sparse). With targets or on_sparse, OpenCL
+ * is not used: OPENCL fails with MFMM_ERR_BAD_ARGUMENT and AUTO runs threads
+ * (fallback_reason says so). sources NULL: all vertices, in order
  * (n_sources must then be nv). Rows go to options->out, to options->on_rows,
  * or both; the library holds only the blocks in flight, never n_sources x nv.
  * With backend AUTO, threads run instead of OpenCL when OpenCL fails (from the
