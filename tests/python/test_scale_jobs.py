@@ -110,3 +110,44 @@ def test_symmetric():
     with pytest.raises(ValueError):
         m.distance_matrix([1, 2], symmetric=True)
     assert n > 0
+
+
+def test_cli_npz_and_targets(tmp_path):
+    """`meshfmm allpairs --max-distance R -o OUT.npz` loads with
+    scipy.sparse.load_npz and equals Python's CSR; --targets gives the
+    columns; the output may not be the targets file; .npz needs a radius."""
+    import subprocess
+
+    need_data()
+    sp = pytest.importorskip("scipy.sparse")
+    from test_cli import find_cli
+
+    exe = find_cli()
+    if exe is None:
+        pytest.skip("no meshfmm command line")
+    from conftest import MESHES
+
+    path = str(MESHES / "hand_lowres.obj")
+    m = mesh("hand_lowres.obj")
+    (tmp_path / "t.txt").write_text("5 400 5 800 2\n")
+    (tmp_path / "s.txt").write_text("0 17 400\n")
+    run = lambda *a: subprocess.run([exe, "allpairs", path, "--quiet", *a], capture_output=True, text=True)
+    for dt in ("float32", "float64"):
+        r = run("--max-distance", "0.05", "--dtype", dt, "-o", str(tmp_path / "o.npz"))
+        assert r.returncode == 0, r.stderr
+        S = sp.load_npz(tmp_path / "o.npz")
+        P = m.distance_matrix(None, dtype=dt, max_distance=0.05, sparse=True)
+        assert S.shape == P.shape and S.dtype == P.dtype
+        assert np.array_equal(S.indptr, P.indptr) and np.array_equal(S.indices, P.indices)
+        assert np.array_equal(S.data, P.data)
+    r = run("--sources", str(tmp_path / "s.txt"), "--targets", str(tmp_path / "t.txt"),
+            "--dtype", "float64", "-o", str(tmp_path / "t.npy"))
+    assert r.returncode == 0, r.stderr
+    ref = m.distance_matrix([0, 17, 400], dtype="float64")[:, [5, 400, 5, 800, 2]]
+    assert np.array_equal(np.load(tmp_path / "t.npy"), ref)
+    r = run("-o", str(tmp_path / "x.npz"))
+    assert r.returncode == 2 and "--max-distance" in r.stderr
+    assert not (tmp_path / "x.npz").exists()
+    (tmp_path / "t.npz").write_bytes(b"")
+    r = run("--targets", str(tmp_path / "t.npz"), "--max-distance", "1", "-o", str(tmp_path / "t.npz"))
+    assert r.returncode == 2
