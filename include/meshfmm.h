@@ -360,8 +360,8 @@ typedef enum mfmm_dtype {
 } mfmm_dtype;
 
 /* Receives finished rows: rows [first_row, first_row + n_rows) of the matrix,
- * n_rows x nv values of the requested dtype, row-major, valid during the
- * call. Rows arrive in order. Return 0 to go on, non-zero to cancel
+ * n_rows x nv values (n_targets with targets) of the requested dtype,
+ * row-major, valid during the call. Rows arrive in order. Return 0 to go on, non-zero to cancel
  * (mfmm_distance_matrix then returns MFMM_ERR_CANCELLED). */
 typedef int (*mfmm_rows_callback)(void *user, int32_t first_row, int32_t n_rows,
                                   const void *rows);
@@ -387,7 +387,8 @@ typedef struct mfmm_matrix_options {
     int32_t n_threads;               /* threads backend; 0: all cores */
     size_t memory_limit;             /* bytes the library may use for workspaces and
                                         blocks in flight; 0: a default from the device */
-    void *out;                       /* n_sources x nv buffer of dtype to fill, or NULL */
+    void *out;                       /* n_sources x nv (n_targets with targets) buffer of
+                                        dtype to fill, or NULL */
     mfmm_rows_callback on_rows;      /* called with each finished block, or NULL */
     void *user;                      /* passed to on_rows */
     mfmm_backend backend_used;       /* out: the backend that ran */
@@ -420,10 +421,11 @@ MFMM_API void mfmm_matrix_options_init(mfmm_matrix_options *options);
 
 /* One row per source: row i holds the distances from vertex sources[i] to
  * every vertex (equal to mfmm_solve's), or to options->targets (an
- * n_sources x n_targets matrix, see mfmm_matrix_options.targets), densely
- * (out, on_rows) or sparsely (on_sparse). With targets or on_sparse, OpenCL
- * is not used: OPENCL fails with MFMM_ERR_BAD_ARGUMENT and AUTO runs threads
- * (fallback_reason says so). sources NULL: all vertices, in order
+ * n_sources x n_targets matrix, see mfmm_matrix_options.targets; on every
+ * backend, OpenCL's kernel marching each row to its targets too), densely
+ * (out, on_rows: n_sources x width values, width = n_targets or nv) or
+ * sparsely (on_sparse; not on OpenCL: OPENCL fails with
+ * MFMM_ERR_BAD_ARGUMENT and AUTO runs threads, fallback_reason says so). sources NULL: all vertices, in order
  * (n_sources must then be nv). Rows go to options->out, to options->on_rows,
  * or both; the library holds only the blocks in flight, never n_sources x nv.
  * With backend AUTO, threads run instead of OpenCL when OpenCL fails (from the

@@ -450,10 +450,10 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
         return mfmm_fail(err, MFMM_ERR_BAD_COUNT, o->n_targets,
                          "n_targets is %ld but targets is %s (give both, n_targets >= 1, or neither)",
                          (long)o->n_targets, o->targets ? "set" : "NULL");
-    if ((o->targets || o->on_sparse) && o->backend == MFMM_BACKEND_OPENCL)
+    if (o->on_sparse && o->backend == MFMM_BACKEND_OPENCL)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
-                         "the OpenCL backend computes full dense rows only; use threads (or auto) "
-                         "for %s", o->on_sparse ? "sparse rows" : "target columns");
+                         "the OpenCL backend computes dense rows only; use threads (or auto) "
+                         "for sparse rows");
     if ((int)o->backend < MFMM_BACKEND_AUTO || (int)o->backend > MFMM_BACKEND_OPENCL)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "unknown backend %d", (int)o->backend);
     if (o->dtype != MFMM_FLOAT32 && o->dtype != MFMM_FLOAT64)
@@ -561,11 +561,10 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     default: { /* auto: OpenCL when it keeps every compute unit busy, else
                 * threads from the first row not delivered, saying why */
         int32_t done = 0;
-        if (job.targets || job.sparse) {
+        if (job.sparse) {
             o->backend_used = MFMM_BACKEND_THREADS;
             snprintf(o->fallback_reason, sizeof o->fallback_reason,
-                     "the OpenCL backend computes full dense rows only, not %s",
-                     job.sparse ? "sparse rows" : "target columns");
+                     "the OpenCL backend computes dense rows only, not sparse rows");
             st = run_threads(&job, 0, err);
             break;
         }

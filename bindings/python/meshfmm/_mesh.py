@@ -651,7 +651,7 @@ class Mesh:
             result is len(sources) x T, column j the distance to
             ``targets[j]``, and each row's march stops once all its targets
             are settled (landmark matrices cost far less than full rows).
-            None: every vertex. Not on OpenCL ("auto" runs threads).
+            None: every vertex. Every backend, OpenCL included.
         sparse: return a ``scipy.sparse.csr_matrix`` of the finite entries
             only (with ``max_distance=r``: the pairs within r; the diagonal
             holds explicit zeros), sorted column ids; memory O(nnz), never
@@ -752,8 +752,8 @@ class Mesh:
         if tgt is not None:
             opts.targets = _addr(tgt)
             opts.n_targets = tgt.shape[0]
-        if opts.backend == _lib.BACKENDS["auto"] and (tgt is not None or sparse):
-            pass  # the library runs threads (OpenCL does full dense rows only)
+        if opts.backend == _lib.BACKENDS["auto"] and sparse:
+            pass  # the library runs threads (OpenCL does dense rows only)
         elif opts.backend in (_lib.BACKENDS["auto"], _lib.BACKENDS["opencl"]):
             opts.opencl = _shared_opencl_context()
 
