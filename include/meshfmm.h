@@ -185,8 +185,11 @@ typedef enum mfmm_cost_location {
 
 typedef struct mfmm_solver mfmm_solver;
 
-/* A reusable workspace (heap, labels) for one mesh and one thread: about
- * 20 bytes per vertex. Solving allocates nothing. */
+/* A reusable workspace (heap, labels, a touched list) for one mesh and one
+ * thread: about 40 bytes per vertex. Solving allocates nothing. Between
+ * solves the workspace is kept clean by resetting only the vertices the
+ * last march reached, so a local solve (max_distance, targets) costs in
+ * proportion to what it reaches, apart from filling `distances`. */
 MFMM_API mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out);
 
 /* Frees a solver; NULL is a no-op. */
