@@ -82,6 +82,17 @@ def main() -> None:
                         "speedup_per_row": per_full / per_land,
                         "settled_per_row_landmarks": settled_land / n_land,
                         "settled_per_row_full": settled_full / n_full}
+    # landmarks in one region (the n_land vertices nearest to one point): rows stop early
+    V = mesh.vertices
+    near = np.argsort(np.linalg.norm(V - V[land[0]], axis=1))[:n_land].astype(np.int32)
+    _, t_near = timed(lambda: mesh.distance_matrix(near, targets=near, backend="threads",
+                                                   n_threads=a.threads))
+    settled_near = mesh.vertices_settled
+    res["landmarks"].update({"clustered_seconds_per_row": t_near / n_land,
+                             "clustered_speedup_per_row": per_full / (t_near / n_land),
+                             "settled_per_row_clustered": settled_near / n_land})
+    print(f"clustered landmarks {n_land}x{n_land}: {t_near/n_land*1e3:.3f} ms/row: "
+          f"{per_full/(t_near/n_land):.1f}x (settled {settled_near/n_land:.0f} per row)", flush=True)
     print(f"landmarks {n_land}x{n_land} on nv={mesh.n_vertices}: {per_land*1e3:.2f} ms/row vs "
           f"full {per_full*1e3:.2f} ms/row: {per_full/per_land:.2f}x "
           f"(settled {settled_land/n_land:.0f} vs {settled_full/n_full:.0f} per row)", flush=True)

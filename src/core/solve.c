@@ -207,6 +207,14 @@ mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources, int32_t 
  * own T back to +inf): the cost of a reset is the previous row's reach. */
 static void solver_reset_pending(mfmm_solver *solver)
 {
+    int32_t nv = solver->mesh->nv;
+    if (solver->n_pending >= nv / 8) { /* most of the mesh: sequential is cheaper */
+        for (int32_t v = 0; v < nv; v++)
+            solver->T[v] = INFINITY;
+        memset(solver->label, MFMM_FAR, (size_t)nv);
+        solver->n_pending = 0;
+        return;
+    }
     for (int32_t i = 0; i < solver->n_pending; i++) {
         int32_t v = solver->touched[i];
         solver->T[v] = INFINITY;
@@ -282,8 +290,11 @@ int32_t mfmm_solve_checked(mfmm_solver *solver, const mfmm_source *sources, int3
         distances[v] = INFINITY;
     int32_t settled = solver_march(solver, sources, n_sources, options, distances);
     /* the row was the caller's: only the labels need resetting */
-    for (int32_t i = 0; i < solver->n_pending; i++)
-        solver->label[solver->touched[i]] = MFMM_FAR;
+    if (solver->n_pending >= nv / 8)
+        memset(solver->label, MFMM_FAR, (size_t)nv);
+    else
+        for (int32_t i = 0; i < solver->n_pending; i++)
+            solver->label[solver->touched[i]] = MFMM_FAR;
     solver->n_pending = 0;
     return settled;
 }
