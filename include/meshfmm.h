@@ -186,8 +186,11 @@ typedef enum mfmm_cost_location {
 
 typedef struct mfmm_solver mfmm_solver;
 
-/* A reusable workspace (heap, labels) for one mesh and one thread: about
- * 20 bytes per vertex. Solving allocates nothing. */
+/* A reusable workspace (heap, labels, a touched list) for one mesh and one
+ * thread: about 40 bytes per vertex. Solving allocates nothing. Between
+ * solves the workspace is kept clean by resetting only the vertices the
+ * last march reached, so a local solve (max_distance, targets) costs in
+ * proportion to what it reaches, apart from filling `distances`. */
 MFMM_API mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out);
 
 /* Frees a solver; NULL is a no-op. */
@@ -433,11 +436,21 @@ typedef enum mfmm_dtype {
 } mfmm_dtype;
 
 /* Receives finished rows: rows [first_row, first_row + n_rows) of the matrix,
- * n_rows x nv values of the requested dtype, row-major, valid during the
- * call. Rows arrive in order. Return 0 to go on, non-zero to cancel
+ * n_rows x nv values (n_targets with targets) of the requested dtype,
+ * row-major, valid during the call. Rows arrive in order. Return 0 to go on, non-zero to cancel
  * (mfmm_distance_matrix then returns MFMM_ERR_CANCELLED). */
 typedef int (*mfmm_rows_callback)(void *user, int32_t first_row, int32_t n_rows,
                                   const void *rows);
+
+/* Receives finished rows as a CSR block (sparse output, see
+ * mfmm_matrix_options.on_sparse): rows [first_row, first_row + n_rows);
+ * row i's entries are indices[indptr[i] .. indptr[i+1]) (column ids,
+ * ascending) with values[same range] of the requested dtype. indptr has
+ * n_rows + 1 entries and starts at 0 for each block. Valid during the call;
+ * rows arrive in order. Return 0 to go on, non-zero to cancel. */
+typedef int (*mfmm_sparse_callback)(void *user, int32_t first_row, int32_t n_rows,
+                                    const int64_t *indptr, const int32_t *indices,
+                                    const void *values);
 
 typedef struct mfmm_matrix_options {
     size_t struct_size;              /* sizeof(mfmm_matrix_options), set by the _init function */
@@ -450,7 +463,8 @@ typedef struct mfmm_matrix_options {
     int32_t n_threads;               /* threads backend; 0: all cores */
     size_t memory_limit;             /* bytes the library may use for workspaces and
                                         blocks in flight; 0: a default from the device */
-    void *out;                       /* n_sources x nv buffer of dtype to fill, or NULL */
+    void *out;                       /* n_sources x nv (n_targets with targets) buffer of
+                                        dtype to fill, or NULL */
     mfmm_rows_callback on_rows;      /* called with each finished block, or NULL */
     void *user;                      /* passed to on_rows */
     mfmm_backend backend_used;       /* out: the backend that ran */
@@ -461,12 +475,33 @@ typedef struct mfmm_matrix_options {
     char fallback_reason[256];       /* out: with backend AUTO, why threads ran instead of
                                         OpenCL (the OpenCL error, or that OpenCL could not
                                         keep every core busy); "" when OpenCL ran */
+    /* Rectangular and sparse jobs (appended fields). */
+    const int32_t *targets;          /* NULL: every vertex is a column (rows nv wide).
+                                        Else n_targets >= 1 vertex ids: rows are n_targets
+                                        wide, column j the distance to targets[j] (any
+                                        order, duplicates allowed), and each row's march
+                                        stops once all its targets are settled */
+    int32_t n_targets;
+    int64_t vertices_settled;        /* out: vertices settled over all rows by the serial and
+                                        threads backends (the work done); 0 from OpenCL */
+    /* Sparse output: rows go to on_sparse as CSR blocks holding only the
+     * finite entries (distance <= max_distance; the source's own 0 is an
+     * explicit entry), built from each march's touched list, so memory and
+     * time follow the entries, never n_sources x nv. out and on_rows must be
+     * NULL. Serial and threads backends; OPENCL fails with
+     * MFMM_ERR_BAD_ARGUMENT, AUTO runs threads. */
+    mfmm_sparse_callback on_sparse;
 } mfmm_matrix_options;
 
 MFMM_API void mfmm_matrix_options_init(mfmm_matrix_options *options);
 
 /* One row per source: row i holds the distances from vertex sources[i] to
- * every vertex (equal to mfmm_solve's). sources NULL: all vertices, in order
+ * every vertex (equal to mfmm_solve's), or to options->targets (an
+ * n_sources x n_targets matrix, see mfmm_matrix_options.targets; on every
+ * backend, OpenCL's kernel marching each row to its targets too), densely
+ * (out, on_rows: n_sources x width values, width = n_targets or nv) or
+ * sparsely (on_sparse; not on OpenCL: OPENCL fails with
+ * MFMM_ERR_BAD_ARGUMENT and AUTO runs threads, fallback_reason says so). sources NULL: all vertices, in order
  * (n_sources must then be nv). Rows go to options->out, to options->on_rows,
  * or both; the library holds only the blocks in flight, never n_sources x nv.
  * With backend AUTO, threads run instead of OpenCL when OpenCL fails (from the

@@ -1,7 +1,9 @@
 /*
  * Many sources at once: one work-item runs one source's full heap march
  * (src/march.h, the serial core's own code) and writes that source's row.
- * Per-item workspaces are item-contiguous slices of nv entries.
+ * Per-item workspaces are item-contiguous slices of nv entries. With
+ * targets (n_targets > 0) a row marches until its targets settle (the
+ * serial solver's early stop, the same flags) and writes only their columns.
  *
  * Built without -cl-mad-enable / -cl-fast-relaxed-math; local_update.h sets
  * FP_CONTRACT OFF, so rows equal the C core's bit for bit in float64.
@@ -17,7 +19,8 @@ inline void mfmm_row_march(int nv, __global const int *update_offset,
                            int source, __global double *T_row, __global uchar *label,
                            __global double *heap_key, __global int *heap_vertex,
                            __global int *heap_pos, __global const int *strip,
-                           __global const double *uniform)
+                           __global const double *uniform,
+                           __global const int *targets, int n_targets)
 {
     mfmm_march_mesh m;
     m.nv = nv;
@@ -38,12 +41,22 @@ inline void mfmm_row_march(int nv, __global const int *update_offset,
     s.unfolding = unfolding;
     s.targets_left = 0;
     s.uniform = uniform;
+    s.touched = 0; /* no list: the per-item workspace resets all nv */
+    s.n_touched = 0;
     mfmm_march_reset(&s, nv);
+    for (int j = 0; j < n_targets; j++) { /* as mfmm_solve: flags, then seeds */
+        int t = targets[j];
+        if (!(label[t] & MFMM_TARGET)) {
+            label[t] = (uchar)(label[t] | MFMM_TARGET);
+            s.targets_left++;
+        }
+    }
     mfmm_march_seed(&s, source, 0.0);
     mfmm_march_run(&s, &m);
 }
 
-/* float64 rows: the output row is the march's T. */
+/* float64 rows: the output row is the march's T (with targets: T in
+ * T_ws, the target columns copied out). */
 __kernel void fmm_rows_f64(int nv, __global const int *update_offset,
                            __global const int *update_corner,
                            __global const mfmm_corner *corners, __global const double *cost,
@@ -51,15 +64,22 @@ __kernel void fmm_rows_f64(int nv, __global const int *update_offset,
                            __global const int *sources, int first, int count,
                            __global uchar *label_ws, __global double *key_ws,
                            __global int *vert_ws, __global int *pos_ws, __global double *out,
-                           __global const int *strip, __global const double *uniform)
+                           __global const int *strip, __global const double *uniform,
+                           __global const int *targets, int n_targets, __global double *T_ws)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
         return;
     ulong o = (ulong)i * (ulong)nv;
+    __global double *T = n_targets > 0 ? T_ws + o : out + o;
     mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
-                   max_distance, unfolding, sources[first + i], out + o, label_ws + o,
-                   key_ws + o, vert_ws + o, pos_ws + o, strip, uniform);
+                   max_distance, unfolding, sources[first + i], T, label_ws + o,
+                   key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets);
+    if (n_targets > 0) {
+        __global double *row = out + (ulong)i * (ulong)n_targets;
+        for (int j = 0; j < n_targets; j++)
+            row[j] = T[targets[j]];
+    }
 }
 
 /* float32 rows: T in a workspace slice, converted (round to nearest). */
@@ -71,7 +91,8 @@ __kernel void fmm_rows_f32(int nv, __global const int *update_offset,
                            __global uchar *label_ws, __global double *key_ws,
                            __global int *vert_ws, __global int *pos_ws,
                            __global double *T_ws, __global float *out,
-                           __global const int *strip, __global const double *uniform)
+                           __global const int *strip, __global const double *uniform,
+                           __global const int *targets, int n_targets, __global double *unused)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
@@ -80,7 +101,14 @@ __kernel void fmm_rows_f32(int nv, __global const int *update_offset,
     __global double *T = T_ws + o;
     mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
-                   key_ws + o, vert_ws + o, pos_ws + o, strip, uniform);
+                   key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets);
+    (void)unused;
+    if (n_targets > 0) {
+        __global float *row = out + (ulong)i * (ulong)n_targets;
+        for (int j = 0; j < n_targets; j++)
+            row[j] = (float)T[targets[j]];
+        return;
+    }
     __global float *row = out + o;
     for (int v = 0; v < nv; v++)
         row[v] = (float)T[v];

@@ -50,7 +50,7 @@ enum {
     OPT_SOURCE = 256, OPT_FACE_SOURCE, OPT_COST, OPT_COST_PER_FACE, OPT_MAX_DISTANCE,
     OPT_NO_UNFOLDING, OPT_EXACT, OPT_TARGET, OPT_TARGET_FACE, OPT_MAX_POINTS, OPT_NO_STRAIGHTEN,
     OPT_JSON, OPT_MAX_UNFOLD_STEPS, OPT_STRETCH, OPT_RADII, OPT_DTYPE, OPT_BACKEND,
-    OPT_SOURCES, OPT_THREADS, OPT_MEMORY
+    OPT_SOURCES, OPT_THREADS, OPT_MEMORY, OPT_TARGETS
 };
 /* Prints the usage error for getopt_long's '?' or ':' (opterr is 0; the
  * optstring starts with ':'); returns CLI_USAGE. */
@@ -183,6 +183,29 @@ int cli_npy_append(cli_npy_writer *w, const void *data, int64_t n_rows);
 int cli_npy_close(cli_npy_writer *w);
 /* Closes and removes the temporary file; safe after a failed open. */
 void cli_npy_abort(cli_npy_writer *w);
+
+/* ---- .npz files: a scipy.sparse CSR matrix (npz.c) ---- */
+
+/* Streaming writer: rows go to unlinked temporary files beside the output,
+ * the zip (scipy.sparse.save_npz's members, zip64, stored) is written by
+ * cli_npz_close through a cli_output. Errors are printed. */
+typedef struct cli_npz_writer {
+    char *path;
+    FILE *data, *indices; /* values and column ids so far */
+    int64_t *indptr;      /* rows + 1 row pointers */
+    int64_t rows, cols, rows_written, nnz;
+    size_t itemsize;      /* 4 or 8 */
+} cli_npz_writer;
+
+/* f64: float64 values, else float32. 0 or -1. */
+int cli_npz_open(cli_npz_writer *w, const char *path, int f64, int64_t rows, int64_t cols);
+/* Appends a CSR block of n_rows rows (indptr from 0, as the library gives). */
+int cli_npz_append(cli_npz_writer *w, int32_t n_rows, const int64_t *indptr,
+                   const int32_t *indices, const void *values);
+/* Writes the .npz (temporary, then renamed) and frees the writer. 0 or -1. */
+int cli_npz_close(cli_npz_writer *w);
+/* Frees the writer; the temporary files vanish (they are unlinked). */
+void cli_npz_abort(cli_npz_writer *w);
 
 /* Readers of regular files (refusing FIFOs, devices, directories), over
  * in-memory parsers that the fuzzers call. `name` labels messages. */

@@ -1,5 +1,7 @@
 /* meshfmm allpairs MESH -o OUT.npy: the distance matrix, streamed in blocks
- * of rows into a .npy file (a temporary file beside it, renamed when complete). */
+ * of rows into a .npy file (a temporary file beside it, renamed when
+ * complete); -o OUT.npz with --max-distance: the sparse local matrix as a
+ * scipy .npz; --targets: only those columns. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,20 +14,27 @@
 static void help(FILE *out)
 {
     fprintf(out,
-            "usage: meshfmm allpairs MESH -o OUT.npy [--dtype float32|float64]\n"
+            "usage: meshfmm allpairs MESH -o OUT.npy|OUT.npz [--dtype float32|float64]\n"
             "                        [--backend auto|opencl|serial|threads] [--sources FILE]\n"
+            "                        [--targets FILE]\n"
             "                        [--cost FILE [--cost-per-face]] [--max-distance X]\n"
             "                        [--threads N] [--memory MB] [--quiet]\n\n"
             "The geodesic distance matrix: one row per source (default every vertex), one\n"
             "column per vertex, streamed into a .npy file block by block (the matrix is\n"
             "never held in memory). The file appears under its name only when complete.\n\n"
-            "  -o, --output OUT.npy  output; written to a temporary file beside it, then\n"
-            "                      renamed (it may not be one of the inputs)\n"
+            "  -o, --output OUT    output; written to a temporary file beside it, then\n"
+            "                      renamed (it may not be one of the inputs). OUT.npy: the\n"
+            "                      dense matrix; OUT.npz (needs --max-distance): the sparse\n"
+            "                      matrix of the pairs within it, scipy.sparse.load_npz's\n"
+            "                      CSR format (explicit zeros on the diagonal); memory\n"
+            "                      follows the entries, never rows x columns\n"
             "  --dtype T           float32 (default) or float64; arithmetic is float64\n"
             "  --backend B         auto (default: OpenCL if a device works, else threads),\n"
             "                      opencl, serial (one thread) or threads\n"
             "  --sources FILE      source vertex ids: .txt (whitespace separated) or .npy\n"
             "                      (1-D integer array)\n"
+            "  --targets FILE      target vertex ids (same formats): columns in this order,\n"
+            "                      each row stops once its targets are settled (landmarks)\n"
             "  --cost FILE         slowness F (.npy float64/float32 or .txt), one value per\n"
             "                      vertex (default) or per face (--cost-per-face), as in\n"
             "                      meshfmm distance\n"
@@ -88,6 +97,7 @@ static int read_sources(const char *path, int32_t **ids, int64_t *n)
 
 typedef struct run_state {
     cli_npy_writer w;
+    cli_npz_writer z;
     int32_t total;
     int32_t done;
     int write_failed;
@@ -109,6 +119,21 @@ static void progress(run_state *s, int final)
     if (s->tty && final)
         fputc('\n', stderr);
     fflush(stderr);
+}
+
+static int on_sparse(void *user, int32_t first, int32_t n, const int64_t *indptr,
+                     const int32_t *indices, const void *values)
+{
+    run_state *s = user;
+    if (cli_interrupted())
+        return 1;
+    if (cli_npz_append(&s->z, n, indptr, indices, values)) {
+        s->write_failed = 1;
+        return 1;
+    }
+    s->done = first + n;
+    progress(s, 0);
+    return cli_interrupted() ? 1 : 0;
 }
 
 static int on_rows(void *user, int32_t first, int32_t n, const void *rows)
@@ -158,7 +183,8 @@ static int load_cost(const char *path, int per_face, const mfmm_mesh *mesh, doub
 
 int cmd_allpairs(int argc, char **argv)
 {
-    const char *path = NULL, *out_path = NULL, *sources_path = NULL, *cost_path = NULL;
+    const char *path = NULL, *out_path = NULL, *sources_path = NULL, *cost_path = NULL,
+               *targets_path = NULL;
     int cost_per_face = 0;
     mfmm_matrix_options o;
     mfmm_matrix_options_init(&o);
@@ -171,6 +197,7 @@ int cmd_allpairs(int argc, char **argv)
         {"dtype", required_argument, NULL, OPT_DTYPE},
         {"backend", required_argument, NULL, OPT_BACKEND},
         {"sources", required_argument, NULL, OPT_SOURCES},
+        {"targets", required_argument, NULL, OPT_TARGETS},
         {"cost", required_argument, NULL, OPT_COST},
         {"cost-per-face", no_argument, NULL, OPT_COST_PER_FACE},
         {"max-distance", required_argument, NULL, OPT_MAX_DISTANCE},
@@ -206,6 +233,9 @@ int cmd_allpairs(int argc, char **argv)
         case OPT_SOURCES:
             sources_path = val;
             break;
+        case OPT_TARGETS:
+            targets_path = val;
+            break;
         case OPT_COST:
             cost_path = val;
             break;
@@ -240,18 +270,25 @@ int cmd_allpairs(int argc, char **argv)
         return cli_usage_error("allpairs", "no mesh file given");
     if (!out_path)
         return cli_usage_error("allpairs", "no output given (-o OUT.npy)");
-    if (!cli_has_ext(out_path, "npy"))
-        return cli_usage_error("allpairs", "the output must end in .npy");
+    int sparse = cli_has_ext(out_path, "npz");
+    if (!cli_has_ext(out_path, "npy") && !sparse)
+        return cli_usage_error("allpairs", "the output must end in .npy (dense) or .npz (sparse, "
+                               "with --max-distance); for .zarr use the command installed by "
+                               "pip (python -m meshfmm allpairs)");
+    if (sparse && !(o.max_distance < INFINITY))
+        return cli_usage_error("allpairs", "a sparse .npz output needs --max-distance R (the "
+                               "pairs within R); without it the matrix is dense: use .npy");
     if (cost_per_face && !cost_path)
         return cli_usage_error("allpairs", "--cost-per-face needs --cost");
-    const char *inputs[3] = {path, sources_path, cost_path};
-    if (cli_check_output_not_input("allpairs", out_path, inputs, 3) != CLI_OK)
+    const char *inputs[4] = {path, sources_path, cost_path, targets_path};
+    if (cli_check_output_not_input("allpairs", out_path, inputs, 4) != CLI_OK)
         return CLI_USAGE;
 
     int rc = CLI_FAIL;
-    int32_t *src = NULL;
+    int32_t *src = NULL, *tgt = NULL;
     double *cost = NULL;
-    int64_t n_src = 0;
+    int64_t n_src = 0, n_tgt = 0;
+    int z_open = 0;
     run_state s;
     memset(&s, 0, sizeof s);
     cli_signals_install();
@@ -289,14 +326,41 @@ int cmd_allpairs(int argc, char **argv)
             src[i] = i;
     }
 
-    if (cli_interrupted() ||
-        cli_npy_open(&s.w, out_path, o.dtype == MFMM_FLOAT64 ? "<f8" : "<f4", n_src, nv))
+    if (targets_path) {
+        if (read_sources(targets_path, &tgt, &n_tgt))
+            goto done;
+        if (n_tgt == 0 || n_tgt > INT32_MAX) {
+            cli_error("%s: %s", targets_path, n_tgt ? "too many targets" : "no targets");
+            goto done;
+        }
+        for (int64_t i = 0; i < n_tgt; i++)
+            if (tgt[i] < 0 || tgt[i] >= nv) {
+                cli_error("%s: target %lld is vertex %ld, outside [0, %ld)", targets_path,
+                          (long long)i, (long)tgt[i], (long)nv);
+                goto done;
+            }
+        o.targets = tgt;
+        o.n_targets = (int32_t)n_tgt;
+    }
+    int64_t n_cols = tgt ? n_tgt : nv;
+    if (cli_interrupted())
         goto done;
+    if (sparse) {
+        if (cli_npz_open(&s.z, out_path, o.dtype == MFMM_FLOAT64, n_src, n_cols))
+            goto done;
+        z_open = 1;
+    } else if (cli_npy_open(&s.w, out_path, o.dtype == MFMM_FLOAT64 ? "<f8" : "<f4", n_src,
+                            n_cols)) {
+        goto done;
+    }
     s.total = (int32_t)n_src;
     s.quiet = quiet;
     s.tty = isatty(2);
     s.t0 = s.last = now();
-    o.on_rows = on_rows;
+    if (sparse)
+        o.on_sparse = on_sparse;
+    else
+        o.on_rows = on_rows;
     o.user = &s;
     o.backend = backend;
     mfmm_error err;
@@ -304,11 +368,15 @@ int cmd_allpairs(int argc, char **argv)
      * delivered) when OpenCL fails or cannot keep every core busy */
     mfmm_status st = mfmm_distance_matrix(mesh, src, (int32_t)n_src, &o, &err);
     mfmm_backend used = o.backend_used;
-    if (o.fallback_reason[0])
+    if (o.fallback_reason[0] && !tgt && !sparse)
         fprintf(stderr, "meshfmm allpairs: OpenCL not used (%s); falling back to threads\n",
                 o.fallback_reason);
     if (cli_interrupted()) {
-        cli_npy_abort(&s.w);
+        if (sparse)
+            cli_npz_abort(&s.z);
+        else
+            cli_npy_abort(&s.w);
+        z_open = 0;
         if (!quiet && s.tty)
             fputc('\n', stderr);
         fprintf(stderr, "meshfmm allpairs: interrupted after %d of %d rows; removed the "
@@ -319,24 +387,32 @@ int cmd_allpairs(int argc, char **argv)
     if (st != MFMM_OK) {
         if (!s.write_failed)
             cli_error("%s", err.message);
-        cli_npy_abort(&s.w);
+        if (sparse)
+            cli_npz_abort(&s.z);
+        else
+            cli_npy_abort(&s.w);
+        z_open = 0;
         goto done;
     }
     if (s.tty)
         progress(&s, 1); /* completes the \r line; the summary says the rest */
-    if (cli_npy_close(&s.w)) {
+    z_open = 0;
+    if (sparse ? cli_npz_close(&s.z) : cli_npy_close(&s.w)) {
         if (cli_interrupted())
             rc = CLI_EXIT_INTERRUPTED;
         goto done;
     }
-    fprintf(stderr, "meshfmm allpairs: %lld x %d %s matrix, backend %s, %.2f s, wrote %s\n",
-            (long long)n_src, (int)nv, o.dtype == MFMM_FLOAT64 ? "float64" : "float32",
+    fprintf(stderr, "meshfmm allpairs: %lld x %lld %s%s matrix, backend %s, %.2f s, wrote %s\n",
+            (long long)n_src, (long long)n_cols, sparse ? "sparse " : "", o.dtype == MFMM_FLOAT64 ? "float64" : "float32",
             mfmm_backend_name(used), now() - s.t0, out_path);
     rc = CLI_OK;
 done:
     if (rc == CLI_FAIL && cli_interrupted())
         rc = CLI_EXIT_INTERRUPTED;
+    if (z_open)
+        cli_npz_abort(&s.z);
     free(src);
+    free(tgt);
     free(cost);
     mfmm_mesh_destroy(mesh);
     return rc;

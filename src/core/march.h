@@ -41,6 +41,14 @@ typedef struct mfmm_march_state {
     /* with a cost and unfolding: per vertex, the cost all around it, or -1
      * (mfmm_uniform_cost); read by mfmm_march_virt_ok */
     MFMM_GLOBAL const double *uniform;
+    /* Optional touched list: NULL, or room for nv ids that receives every
+     * vertex the march takes off Far, in that order (n_touched of them).
+     * With a list the march only needs T = +inf and labels Far at the
+     * vertices it touches (the caller resets those afterwards), so a row
+     * costs in proportion to what it reaches, not to nv; without one (the
+     * OpenCL kernel's per-item workspace) the final pass covers all nv. */
+    MFMM_GLOBAL mfmm_i32 *touched;
+    mfmm_i32 n_touched;
 } mfmm_march_state;
 
 /* ---- indexed d-ary min-heap with decrease-key: a node's 8 children are
@@ -120,6 +128,14 @@ MFMM_INLINE void mfmm_march_reset(mfmm_march_state *s, mfmm_i32 nv)
     }
     s->heap_size = 0;
     s->targets_left = 0;
+    s->n_touched = 0;
+}
+
+/* Vertex v leaves Far: remember it when the march keeps a touched list. */
+MFMM_INLINE void mfmm_march_touch(mfmm_march_state *s, mfmm_i32 v, mfmm_u8 st)
+{
+    if (st == MFMM_FAR && s->touched)
+        s->touched[s->n_touched++] = v;
 }
 
 /* Offers value to vertex v as an initial condition (a source). Sources start
@@ -131,6 +147,7 @@ MFMM_INLINE void mfmm_march_seed(mfmm_march_state *s, mfmm_i32 v, double value)
     if (value < s->T[v]) {
         s->T[v] = value;
         mfmm_heap_push_or_decrease(s, v, value, st == MFMM_CLOSE);
+        mfmm_march_touch(s, v, st);
         s->label[v] = (mfmm_u8)((s->label[v] & MFMM_TARGET) | MFMM_CLOSE);
     }
 }
@@ -170,7 +187,9 @@ MFMM_INLINE int mfmm_march_virt_ok(const mfmm_march_state *s, const mfmm_march_m
 /* Section 2's loop: settle the Close vertex of least T, recompute its
  * neighbours from settled values, until the heap is empty, T passes
  * max_distance, or every target is settled. Vertices not settled are set
- * to +inf. Returns the number of vertices settled. */
+ * to +inf and target flags cleared (with a touched list: only at the
+ * touched vertices; labels stay Close/Alive there for the caller to reset).
+ * Returns the number of vertices settled. */
 MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *m)
 {
     mfmm_i32 settled = 0;
@@ -216,9 +235,20 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
                     MFMM_PREFETCH(m->update_corner + 2 * m->update_offset[c]);
                 s->T[c] = t;
                 mfmm_heap_push_or_decrease(s, c, t, st == MFMM_CLOSE);
+                mfmm_march_touch(s, c, st);
                 s->label[c] = (mfmm_u8)((s->label[c] & MFMM_TARGET) | MFMM_CLOSE);
             }
         }
+    }
+    /* a list is worth it for a local march; past nv/8 touched vertices a
+     * sequential pass is cheaper than scattered ones (measured, bench_scale) */
+    if (s->touched && s->n_touched < m->nv / 8) {
+        for (mfmm_i32 i = 0; i < s->n_touched; i++) {
+            mfmm_i32 v = s->touched[i];
+            if ((s->label[v] & MFMM_STATE_MASK) != MFMM_ALIVE)
+                s->T[v] = MFMM_INF;
+        }
+        return settled;
     }
     for (mfmm_i32 v = 0; v < m->nv; v++) {
         if ((s->label[v] & MFMM_STATE_MASK) != MFMM_ALIVE)

@@ -13,8 +13,14 @@ struct mfmm_solver {
     double *heap_key;
     int32_t *heap_vertex;
     int32_t *heap_pos;
-    uint8_t *label;
+    uint8_t *label;  /* all Far between solves (but the pending touched list) */
     double *uniform; /* for the virtual stencils under a cost (march.h) */
+    double *T;       /* own T, +inf between solves (but the pending list) */
+    int32_t *touched;   /* the vertices the last march touched (march.h) */
+    int32_t n_pending;  /* touched vertices still to reset to Far / +inf */
+    /* a cost whose `uniform` is computed once for many solves (matrix jobs) */
+    const double *fixed_cost;
+    int fixed_location;
 };
 
 mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out)
@@ -34,9 +40,16 @@ mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out)
     s->heap_pos = malloc(n * sizeof *s->heap_pos);
     s->label = malloc(n * sizeof *s->label);
     s->uniform = malloc(n * sizeof *s->uniform);
-    if (!s->heap_key || !s->heap_vertex || !s->heap_pos || !s->label || !s->uniform) {
+    s->T = malloc(n * sizeof *s->T);
+    s->touched = malloc(n * sizeof *s->touched);
+    if (!s->heap_key || !s->heap_vertex || !s->heap_pos || !s->label || !s->uniform || !s->T ||
+        !s->touched) {
         mfmm_solver_destroy(s);
         return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    for (size_t v = 0; v < n; v++) {
+        s->T[v] = INFINITY;
+        s->label[v] = MFMM_FAR;
     }
     *out = s;
     return MFMM_OK;
@@ -51,6 +64,8 @@ void mfmm_solver_destroy(mfmm_solver *solver)
     free(solver->heap_pos);
     free(solver->label);
     free(solver->uniform);
+    free(solver->T);
+    free(solver->touched);
     free(solver);
 }
 
@@ -188,29 +203,67 @@ mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources, int32_t 
     return MFMM_OK;
 }
 
-void mfmm_solve_checked(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
-                        const mfmm_solve_options *options, double *distances)
+/* Puts the vertices the last march touched back to Far (and the solver's
+ * own T back to +inf): the cost of a reset is the previous row's reach. */
+static void solver_reset_pending(mfmm_solver *solver)
+{
+    int32_t nv = solver->mesh->nv;
+    if (solver->n_pending >= nv / 8) { /* most of the mesh: sequential is cheaper */
+        for (int32_t v = 0; v < nv; v++)
+            solver->T[v] = INFINITY;
+        memset(solver->label, MFMM_FAR, (size_t)nv);
+        solver->n_pending = 0;
+        return;
+    }
+    for (int32_t i = 0; i < solver->n_pending; i++) {
+        int32_t v = solver->touched[i];
+        solver->T[v] = INFINITY;
+        solver->label[v] = MFMM_FAR;
+    }
+    solver->n_pending = 0;
+}
+
+void mfmm_solver_fix_cost(mfmm_solver *solver, const double *cost, int cost_location)
+{
+    solver->fixed_cost = NULL;
+    if (cost && cost_location != MFMM_COST_NONE) {
+        mfmm_uniform_cost(solver->mesh, cost, cost_location, solver->uniform);
+        solver->fixed_cost = cost;
+        solver->fixed_location = cost_location;
+    }
+}
+
+/* One march into T (the caller's +inf-filled row, or the solver's own T);
+ * leaves the touched list pending. Returns the vertices settled. */
+static int32_t solver_march(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
+                            const mfmm_solve_options *options, double *T)
 {
     const mfmm_mesh *mesh = solver->mesh;
     mfmm_solve_options opt = *options;
     if (!opt.cost)
         opt.cost_location = MFMM_COST_NONE;
+    solver_reset_pending(solver);
     mfmm_march_state s;
-    s.T = distances;
+    memset(&s, 0, sizeof s);
+    s.T = T;
     s.label = solver->label;
     s.heap_key = solver->heap_key;
     s.heap_vertex = solver->heap_vertex;
     s.heap_pos = solver->heap_pos;
+    s.heap_size = 0;
     s.cost = opt.cost;
     s.cost_location = (int)opt.cost_location;
     s.max_distance = opt.max_distance;
     s.unfolding = opt.unfolding != 0;
     s.uniform = NULL;
+    s.touched = solver->touched;
+    s.n_touched = 0;
+    s.targets_left = 0;
     if (s.cost && s.unfolding) {
-        mfmm_uniform_cost(mesh, s.cost, s.cost_location, solver->uniform);
+        if (solver->fixed_cost != s.cost || solver->fixed_location != s.cost_location)
+            mfmm_uniform_cost(mesh, s.cost, s.cost_location, solver->uniform);
         s.uniform = solver->uniform;
     }
-    mfmm_march_reset(&s, mesh->nv);
     for (int32_t i = 0; i < opt.n_targets; i++) {
         uint8_t *l = s.label + opt.targets[i];
         if (!(*l & MFMM_TARGET)) {
@@ -221,5 +274,38 @@ void mfmm_solve_checked(mfmm_solver *solver, const mfmm_source *sources, int32_t
     for (int32_t i = 0; i < n_sources; i++)
         mfmm_seed_source(mesh, &s, sources + i);
     mfmm_march_mesh mm = mfmm_mesh_march_view(mesh);
-    mfmm_march_run(&s, &mm);
+    int32_t settled = mfmm_march_run(&s, &mm);
+    /* target flags on vertices never touched (touched ones: reset below) */
+    for (int32_t i = 0; i < opt.n_targets; i++)
+        s.label[opt.targets[i]] &= (uint8_t)MFMM_STATE_MASK;
+    solver->n_pending = s.n_touched;
+    return settled;
+}
+
+int32_t mfmm_solve_checked(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
+                           const mfmm_solve_options *options, double *distances)
+{
+    int32_t nv = solver->mesh->nv;
+    for (int32_t v = 0; v < nv; v++)
+        distances[v] = INFINITY;
+    int32_t settled = solver_march(solver, sources, n_sources, options, distances);
+    /* the row was the caller's: only the labels need resetting */
+    if (solver->n_pending >= nv / 8)
+        memset(solver->label, MFMM_FAR, (size_t)nv);
+    else
+        for (int32_t i = 0; i < solver->n_pending; i++)
+            solver->label[solver->touched[i]] = MFMM_FAR;
+    solver->n_pending = 0;
+    return settled;
+}
+
+int32_t mfmm_solve_local(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
+                         const mfmm_solve_options *options, const double **T,
+                         const int32_t **touched, int32_t *n_touched)
+{
+    int32_t settled = solver_march(solver, sources, n_sources, options, solver->T);
+    *T = solver->T;
+    *touched = solver->touched;
+    *n_touched = solver->n_pending;
+    return settled;
 }

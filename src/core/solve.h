@@ -17,8 +17,23 @@ mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int
 void mfmm_seed_source(const mfmm_mesh *mesh, mfmm_march_state *st, const mfmm_source *src);
 
 /* mfmm_solve without the checks, for callers that checked the arguments
- * once for many solves (the matrix backends). options must not be NULL. */
-void mfmm_solve_checked(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
-                        const mfmm_solve_options *options, double *distances);
+ * once for many solves (the matrix backends). options must not be NULL.
+ * Returns the number of vertices settled. */
+int32_t mfmm_solve_checked(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
+                           const mfmm_solve_options *options, double *distances);
+
+/* A checked solve that costs in proportion to the vertices it reaches: T
+ * stays in the solver's own (nv,) array, +inf except at the n_touched
+ * vertices of `touched` (every vertex the march took off Far; settled ones
+ * hold their T, the others +inf). Valid until the solver's next solve.
+ * Returns the number of vertices settled. */
+int32_t mfmm_solve_local(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
+                         const mfmm_solve_options *options, const double **T,
+                         const int32_t **touched, int32_t *n_touched);
+
+/* For many solves with one cost array that does not change: computes the
+ * virtual stencils' 'cost around each vertex' (march.h) once, instead of
+ * per solve. NULL cost: forget it. */
+void mfmm_solver_fix_cost(mfmm_solver *solver, const double *cost, int cost_location);
 
 #endif

@@ -47,7 +47,7 @@ void mfmm_matrix_options_init(mfmm_matrix_options *options)
 static int32_t cpu_block_rows(const mfmm_rows_job *job, int n_workers, int ring)
 {
     size_t nv = (size_t)job->mesh->nv;
-    size_t row_bytes = nv * job->elem_size;
+    size_t row_bytes = job->slot_bytes;
     size_t work = (size_t)n_workers * nv * 32; /* solver + a float64 row */
     size_t left = job->budget > work ? job->budget - work : 0;
     /* ring 0: rows go straight into the caller's buffer */
@@ -68,13 +68,33 @@ static void fill_solve_options(const mfmm_rows_job *job, mfmm_solve_options *so)
     so->cost_location = (mfmm_cost_location)job->cost_location;
     so->max_distance = job->opt->max_distance;
     so->unfolding = job->opt->unfolding != 0;
+    so->targets = job->targets;
+    so->n_targets = job->targets ? job->width : 0;
 }
 
-/* Solves row r into dst (elem_size per entry); tmp is an nv float64 row
- * for float32 output. The job was checked once, in mfmm_distance_matrix, so
- * rows skip mfmm_solve's checks (the cost array alone is nv or nf values). */
-static void solve_row(const mfmm_rows_job *job, mfmm_solver *solver,
-                      const mfmm_solve_options *so, int32_t r, void *dst, double *tmp)
+static int cmp_i32(const void *a, const void *b)
+{
+    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+    return (x > y) - (x < y);
+}
+
+static void put_value(const mfmm_rows_job *job, void *dst, size_t j, double t)
+{
+    if (job->elem_size == sizeof(double))
+        ((double *)dst)[j] = t;
+    else
+        ((float *)dst)[j] = (float)t;
+}
+
+/* Solves row r into dst: a dense row of job->width values of the job's
+ * dtype, or (sparse) an mfmm_sparse_row whose arrays it allocates; tmp is an
+ * nv float64 row for float32 full rows. The job was checked once, in
+ * mfmm_distance_matrix, so rows skip mfmm_solve's checks. Full dense rows
+ * march straight into the row; target columns and sparse rows read the
+ * solver's own T at the touched vertices only (cost ~ the row's reach).
+ * Returns the vertices settled, or -1 when out of memory. */
+static int64_t solve_row(const mfmm_rows_job *job, mfmm_solver *solver,
+                         const mfmm_solve_options *so, int32_t r, void *dst, double *tmp)
 {
     mfmm_source src;
     memset(&src, 0, sizeof src);
@@ -82,23 +102,83 @@ static void solve_row(const mfmm_rows_job *job, mfmm_solver *solver,
     src.face = -1;
     src.value = 0.0;
     int32_t nv = job->mesh->nv;
-    if (job->elem_size == sizeof(double)) {
-        mfmm_solve_checked(solver, &src, 1, so, (double *)dst);
-        return;
+    if (!job->targets && !job->sparse) {
+        if (job->elem_size == sizeof(double))
+            return mfmm_solve_checked(solver, &src, 1, so, (double *)dst);
+        int32_t settled = mfmm_solve_checked(solver, &src, 1, so, tmp);
+        float *f = (float *)dst;
+        for (int32_t v = 0; v < nv; v++)
+            f[v] = (float)tmp[v];
+        return settled;
     }
-    mfmm_solve_checked(solver, &src, 1, so, tmp);
-    float *f = (float *)dst;
-    for (int32_t v = 0; v < nv; v++)
-        f[v] = (float)tmp[v];
+    const double *T;
+    const int32_t *touched;
+    int32_t n_touched;
+    int32_t settled = mfmm_solve_local(solver, &src, 1, so, &T, &touched, &n_touched);
+    if (!job->sparse) {
+        for (int32_t j = 0; j < job->width; j++)
+            put_value(job, dst, (size_t)j, T[job->targets[j]]);
+        return settled;
+    }
+    mfmm_sparse_row *row = dst;
+    size_t cap = job->targets ? (size_t)job->width : (size_t)settled;
+    row->n = 0;
+    row->idx = malloc((cap ? cap : 1) * sizeof *row->idx);
+    row->val = malloc((cap ? cap : 1) * job->elem_size);
+    if (!row->idx || !row->val)
+        return -1;
+    int32_t n = 0;
+    if (job->targets) {
+        for (int32_t j = 0; j < job->width; j++)
+            if (T[job->targets[j]] < INFINITY)
+                row->idx[n++] = j;
+    } else {
+        for (int32_t i = 0; i < n_touched; i++)
+            if (T[touched[i]] < INFINITY)
+                row->idx[n++] = touched[i];
+        qsort(row->idx, (size_t)n, sizeof *row->idx, cmp_i32);
+    }
+    for (int32_t i = 0; i < n; i++)
+        put_value(job, row->val, (size_t)i,
+                  T[job->targets ? job->targets[row->idx[i]] : row->idx[i]]);
+    row->n = n;
+    return settled;
 }
 
 /* ---- serial: one solver, this thread ---- */
 
+/* Hands a finished block to the caller (dense or sparse). Returns non-zero
+ * to stop, with *st the failure. */
+static int deliver_block(const mfmm_rows_job *job, int32_t first, int32_t n, char *base,
+                         mfmm_status *st)
+{
+    *st = MFMM_OK;
+    if (job->sparse) {
+        int r = mfmm_rows_deliver_sparse(job, first, n, (mfmm_sparse_row *)(void *)base, st);
+        if (r && *st == MFMM_OK)
+            *st = MFMM_ERR_CANCELLED;
+        return r;
+    }
+    if (mfmm_rows_deliver(job, first, n, base)) {
+        *st = MFMM_ERR_CANCELLED;
+        return 1;
+    }
+    return 0;
+}
+
+static mfmm_status block_failed(mfmm_status st, int32_t first, mfmm_error *err)
+{
+    if (st == MFMM_ERR_CANCELLED)
+        return mfmm_fail(err, st, first, "cancelled by the row callback");
+    return mfmm_fail(err, st, first, "out of memory for the rows of a block from row %d",
+                     (int)first);
+}
+
 static mfmm_status run_serial(const mfmm_rows_job *job, int32_t start, mfmm_error *err)
 {
     int32_t nv = job->mesh->nv;
-    size_t row_bytes = (size_t)nv * job->elem_size;
-    int direct = job->opt->out != NULL;
+    size_t row_bytes = job->slot_bytes;
+    int direct = job->opt->out != NULL && !job->sparse;
     int32_t block = cpu_block_rows(job, 1, direct ? 0 : 1);
     mfmm_solver *solver = NULL;
     double *tmp = NULL;
@@ -106,10 +186,11 @@ static mfmm_status run_serial(const mfmm_rows_job *job, int32_t start, mfmm_erro
     mfmm_status st = mfmm_solver_create(job->mesh, &solver);
     if (st != MFMM_OK)
         return mfmm_fail(err, st, -1, "could not create a solver");
+    mfmm_solver_fix_cost(solver, job->cost, job->cost_location);
     if (job->elem_size != sizeof(double))
         tmp = malloc((size_t)nv * sizeof *tmp);
     if (!direct)
-        buf = malloc((size_t)block * row_bytes);
+        buf = calloc((size_t)block, row_bytes);
     if ((job->elem_size != sizeof(double) && !tmp) || (!direct && !buf)) {
         st = mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for a block of %d rows",
                        (int)block);
@@ -117,14 +198,23 @@ static mfmm_status run_serial(const mfmm_rows_job *job, int32_t start, mfmm_erro
     }
     mfmm_solve_options so;
     fill_solve_options(job, &so);
+    int64_t settled = 0;
     for (int32_t first = start; first < job->n_sources; first += block) {
         int32_t n = job->n_sources - first < block ? job->n_sources - first : block;
         char *base = direct ? (char *)job->opt->out + (size_t)first * row_bytes : buf;
         for (int32_t i = 0; i < n; i++) {
-            solve_row(job, solver, &so, first + i, base + (size_t)i * row_bytes, tmp);
+            int64_t k = solve_row(job, solver, &so, first + i, base + (size_t)i * row_bytes, tmp);
+            if (k < 0) {
+                mfmm_sparse_rows_free((mfmm_sparse_row *)(void *)base, i + 1);
+                st = block_failed(MFMM_ERR_OUT_OF_MEMORY, first + i, err);
+                goto done;
+            }
+            settled += k;
         }
-        if (mfmm_rows_deliver(job, first, n, base)) {
-            st = mfmm_fail(err, MFMM_ERR_CANCELLED, first, "cancelled by the row callback");
+        job->opt->vertices_settled = settled;
+        mfmm_status bst;
+        if (deliver_block(job, first, n, base, &bst)) {
+            st = block_failed(bst, first, err);
             goto done;
         }
     }
@@ -150,6 +240,7 @@ typedef struct pool {
     mfmm_status fail;
     mfmm_error fail_err;
     char *ring;               /* 2 blocks, or NULL when writing into out */
+    int64_t settled;          /* vertices settled so far */
 } pool;
 
 static int32_t block_len(const pool *p, int32_t b)
@@ -161,7 +252,7 @@ static int32_t block_len(const pool *p, int32_t b)
 
 static char *row_dest(const pool *p, int32_t r)
 {
-    size_t row_bytes = (size_t)p->job->mesh->nv * p->job->elem_size;
+    size_t row_bytes = p->job->slot_bytes;
     if (!p->ring)
         return (char *)p->job->opt->out + (size_t)r * row_bytes;
     int32_t b = (r - p->start) / p->block;
@@ -190,6 +281,8 @@ static void *pool_worker(void *arg)
     mfmm_solver *solver = NULL;
     double *tmp = NULL;
     mfmm_status st = mfmm_solver_create(job->mesh, &solver);
+    if (st == MFMM_OK)
+        mfmm_solver_fix_cost(solver, job->cost, job->cost_location);
     if (st == MFMM_OK && job->elem_size != sizeof(double)) {
         tmp = malloc((size_t)job->mesh->nv * sizeof *tmp);
         if (!tmp)
@@ -209,8 +302,13 @@ static void *pool_worker(void *arg)
         }
         p->next_row++;
         pthread_mutex_unlock(&p->mu);
-        solve_row(job, solver, &so, r, row_dest(p, r), tmp);
+        int64_t k = solve_row(job, solver, &so, r, row_dest(p, r), tmp);
         pthread_mutex_lock(&p->mu);
+        if (k < 0) {
+            pool_failed(p, MFMM_ERR_OUT_OF_MEMORY, NULL);
+            break;
+        }
+        p->settled += k;
         if (++p->done[b & 1] == block_len(p, b))
             pthread_cond_broadcast(&p->cv_main);
     }
@@ -242,10 +340,10 @@ static mfmm_status run_threads(const mfmm_rows_job *job, int32_t start, mfmm_err
     p.job = job;
     p.start = p.next_row = start;
     p.fail = MFMM_OK;
-    int use_ring = job->opt->out == NULL;
+    int use_ring = job->opt->out == NULL || job->sparse;
     p.block = cpu_block_rows(job, n_threads, use_ring ? 2 : 0);
     if (use_ring) {
-        p.ring = malloc(2 * (size_t)p.block * (size_t)job->mesh->nv * job->elem_size);
+        p.ring = calloc(2 * (size_t)p.block, job->slot_bytes);
         if (!p.ring)
             return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1,
                              "out of memory for two blocks of %d rows", (int)p.block);
@@ -291,10 +389,12 @@ static mfmm_status run_threads(const mfmm_rows_job *job, int32_t start, mfmm_err
             break;
         pthread_mutex_unlock(&p.mu);
         int32_t first = start + b * p.block;
-        int cancel = mfmm_rows_deliver(job, first, n, row_dest(&p, first));
+        job->opt->vertices_settled = p.settled;
+        mfmm_status bst;
+        int cancel = deliver_block(job, first, n, row_dest(&p, first), &bst);
         pthread_mutex_lock(&p.mu);
         if (cancel) {
-            st = mfmm_fail(err, MFMM_ERR_CANCELLED, first, "cancelled by the row callback");
+            st = block_failed(bst, first, err);
             p.stop = 1;
             pthread_cond_broadcast(&p.cv_worker);
             break;
@@ -306,6 +406,9 @@ static mfmm_status run_threads(const mfmm_rows_job *job, int32_t start, mfmm_err
     pthread_mutex_unlock(&p.mu);
     for (int i = 0; i < started; i++)
         pthread_join(tid[i], NULL);
+    job->opt->vertices_settled = p.settled;
+    if (p.ring && job->sparse) /* rows of blocks not delivered (a failure) */
+        mfmm_sparse_rows_free((mfmm_sparse_row *)(void *)p.ring, 2 * p.block);
     if (st == MFMM_OK && p.fail != MFMM_OK) {
         st = p.fail;
         if (err)
@@ -336,9 +439,21 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     o->backend_used = o->backend;
     o->fallback_reason[0] = '\0';
     int32_t nv = mesh->nv;
-    if (!o->out && !o->on_rows)
+    o->vertices_settled = 0;
+    if (!o->out && !o->on_rows && !o->on_sparse)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
-                         "options give neither an out buffer nor an on_rows callback");
+                         "options give neither an out buffer nor an on_rows or on_sparse callback");
+    if (o->on_sparse && (o->out || o->on_rows))
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "on_sparse (sparse rows) cannot be combined with out or on_rows (dense rows)");
+    if (o->n_targets < 0 || (o->n_targets > 0 && !o->targets) || (o->targets && o->n_targets < 1))
+        return mfmm_fail(err, MFMM_ERR_BAD_COUNT, o->n_targets,
+                         "n_targets is %ld but targets is %s (give both, n_targets >= 1, or neither)",
+                         (long)o->n_targets, o->targets ? "set" : "NULL");
+    if (o->on_sparse && o->backend == MFMM_BACKEND_OPENCL)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "the OpenCL backend computes dense rows only; use threads (or auto) "
+                         "for sparse rows");
     if ((int)o->backend < MFMM_BACKEND_AUTO || (int)o->backend > MFMM_BACKEND_OPENCL)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "unknown backend %d", (int)o->backend);
     if (o->dtype != MFMM_FLOAT32 && o->dtype != MFMM_FLOAT64)
@@ -376,6 +491,25 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
                              (int)i, (int)bad, (int)nv);
         }
     sources = own_sources;
+    int32_t *own_targets = NULL;
+    if (o->targets) {
+        own_targets = malloc((size_t)o->n_targets * sizeof *own_targets);
+        if (!own_targets) {
+            free(own_sources);
+            return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for %d target ids",
+                             (int)o->n_targets);
+        }
+        memcpy(own_targets, o->targets, (size_t)o->n_targets * sizeof *own_targets);
+        for (int32_t j = 0; j < o->n_targets; j++)
+            if (own_targets[j] < 0 || own_targets[j] >= nv) {
+                int32_t bad = own_targets[j];
+                free(own_sources);
+                free(own_targets);
+                return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, j,
+                                 "target %d is vertex %d, outside [0, %d)", (int)j, (int)bad,
+                                 (int)nv);
+            }
+    }
     int cost_location = o->cost ? (int)o->cost_location : 0;
     double *own_cost = NULL;
     if (o->cost && (o->cost_location == MFMM_COST_PER_VERTEX || o->cost_location == MFMM_COST_PER_FACE)) {
@@ -383,6 +517,7 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
         own_cost = malloc(n * sizeof *own_cost);
         if (!own_cost) {
             free(own_sources);
+            free(own_targets);
             return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the cost");
         }
         memcpy(own_cost, o->cost, n * sizeof *own_cost);
@@ -391,6 +526,7 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     mfmm_status cst = mfmm_check_cost(mesh, cost, o->cost_location, err);
     if (cst != MFMM_OK) {
         free(own_sources);
+        free(own_targets);
         free(own_cost);
         return cst;
     }
@@ -404,6 +540,10 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     job.cost_location = cost_location;
     job.elem_size = o->dtype == MFMM_FLOAT64 ? sizeof(double) : sizeof(float);
     job.budget = o->memory_limit ? o->memory_limit : MFMM_DEFAULT_BUDGET;
+    job.targets = own_targets;
+    job.width = own_targets ? o->n_targets : nv;
+    job.sparse = o->on_sparse != NULL;
+    job.slot_bytes = job.sparse ? sizeof(mfmm_sparse_row) : (size_t)job.width * job.elem_size;
 
     mfmm_status st;
     switch (o->backend) {
@@ -421,6 +561,13 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     default: { /* auto: OpenCL when it keeps every compute unit busy, else
                 * threads from the first row not delivered, saying why */
         int32_t done = 0;
+        if (job.sparse) {
+            o->backend_used = MFMM_BACKEND_THREADS;
+            snprintf(o->fallback_reason, sizeof o->fallback_reason,
+                     "the OpenCL backend computes dense rows only, not sparse rows");
+            st = run_threads(&job, 0, err);
+            break;
+        }
         mfmm_error cl_err;
         o->backend_used = MFMM_BACKEND_OPENCL;
         job.full_batches = 1;
@@ -439,6 +586,7 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     if (st == MFMM_OK)
         mfmm_ok(err);
     free(own_sources);
+    free(own_targets);
     free(own_cost);
     return st;
 }

@@ -659,19 +659,19 @@ const char *mfmm_opencl_context_device_name(const mfmm_opencl_context *context)
 
 /* ---- rows ---- */
 
-enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_LABEL, MB_KEY, MB_VERT,
+enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_LABEL, MB_KEY, MB_VERT,
        MB_POS, MB_T, MB_OUT, MB_COUNT };
 
 /* Bytes per work-item on the device (workspace and output row), and on the
  * host (two blocks when rows are not read straight into the caller's buffer). */
 static size_t item_bytes(const mfmm_rows_job *job, int direct)
 {
-    size_t nv = (size_t)job->mesh->nv;
-    size_t b = nv * (1 + 8 + 4 + 4) + nv * job->elem_size;
-    if (job->elem_size != sizeof(double))
-        b += nv * 8;
+    size_t nv = (size_t)job->mesh->nv, w = (size_t)job->width;
+    size_t b = nv * (1 + 8 + 4 + 4) + w * job->elem_size;
+    if (job->elem_size != sizeof(double) || job->targets)
+        b += nv * 8; /* T apart from the output row */
     if (!direct)
-        b += 2 * nv * job->elem_size;
+        b += 2 * w * job->elem_size;
     return b;
 }
 
@@ -745,8 +745,10 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     cl_event ev[2] = {NULL, NULL};
     cl_int e = CL_SUCCESS;
     size_t nv = (size_t)mesh->nv;
-    size_t row_bytes = nv * job->elem_size;
+    size_t row_bytes = (size_t)job->width * job->elem_size;
     double one = 1.0;
+    int32_t no_target = 0;
+    cl_int n_targets = job->targets ? (cl_int)job->width : 0;
 
     /* the mesh, read-only, used in place where the driver allows */
     cl_mem_flags ro = CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR;
@@ -785,6 +787,11 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     if (e == CL_SUCCESS)
         mem[MB_UNIFORM] = api->clCreateBuffer(cl.context, ro, (uniform ? nv : 1) * sizeof(double),
                                          uniform ? (void *)uniform : (void *)&one, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_TARGETS] = api->clCreateBuffer(cl.context, ro,
+                                              (job->targets ? (size_t)job->width : 1) * sizeof(int32_t),
+                                              job->targets ? (void *)job->targets : (void *)&no_target,
+                                              &e);
     if (e != CL_SUCCESS) {
         st = runtime_fail(err, "uploading the mesh", e);
         goto done;
@@ -809,7 +816,7 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
             mem[MB_VERT] = api->clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv * 4, NULL, &e);
         if (e == CL_SUCCESS)
             mem[MB_POS] = api->clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv * 4, NULL, &e);
-        if (e == CL_SUCCESS && !f64)
+        if (e == CL_SUCCESS && (!f64 || job->targets))
             mem[MB_T] = api->clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv * 8, NULL, &e);
         if (e == CL_SUCCESS)
             mem[MB_OUT] = api->clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * row_bytes, NULL, &e);
@@ -850,15 +857,24 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     e |= api->clSetKernelArg(cl.kernel, 12, sizeof(cl_mem), &mem[MB_KEY]);
     e |= api->clSetKernelArg(cl.kernel, 13, sizeof(cl_mem), &mem[MB_VERT]);
     e |= api->clSetKernelArg(cl.kernel, 14, sizeof(cl_mem), &mem[MB_POS]);
+    /* the float64 kernel's T workspace is used only with targets (else T is
+     * the output row): any buffer stands in for it */
+    cl_mem t_ws = mem[MB_T] ? mem[MB_T] : mem[MB_KEY];
     if (f64) {
         e |= api->clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_OUT]);
         e |= api->clSetKernelArg(cl.kernel, 16, sizeof(cl_mem), &mem[MB_STRIP]);
         e |= api->clSetKernelArg(cl.kernel, 17, sizeof(cl_mem), &mem[MB_UNIFORM]);
+        e |= api->clSetKernelArg(cl.kernel, 18, sizeof(cl_mem), &mem[MB_TARGETS]);
+        e |= api->clSetKernelArg(cl.kernel, 19, sizeof n_targets, &n_targets);
+        e |= api->clSetKernelArg(cl.kernel, 20, sizeof(cl_mem), &t_ws);
     } else {
         e |= api->clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_T]);
         e |= api->clSetKernelArg(cl.kernel, 16, sizeof(cl_mem), &mem[MB_OUT]);
         e |= api->clSetKernelArg(cl.kernel, 17, sizeof(cl_mem), &mem[MB_STRIP]);
         e |= api->clSetKernelArg(cl.kernel, 18, sizeof(cl_mem), &mem[MB_UNIFORM]);
+        e |= api->clSetKernelArg(cl.kernel, 19, sizeof(cl_mem), &mem[MB_TARGETS]);
+        e |= api->clSetKernelArg(cl.kernel, 20, sizeof n_targets, &n_targets);
+        e |= api->clSetKernelArg(cl.kernel, 21, sizeof(cl_mem), &t_ws);
     }
     if (e != CL_SUCCESS) {
         st = runtime_fail(err, "clSetKernelArg", e);
@@ -1009,6 +1025,8 @@ static mfmm_status self_test(ocl *cl, mfmm_error *err)
         job.opt = &o;
         job.elem_size = f64 ? sizeof(double) : sizeof(float);
         job.budget = MFMM_DEFAULT_BUDGET;
+        job.width = NV;
+        job.slot_bytes = (size_t)NV * job.elem_size;
         int32_t done = 0;
         st = run_rows(cl, &job, 0, &done, err);
         for (int i = 0; st == MFMM_OK && i < NV * NV; i++) {

@@ -142,6 +142,141 @@ static void test_all_vertices_costs_and_limit(void **state)
     mfmm_gen_free(&g);
 }
 
+/* A sparse collector: checks blocks in order, ascending columns, and each
+ * entry against the dense reference (float64 bit-equal, float32 its
+ * rounding); counts entries. */
+typedef struct sp_check {
+    const double *ref;
+    int32_t width, next;
+    size_t esz;
+    int64_t nnz;
+} sp_check;
+
+static int on_sparse(void *user, int32_t first, int32_t n, const int64_t *indptr,
+                     const int32_t *indices, const void *values)
+{
+    sp_check *c = user;
+    assert_int_equal(first, c->next);
+    assert_true(indptr[0] == 0);
+    for (int32_t i = 0; i < n; i++) {
+        const double *row = c->ref + (size_t)(first + i) * (size_t)c->width;
+        int32_t finite = 0;
+        for (int32_t j = 0; j < c->width; j++)
+            finite += row[j] < INFINITY;
+        assert_int_equal(indptr[i + 1] - indptr[i], finite);
+        for (int64_t k = indptr[i]; k < indptr[i + 1]; k++) {
+            if (k > indptr[i])
+                assert_true(indices[k] > indices[k - 1]);
+            double want = row[indices[k]];
+            if (c->esz == 8)
+                assert_true(((const double *)values)[k] == want);
+            else
+                assert_true(((const float *)values)[k] == (float)want);
+        }
+    }
+    c->nnz += indptr[n];
+    c->next += n;
+    return 0;
+}
+
+/* Target columns (S x T, any order, duplicates) equal the full rows'
+ * columns and settle fewer vertices; sparse rows equal the dense rows'
+ * finite entries (issue 11). Serial and threads, both dtypes. */
+static void test_targets_and_sparse(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh g = mfmm_gen_sine(20);
+    mfmm_mesh *mesh = tm_make(&g);
+    int32_t nv = g.nv;
+    int32_t targets[5] = {30, 2, 30, nv / 3, 11};
+    double limits[2] = {INFINITY, 0.3};
+    for (int li = 0; li < 2; li++) {
+        mfmm_solve_options so;
+        mfmm_solve_options_init(&so);
+        so.max_distance = limits[li];
+        double *ref = tm_reference_rows(mesh, some_sources, N_SOME, &so);
+        double *tref = malloc((size_t)N_SOME * 5 * sizeof *tref);
+        assert_non_null(tref);
+        for (int32_t i = 0; i < N_SOME; i++)
+            for (int j = 0; j < 5; j++)
+                tref[i * 5 + j] = ref[(size_t)i * (size_t)nv + (size_t)targets[j]];
+        for (int b = 0; b < 3; b++) {
+            mfmm_backend be = b == 0 ? MFMM_BACKEND_SERIAL : MFMM_BACKEND_THREADS;
+            for (int dt = 0; dt < 2; dt++) {
+                size_t esz = dt ? 8 : 4;
+                mfmm_matrix_options o;
+                mfmm_matrix_options_init(&o);
+                o.backend = be;
+                o.n_threads = b + 1;
+                o.dtype = dt ? MFMM_FLOAT64 : MFMM_FLOAT32;
+                o.max_distance = limits[li];
+                o.memory_limit = b == 2 ? 1 : 0; /* blocks of one row per thread */
+                /* full rows: the work */
+                double *full = malloc((size_t)N_SOME * (size_t)nv * esz);
+                assert_non_null(full);
+                o.out = full;
+                assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, NULL), MFMM_OK);
+                int64_t full_settled = o.vertices_settled;
+                assert_true(full_settled > 0);
+                free(full);
+                /* target columns */
+                char *out = malloc((size_t)N_SOME * 5 * esz);
+                assert_non_null(out);
+                o.out = out;
+                o.targets = targets;
+                o.n_targets = 5;
+                mfmm_error err;
+                if (mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &err) != MFMM_OK)
+                    fail_msg("%s", err.message);
+                if (dt)
+                    assert_memory_equal(out, tref, (size_t)N_SOME * 5 * 8);
+                else
+                    tm_assert_float32_of(out, tref, (size_t)N_SOME * 5);
+                if (li == 0)
+                    assert_true(o.vertices_settled < full_settled);
+                free(out);
+                /* sparse, full width and target columns */
+                for (int t = 0; t < 2; t++) {
+                    sp_check c = {t ? tref : ref, t ? 5 : nv, 0, esz, 0};
+                    o.out = NULL;
+                    o.targets = t ? targets : NULL;
+                    o.n_targets = t ? 5 : 0;
+                    o.on_sparse = on_sparse;
+                    o.user = &c;
+                    if (mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &err) != MFMM_OK)
+                        fail_msg("%s", err.message);
+                    assert_int_equal(c.next, N_SOME);
+                    assert_true(c.nnz >= N_SOME);
+                }
+                /* OpenCL refuses, auto runs threads */
+                o.backend = MFMM_BACKEND_OPENCL;
+                assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, NULL),
+                                 MFMM_ERR_BAD_ARGUMENT);
+                sp_check c = {tref, 5, 0, esz, 0};
+                o.user = &c;
+                o.backend = MFMM_BACKEND_AUTO;
+                assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, NULL), MFMM_OK);
+                assert_int_equal(o.backend_used, MFMM_BACKEND_THREADS);
+                assert_int_equal(c.next, N_SOME);
+            }
+        }
+        free(tref);
+        free(ref);
+    }
+    int32_t bad[1] = {nv};
+    mfmm_matrix_options o;
+    mfmm_matrix_options_init(&o);
+    double one[4];
+    o.out = one;
+    o.targets = bad;
+    o.n_targets = 1;
+    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, 1, &o, NULL), MFMM_ERR_BAD_ARGUMENT);
+    o.n_targets = 0;
+    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, 1, &o, NULL), MFMM_ERR_BAD_COUNT);
+    mfmm_mesh_destroy(mesh);
+    mfmm_gen_free(&g);
+}
+
 /* No OpenCL platform here: auto runs threads (same rows), opencl says why. */
 static void test_no_opencl_fallback(void **state)
 {
@@ -447,6 +582,7 @@ int main(void)
         cmocka_unit_test(test_bad_arguments),
         cmocka_unit_test(test_cpu_backends_equal_solve),
         cmocka_unit_test(test_all_vertices_costs_and_limit),
+        cmocka_unit_test(test_targets_and_sparse),
         cmocka_unit_test(test_no_opencl_fallback),
         cmocka_unit_test(test_cancel),
         cmocka_unit_test(test_no_opencl_loader),

@@ -535,6 +535,78 @@ static void test_batches_fill_compute_units(void **state)
 
 /* The device and cache folder through mfmm_opencl_options (they win over the
  * environment); a wrong struct_size is refused. */
+/* Target columns on OpenCL (the kernel marches to its targets and writes
+ * their columns) equal the serial backend's bit for bit (issue 11), with and
+ * without a cost, into out and by callback over many batches. Sparse rows
+ * are refused with a reason. */
+static void test_targets(void **state)
+{
+    (void)state;
+    if (have_device == 0)
+        skip();
+    mfmm_gen_mesh g = mfmm_gen_sine(24);
+    mfmm_mesh *mesh = tm_make(&g);
+    int32_t nv = g.nv, n = 30;
+    int32_t src[30];
+    for (int32_t i = 0; i < n; i++)
+        src[i] = (int32_t)(((int64_t)i * 7919) % nv);
+    int32_t tg[6] = {nv - 1, 3, 100, 3, nv / 2, 0};
+    double *vcost = malloc((size_t)nv * sizeof *vcost);
+    assert_non_null(vcost);
+    for (int32_t v = 0; v < nv; v++)
+        vcost[v] = 0.5 + 0.1 * (double)(v % 13);
+    for (int k = 0; k < 3; k++) {
+        for (int dt = 0; dt < 2; dt++) {
+            size_t esz = dt ? 8 : 4, bytes = (size_t)n * 6 * esz;
+            char *ref = malloc(bytes), *got = malloc(bytes);
+            assert_true(ref && got);
+            mfmm_matrix_options o;
+            mfmm_matrix_options_init(&o);
+            o.dtype = dt ? MFMM_FLOAT64 : MFMM_FLOAT32;
+            o.targets = tg;
+            o.n_targets = 6;
+            if (k == 1) {
+                o.cost = vcost;
+                o.cost_location = MFMM_COST_PER_VERTEX;
+            }
+            if (k == 2)
+                o.max_distance = 0.5;
+            o.backend = MFMM_BACKEND_SERIAL;
+            o.out = ref;
+            assert_int_equal(mfmm_distance_matrix(mesh, src, n, &o, NULL), MFMM_OK);
+            o.backend = MFMM_BACKEND_OPENCL;
+            tm_collect c = {got, 6 * esz, 0, 0, -1};
+            if (k == 0) {
+                o.out = NULL;
+                o.on_rows = tm_collect_rows;
+                o.user = &c;
+                o.memory_limit = (size_t)nv * 60 * 3;
+            } else {
+                o.out = got;
+            }
+            mfmm_error err;
+            mfmm_status st = mfmm_distance_matrix(mesh, src, n, &o, &err);
+            if (st == MFMM_ERR_NO_OPENCL) {
+                free(ref);
+                free(got);
+                free(vcost);
+                mfmm_mesh_destroy(mesh);
+                mfmm_gen_free(&g);
+                skip();
+            }
+            if (st != MFMM_OK)
+                fail_msg("opencl targets: %s", err.message);
+            assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL);
+            assert_memory_equal(got, ref, bytes);
+            free(ref);
+            free(got);
+        }
+    }
+    free(vcost);
+    mfmm_mesh_destroy(mesh);
+    mfmm_gen_free(&g);
+}
+
 static void test_opencl_options(void **state)
 {
     (void)state;
@@ -708,6 +780,7 @@ int main(void)
         cmocka_unit_test(test_device_selection_and_cancel),
         cmocka_unit_test(test_reused_context),
         cmocka_unit_test(test_batches_fill_compute_units),
+        cmocka_unit_test(test_targets),
         cmocka_unit_test(test_opencl_options),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);

@@ -235,6 +235,66 @@ static void test_early_stop(void **state)
     tm_fixture_free(&fx);
 }
 
+/* The solver resets only the vertices its last march touched (issue 11):
+ * a sequence of solves with different sources, limits, targets, costs,
+ * point sources and failing calls in between leaves every solve bit-equal
+ * to the same solve on a fresh solver. */
+static void test_reuse_equals_fresh(void **state)
+{
+    (void)state;
+    tm_fixture fx = tm_fixture_make(mfmm_gen_sine(30), 0);
+    int32_t nv = fx.g.nv, nf = fx.g.nf;
+    double *fresh = malloc((size_t)nv * sizeof *fresh);
+    double *vcost = malloc((size_t)nv * sizeof *vcost);
+    double *fcost = malloc((size_t)nf * sizeof *fcost);
+    assert_true(fresh && vcost && fcost);
+    for (int32_t v = 0; v < nv; v++)
+        vcost[v] = 1.0 + (v % 7) * 0.25;
+    for (int32_t f = 0; f < nf; f++)
+        fcost[f] = f % 3 ? 1.0 : 4.0;
+    int32_t targets[3] = {5, nv / 2, 5};
+    for (int k = 0; k < 24; k++) {
+        mfmm_solve_options opt;
+        mfmm_solve_options_init(&opt);
+        mfmm_source src[2] = {tm_vertex_source((k * 97) % nv), tm_vertex_source((k * 31 + 7) % nv)};
+        int32_t n_src = 1 + (k % 2);
+        if (k % 5 == 3) { /* a point in a face */
+            src[0].face = (k * 13) % nf;
+            src[0].bary[0] = 0.2;
+            src[0].bary[1] = 0.3;
+            src[0].bary[2] = 0.5;
+        }
+        if (k % 3 == 1)
+            opt.max_distance = 0.1 * (k % 4 + 1);
+        if (k % 4 == 2) {
+            opt.targets = targets;
+            opt.n_targets = 3;
+        }
+        if (k % 6 == 4) {
+            opt.cost = vcost;
+            opt.cost_location = MFMM_COST_PER_VERTEX;
+        } else if (k % 6 == 5) {
+            opt.cost = fcost;
+            opt.cost_location = MFMM_COST_PER_FACE;
+        }
+        opt.unfolding = k % 7 != 6;
+        assert_int_equal(mfmm_solve(fx.solver, src, n_src, &opt, fx.d, NULL), MFMM_OK);
+        mfmm_solver *s2 = NULL;
+        assert_int_equal(mfmm_solver_create(fx.mesh, &s2), MFMM_OK);
+        assert_int_equal(mfmm_solve(s2, src, n_src, &opt, fresh, NULL), MFMM_OK);
+        mfmm_solver_destroy(s2);
+        assert_memory_equal(fx.d, fresh, (size_t)nv * sizeof *fresh);
+        /* a refused solve in between changes nothing */
+        opt.max_distance = -1.0;
+        assert_int_equal(mfmm_solve(fx.solver, src, n_src, &opt, fx.d, NULL),
+                         MFMM_ERR_BAD_ARGUMENT);
+    }
+    free(fresh);
+    free(vcost);
+    free(fcost);
+    tm_fixture_free(&fx);
+}
+
 /* Distances scale with the mesh, from 1e-90 to 1e90 (Eq. 4 is solved in
  * units of an edge, so no power of a length overflows); beyond 1e100, or
  * below a 1e-100 extent, the mesh is refused with a reason. */
@@ -551,6 +611,7 @@ int main(void)
         cmocka_unit_test(test_snell_per_face_cost),
         cmocka_unit_test(test_constant_cost_scales),
         cmocka_unit_test(test_early_stop),
+        cmocka_unit_test(test_reuse_equals_fresh),
         cmocka_unit_test(test_scale_invariance),
         cmocka_unit_test(test_bad_meshes),
         cmocka_unit_test(test_degenerate_faces_accepted),

@@ -213,6 +213,8 @@ class mfmm_path_options(Structure):
 # typedef int (*mfmm_rows_callback)(void *user, int32_t first_row, int32_t n_rows,
 #                                   const void *rows);
 mfmm_rows_callback = CFUNCTYPE(c_int, c_void_p, c_int32, c_int32, c_void_p)
+# (user, first_row, n_rows, indptr int64*, indices int32*, values)
+mfmm_sparse_callback = CFUNCTYPE(c_int, c_void_p, c_int32, c_int32, c_void_p, c_void_p, c_void_p)
 
 
 class mfmm_opencl_options(Structure):
@@ -242,6 +244,10 @@ class mfmm_matrix_options(Structure):
         ("opencl", c_void_p),  # mfmm_opencl_context *
         ("opencl_options", c_void_p),  # const mfmm_opencl_options *
         ("fallback_reason", c_char * 256),  # out: why AUTO ran threads
+        ("targets", c_void_p),  # const int32_t *: target columns, or NULL
+        ("n_targets", c_int32),
+        ("vertices_settled", c_int64),  # out
+        ("on_sparse", mfmm_sparse_callback),
     ]
 
 

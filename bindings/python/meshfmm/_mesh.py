@@ -668,9 +668,13 @@ class Mesh:
         n_threads: int = 0,
         memory_limit: int = 0,
         progress: Optional[Callable[[int, int], Any]] = None,
-    ) -> np.ndarray:
+        targets: Any = None,
+        sparse: bool = False,
+        symmetric: bool = False,
+    ) -> Any:
         """Distances from many vertex sources: row i holds the distances from
-        ``sources[i]`` to every vertex (equal to :meth:`distance`'s).
+        ``sources[i]`` to every vertex (equal to :meth:`distance`'s), or to
+        ``targets``.
 
         sources: vertex ids; None for all vertices in order (an N x N matrix).
         backend: "auto" (OpenCL when a device is usable, else threads),
@@ -686,6 +690,22 @@ class Mesh:
         progress: called as ``progress(rows_done, n_rows)`` as blocks of rows
             finish; an exception it raises (or Ctrl-C) stops the computation
             and propagates.
+        targets: vertex ids (T of them, any order, duplicates allowed): the
+            result is len(sources) x T, column j the distance to
+            ``targets[j]``, and each row's march stops once all its targets
+            are settled (landmark matrices cost far less than full rows).
+            None: every vertex. Every backend, OpenCL included.
+        sparse: return a ``scipy.sparse.csr_matrix`` of the finite entries
+            only (with ``max_distance=r``: the pairs within r; the diagonal
+            holds explicit zeros), sorted column ids; memory O(nnz), never
+            S x N. Needs max_distance (a sparse full matrix is dense). Not on
+            OpenCL ("auto" runs threads); ``out`` must be None.
+        symmetric: for a square result (sources None, or sources equal to
+            targets) return (D + D^T) / 2, symmetrised in place (no copy of
+            D); dense only.
+
+        After the call, :attr:`vertices_settled` holds the vertices the
+        marches settled in all (the work done; 0 from OpenCL).
 
         Raises OpenCLError when backend="opencl" cannot run, ValueError for
         bad arguments.
@@ -707,8 +727,35 @@ class Mesh:
             raise ValueError(f"dtype must be float32 or float64, got {dt}")
         if not isinstance(backend, str) or backend.lower() not in _lib.BACKENDS:
             raise ValueError(f"backend must be one of {sorted(_lib.BACKENDS)}, got {backend!r}")
-        shape = (n_rows, self._nv)
-        if out is None:
+        tgt = None
+        if targets is not None:
+            tgt = _index_array(targets, "target")
+            if tgt.shape[0] == 0:
+                raise ValueError("targets must hold at least one vertex id (None: every vertex)")
+            if int(tgt.min()) < 0 or int(tgt.max()) >= self._nv:
+                raise ValueError(f"target ids must lie in [0, {self._nv})")
+        width = self._nv if tgt is None else tgt.shape[0]
+        if symmetric:
+            if sparse:
+                raise ValueError("symmetric=True is for dense results")
+            square = (src is None and (tgt is None or np.array_equal(tgt, np.arange(self._nv)))) or (
+                src is not None
+                and np.array_equal(src, tgt if tgt is not None else np.arange(self._nv))
+            )
+            if not square:
+                raise ValueError(
+                    "symmetric=True needs a square result: sources None or equal to targets"
+                )
+        if sparse:
+            if out is not None:
+                raise ValueError("out is for dense results; sparse=True returns a csr_matrix")
+            if max_distance is None or not np.isfinite(float(max_distance)):
+                raise ValueError("sparse=True needs a finite max_distance (else every entry is stored)")
+            out = np.empty((0, 0), dtype=dt)  # no dense buffer
+        shape = (n_rows, width)
+        if sparse:
+            pass
+        elif out is None:
             out = np.empty(shape, dtype=dt)
         else:
             if not isinstance(out, np.ndarray):
@@ -745,7 +792,12 @@ class Mesh:
             raise ValueError("memory_limit must be >= 0")
         opts.memory_limit = int(memory_limit)
         opts.out = _addr(out) if out.size else None
-        if opts.backend in (_lib.BACKENDS["auto"], _lib.BACKENDS["opencl"]):
+        if tgt is not None:
+            opts.targets = _addr(tgt)
+            opts.n_targets = tgt.shape[0]
+        if opts.backend == _lib.BACKENDS["auto"] and sparse:
+            pass  # the library runs threads (OpenCL does dense rows only)
+        elif opts.backend in (_lib.BACKENDS["auto"], _lib.BACKENDS["opencl"]):
             opts.opencl = _shared_opencl_context()
 
         caught: List[BaseException] = []
@@ -765,8 +817,37 @@ class Mesh:
                 caught.append(exc)
                 return 1
 
-        callback = _lib.mfmm_rows_callback(on_rows)
-        opts.on_rows = callback
+        pieces: List[Any] = []
+
+        def on_sparse(user: Any, first: int, n: int, indptr: Any, indices: Any, values: Any) -> int:
+            try:
+                if interrupted:
+                    return 1
+                ip = np.ctypeslib.as_array(ctypes.cast(indptr, ctypes.POINTER(ctypes.c_int64)), (n + 1,))
+                nnz = int(ip[n])
+                if nnz:
+                    ix = np.ctypeslib.as_array(
+                        ctypes.cast(indices, ctypes.POINTER(ctypes.c_int32)), (nnz,)
+                    ).copy()
+                    ctype = ctypes.c_double if dt == np.float64 else ctypes.c_float
+                    vals = np.ctypeslib.as_array(ctypes.cast(values, ctypes.POINTER(ctype)), (nnz,)).copy()
+                else:
+                    ix = np.empty(0, np.int32)
+                    vals = np.empty(0, dt)
+                pieces.append((ip.copy(), ix, vals))
+                if progress is not None:
+                    progress(first + n, n_rows)
+                return 0
+            except BaseException as exc:
+                caught.append(exc)
+                return 1
+
+        if sparse:
+            callback = _lib.mfmm_sparse_callback(on_sparse)
+            opts.on_sparse = callback
+        else:
+            callback = _lib.mfmm_rows_callback(on_rows)
+            opts.on_rows = callback
         err = _lib.mfmm_error()
         mesh_ptr = self._enter()
         try:
@@ -784,7 +865,79 @@ class Mesh:
         name = _lib.mfmm_backend_name(opts.backend_used)
         self.backend_used = name.decode("ascii") if name else None
         self.fallback_reason = opts.fallback_reason.decode("utf-8", "replace")
+        self.vertices_settled = int(opts.vertices_settled)
+        if sparse:
+            return _csr_from_pieces(pieces, (n_rows, width), dt)
+        if symmetric:
+            _symmetrize_in_place(out)
         return out
+
+    def iter_distance_rows(
+        self, sources: Any = None, block_rows: int = 256, **kwargs: Any
+    ) -> Iterator[Tuple[int, np.ndarray]]:
+        """Yields ``(first_row, block)``: dense blocks of at most ``block_rows``
+        rows of :meth:`distance_matrix` (same keyword options: backend, dtype,
+        targets, max_distance, cost, ...), in order, without the whole matrix
+        in memory, for writing into h5py, Zarr or a database. ``progress`` is
+        called as ``progress(rows_done, n_rows)`` over the whole job. Each
+        block is one library call; closing the generator early (``break``)
+        computes no further block."""
+        if kwargs.get("sparse") or kwargs.get("symmetric") or kwargs.get("out") is not None:
+            raise ValueError("iter_distance_rows yields dense blocks: no sparse, symmetric or out")
+        if block_rows < 1:
+            raise ValueError("block_rows must be >= 1")
+        src = np.arange(self._nv, dtype=np.int32) if sources is None else _index_array(sources, "source")
+        n_rows = src.shape[0]
+        if n_rows == 0:
+            raise ValueError("at least one source is needed")
+        progress = kwargs.pop("progress", None)
+        for first in range(0, n_rows, block_rows):
+            part = src[first : first + block_rows]
+
+            def prog(done: int, _total: int, first: int = first) -> Any:
+                if progress is not None:
+                    return progress(first + done, n_rows)
+                return None
+
+            block = self.distance_matrix(part, progress=prog, **kwargs)
+            yield first, block
+
+
+def _csr_from_pieces(pieces: List[Any], shape: Tuple[int, int], dt: Any) -> Any:
+    """Joins the library's CSR blocks into one scipy.sparse.csr_matrix."""
+    import scipy.sparse
+
+    nnz = sum(int(p[0][-1]) for p in pieces)
+    idx_dt = np.int32 if nnz < 2**31 else np.int64
+    indptr = np.zeros(shape[0] + 1, dtype=idx_dt)
+    indices = np.empty(nnz, dtype=np.int32)
+    data = np.empty(nnz, dtype=dt)
+    row = 0
+    k = 0
+    for ip, ix, vals in pieces:
+        n = ip.shape[0] - 1
+        m = int(ip[-1])
+        indptr[row + 1 : row + n + 1] = ip[1:] + k
+        indices[k : k + m] = ix
+        data[k : k + m] = vals
+        row += n
+        k += m
+    return scipy.sparse.csr_matrix((data, indices, indptr), shape=shape)
+
+
+def _symmetrize_in_place(d: np.ndarray, tile: int = 256) -> None:
+    """d <- (d + d^T) / 2 for a square array, tile by tile (O(tile^2) extra
+    memory). Each pair (i, j), (j, i) gets the same value, (a + b) / 2 in
+    the array's dtype."""
+    n = d.shape[0]
+    for i0 in range(0, n, tile):
+        i1 = min(i0 + tile, n)
+        for j0 in range(i0, n, tile):
+            j1 = min(j0 + tile, n)
+            a = d[i0:i1, j0:j1]
+            m = (a + d[j0:j1, i0:i1].T) / 2
+            d[i0:i1, j0:j1] = m
+            d[j0:j1, i0:i1] = m.T
 
 
 @contextlib.contextmanager
