@@ -52,7 +52,6 @@ def test_sparse_equals_dense_within_r(backend, dtype):
     assert S.has_sorted_indices
     finite = np.isfinite(dense)
     assert S.nnz == int(finite.sum())
-    rows, cols = S.nonzero()  # nonzero() drops explicit zeros: use the structure instead
     coo = S.tocoo()
     assert np.array_equal(dense[coo.row, coo.col], coo.data)
     assert finite[coo.row, coo.col].all()
