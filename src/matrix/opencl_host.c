@@ -22,10 +22,9 @@ void mfmm_opencl_options_init(mfmm_opencl_options *options)
     options->library = NULL;
 }
 
-#ifndef MESHFMM_HAVE_OPENCL
-
-mfmm_status mfmm_opencl_context_create(const mfmm_opencl_options *options,
-                                       mfmm_opencl_context **out, mfmm_error *err)
+/* mfmm_opencl_context_create's argument checks, with or without OpenCL. */
+static mfmm_status check_create_args(const mfmm_opencl_options *options,
+                                     mfmm_opencl_context **out, mfmm_error *err)
 {
     mfmm_ok(err);
     if (!out)
@@ -34,6 +33,17 @@ mfmm_status mfmm_opencl_context_create(const mfmm_opencl_options *options,
     if (options && mfmm_check_struct_size(options, sizeof *options, "mfmm_opencl_options",
                                           err) != MFMM_OK)
         return MFMM_ERR_BAD_ARGUMENT;
+    return MFMM_OK;
+}
+
+#ifndef MESHFMM_HAVE_OPENCL
+
+mfmm_status mfmm_opencl_context_create(const mfmm_opencl_options *options,
+                                       mfmm_opencl_context **out, mfmm_error *err)
+{
+    mfmm_status st = check_create_args(options, out, err);
+    if (st != MFMM_OK)
+        return st;
     return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1,
                      "meshfmm was built without OpenCL (MESHFMM_WITH_OPENCL=OFF or no "
                      "OpenCL headers)");
@@ -618,17 +628,13 @@ struct mfmm_opencl_context {
 mfmm_status mfmm_opencl_context_create(const mfmm_opencl_options *options,
                                        mfmm_opencl_context **out, mfmm_error *err)
 {
-    mfmm_ok(err);
-    if (!out)
-        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "out (the context pointer) is NULL");
-    *out = NULL;
-    if (options && mfmm_check_struct_size(options, sizeof *options, "mfmm_opencl_options",
-                                          err) != MFMM_OK)
-        return MFMM_ERR_BAD_ARGUMENT;
+    mfmm_status st = check_create_args(options, out, err);
+    if (st != MFMM_OK)
+        return st;
     mfmm_opencl_context *ctx = calloc(1, sizeof *ctx);
     if (!ctx)
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
-    mfmm_status st = mfmm_cl_api_load(&ctx->api, options ? options->library : NULL, err);
+    st = mfmm_cl_api_load(&ctx->api, options ? options->library : NULL, err);
     if (st != MFMM_OK) {
         free(ctx);
         return st;
