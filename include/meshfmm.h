@@ -178,7 +178,8 @@ typedef struct mfmm_source {
 /* Where a cost array lives. */
 typedef enum mfmm_cost_location {
     MFMM_COST_NONE = 0,       /* F = 1 everywhere: geodesic distance */
-    MFMM_COST_PER_VERTEX = 1, /* cost has nv entries; a vertex is updated with its own F */
+    MFMM_COST_PER_VERTEX = 1, /* cost has nv entries; F is linear along each edge
+                                 and local path (trapezoid means, march.h) */
     MFMM_COST_PER_FACE = 2    /* cost has nf entries; paths refract at region borders */
 } mfmm_cost_location;
 

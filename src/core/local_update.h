@@ -71,25 +71,24 @@ MFMM_INLINE double mfmm_min(double x, double y)
     return x < y ? x : y;
 }
 
-/* T(C) from triangle ABC with T(A) = ta, T(B) = tb both known; a = |BC|,
- * b = |AC|, cos_c = cos theta at C; f = cost F.
+/* T(C) through the inside of triangle ABC, with T(A) = ta, T(B) = tb both
+ * known; a = |BC|, b = |AC|, cos_c = cos theta at C; f = cost F. +inf when
+ * the update does not come from within the triangle.
  * Eq. 4 gives t = T(C) - T(A) with u = T(B) - T(A) >= 0 (A the smaller); it is
  * accepted when u < t and the update comes from within the triangle, Eq. 5:
  * a cos theta < b(t-u)/t < a / cos theta. That test is used multiplied through
  * by cos theta (a cos theta < x and x cos theta < a, x = b(t-u)/t), which is
  * Eq. 5 for acute theta and stays meaningful for obtuse theta (where the
- * literal form rejects everything). Otherwise the edge updates
- * min(T(A) + bF, T(B) + aF) (the paper prints cF, but BC has length a). */
-MFMM_INLINE double mfmm_triangle_update(double ta, double tb, double a, double b,
-                                        double cos_c, double f)
+ * literal form rejects everything). */
+MFMM_INLINE double mfmm_triangle_interior(double ta, double tb, double a, double b,
+                                          double cos_c, double f)
 {
     if (ta > tb) { /* let A be the vertex reached first */
         double s = ta; ta = tb; tb = s;
         s = a; a = b; b = s;
     }
-    double edge = mfmm_min(ta + b * f, tb + a * f);
     if (!(b > 0.0))
-        return edge;
+        return MFMM_INF;
     /* Eq. 4 is homogeneous of degree 4 in lengths: solve it in units of b,
      * so that no power of a length overflows or underflows at any scale */
     double scale = b, inv = 1.0 / b;
@@ -102,50 +101,63 @@ MFMM_INLINE double mfmm_triangle_update(double ta, double tb, double a, double b
     double q1 = 2.0 * b * u * (a * cos_c - b);
     double q0 = b * b * (u * u - f * f * a * a * sin2);
     if (!(q2 > 0.0))
-        return edge;
+        return MFMM_INF;
     double disc = q1 * q1 - 4.0 * q2 * q0;
     disc = disc > 0.0 ? disc : 0.0; /* clamp: never the root of a negative */
     double s = sqrt(disc);
     /* the larger root, without cancellation */
     double t = q1 <= 0.0 ? (s - q1) / (2.0 * q2) : (2.0 * q0) / (-q1 - s);
     if (!(t > u)) /* also rejects NaN */
-        return edge;
+        return MFMM_INF;
     /* the test with x = CD = b (t - u) / t of section 4.1, multiplied by t > 0 */
     double xt = b * (t - u);
     if (a * cos_c * t < xt && xt * cos_c < a * t)
-        return mfmm_min(ta + t * scale, edge);
-    return edge;
+        return ta + t * scale;
+    return MFMM_INF;
+}
+
+/* The full local update of section 4.1 with one cost f: the inside of the
+ * triangle when Eq. 5 accepts it, else the edge updates
+ * min(T(A) + bF, T(B) + aF) (the paper prints cF, but BC has length a). */
+MFMM_INLINE double mfmm_triangle_update(double ta, double tb, double a, double b,
+                                        double cos_c, double f)
+{
+    double edge = mfmm_min(ta + b * f, tb + a * f);
+    return mfmm_min(mfmm_triangle_interior(ta, tb, a, b, cos_c, f), edge);
 }
 
 /* The best T(C) that corner `cr` offers from its settled neighbours; +inf if
- * none. f is the cost F to use; unfolding 0 ignores virtual edges. */
+ * none. Costs: f_b along edge CA, f_a along edge CB, f_t across the
+ * triangle and over the virtual stencil (which is used only where the cost
+ * is the same all around, march.h); unfolding 0 ignores virtual edges. */
 MFMM_INLINE double mfmm_corner_update(MFMM_GLOBAL const mfmm_corner *cr,
                                       MFMM_GLOBAL const double *T,
                                       MFMM_GLOBAL const mfmm_u8 *label,
-                                      double f, int unfolding)
+                                      double f_a, double f_b, double f_t, int unfolding)
 {
     mfmm_i32 ia = cr->a, ib = cr->b, iv = cr->virt;
     int alive_a = (label[ia] & MFMM_STATE_MASK) == MFMM_ALIVE;
     int alive_b = (label[ib] & MFMM_STATE_MASK) == MFMM_ALIVE;
     double best = MFMM_INF;
-    if (alive_a) best = mfmm_min(best, T[ia] + cr->len_b * f);
-    if (alive_b) best = mfmm_min(best, T[ib] + cr->len_a * f);
+    if (alive_a) best = mfmm_min(best, T[ia] + cr->len_b * f_b);
+    if (alive_b) best = mfmm_min(best, T[ib] + cr->len_a * f_a);
     if (iv >= 0 && unfolding) {
         /* section 4.2: the obtuse angle split into two acute virtual
          * triangles A-C-V and V-C-B */
         if ((label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE) {
             double tv = T[iv];
-            best = mfmm_min(best, tv + cr->virt_len * f);
+            best = mfmm_min(best, tv + cr->virt_len * f_t);
             if (alive_a)
                 best = mfmm_min(best, mfmm_triangle_update(T[ia], tv, cr->virt_len, cr->len_b,
-                                                       cr->virt_cos_a, f));
+                                                       cr->virt_cos_a, f_t));
             if (alive_b)
                 best = mfmm_min(best, mfmm_triangle_update(tv, T[ib], cr->len_a, cr->virt_len,
-                                                       cr->virt_cos_b, f));
+                                                       cr->virt_cos_b, f_t));
         }
     } else if (alive_a && alive_b && iv != MFMM_VIRT_DEGENERATE) {
-        best = mfmm_min(best, mfmm_triangle_update(T[ia], T[ib], cr->len_a, cr->len_b,
-                                               cr->cos_c, f));
+        /* the edge updates are above, each with its own edge's cost */
+        best = mfmm_min(best, mfmm_triangle_interior(T[ia], T[ib], cr->len_a, cr->len_b,
+                                                 cr->cos_c, f_t));
     }
     return best;
 }

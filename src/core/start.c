@@ -56,6 +56,7 @@ typedef struct walk {
     const mfmm_mesh *m;
     const double *cost;
     int loc;
+    double fp; /* per vertex: F at the point, interpolated in its face */
     double radius;
     mfmm_start_fn fn;
     void *user;
@@ -87,7 +88,7 @@ static void hit(walk *w, int32_t v, v2 pw, int depth)
     if (w->loc == 2)
         weighted += w->cost[w->face[depth]] * (len - prev);
     else
-        weighted = w->loc == 1 ? w->cost[v] * len : len;
+        weighted = w->loc == 1 ? 0.5 * (w->fp + w->cost[v]) * len : len;
     h.vertex = v;
     h.length = len;
     h.cost_length = weighted;
@@ -215,7 +216,9 @@ static void start_face(walk *w, int32_t f, const double *p)
         double t0 = 0.0;
         h.vertex = fv[k];
         h.length = r[k];
-        h.cost_length = w->loc == 2 ? w->cost[f] * r[k] : w->loc == 1 ? w->cost[fv[k]] * r[k] : r[k];
+        h.cost_length = w->loc == 2   ? w->cost[f] * r[k]
+                        : w->loc == 1 ? 0.5 * (w->fp + w->cost[fv[k]]) * r[k]
+                                      : r[k];
         h.depth = 0;
         h.a = h.b = fv;
         h.face = w->face;
@@ -264,6 +267,8 @@ void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double
     if (n_zero >= 2) { /* at a vertex: every face around it */
         int32_t v = fv[top];
         memcpy(p, mesh->xyz + 3 * (size_t)v, sizeof p);
+        if (w.loc == 1)
+            w.fp = cost[v];
         for (int32_t i = mesh->vertex_face_offset[v]; i < mesh->vertex_face_offset[v + 1] && !w.stop; i++) {
             int32_t f = mesh->vertex_face_corner[i] / 3;
             if (!mesh->degenerate[f])
@@ -271,9 +276,13 @@ void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double
         }
         return;
     }
-    for (int k = 0; k < 3; k++)
+    for (int k = 0; k < 3; k++) {
+        double bk = src->bary[k] > 0.0 ? src->bary[k] : 0.0;
         for (int c = 0; c < 3; c++)
-            p[c] += (src->bary[k] > 0.0 ? src->bary[k] : 0.0) * mesh->xyz[3 * (size_t)fv[k] + c];
+            p[c] += bk * mesh->xyz[3 * (size_t)fv[k] + c];
+        if (w.loc == 1)
+            w.fp += bk * cost[fv[k]];
+    }
     int32_t g = zero >= 0 ? mesh->face_neighbor[3 * (size_t)src->face + zero] : -1;
     if (g >= 0 && mesh->degenerate[g])
         g = -1;

@@ -33,9 +33,10 @@ typedef int (*mfmm_start_fn)(void *user, const mfmm_start_hit *hit);
  * (one, the two of an edge it lies on, or all around a vertex it is at, so
  * that the result does not depend on which face names it), their corners,
  * then straight on through their edges within MFMM_START_RADIUS. cost NULL:
- * cost_length = length; per vertex: F at the vertex reached times length
- * (the march's F(C)); per face: the sum over the faces crossed of F times the
- * piece in that face. */
+ * cost_length = length; per vertex: the mean of F at the point (linear in
+ * its face) and at the vertex reached, times length (trapezoid, as
+ * march.h); per face: the sum over the faces crossed of F times the piece
+ * in that face. */
 void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double *cost,
                      int cost_location, mfmm_start_fn fn, void *user);
 

@@ -12,13 +12,22 @@
  * subdivided solve; the default solve (unfolding on) must not go below the
  * subdivided solve by more than that plus 0.5 % of T. Measured, min over the
  * vertices of (T - T_sub) / T_sub, default / plain stencil:
- *   lattice         per face   0.0 % /  0.0 %   (before the fix: -98 %, T(91) = 1.73)
- *                   per vertex -96 %  / -96 %   (the per-vertex plain stencil
- *                              charges F(C) = 1 over triangles whose other corners cost 100)
- *   camelhead band  per face  -6.8 % / -6.8 %   (off the band; on it -0.1 %)
- *                   per vertex -0.1 % / -0.3 %  (before the fix: -5.6 %, on the band)
- * The camelhead band as built here (below) has no band vertex > 20 % low,
- * before or after; the lattice's are (per face) 3 of 3 before, 0 after. */
+ *   lattice           per face   0.0 % /  0.0 %  (before the fix: -98 %, T(91) = 1.73)
+ *                     per vertex 0.0 % /  0.0 %  (before the trapezoid costs of
+ *                                march.h: -96 %, F(C) = 1 charged over triangles
+ *                                whose other corners cost 100)
+ *   camelhead band x  per face  -6.8 % / -6.8 %  (off the band; on it -0.1 %)
+ *                     per vertex -4.9 % / -4.9 % (on the band -0.1 %)
+ *   camelhead band y  per face  -9.6 % / -9.6 %  (on the band 0.0 %)
+ *                     per vertex -4.5 % / -4.5 % (on the band 0.0 %; before:
+ *                                2 of 366 band vertices > 20 % low, worst -36 %)
+ * Off the band the coarse solves lie below the subdivided ones where the
+ * subdivided mesh keeps the plain stencil at obtuse corners next to the band
+ * (it does not converge there); further 1-to-4 splits raise those values.
+ * The issue's camelhead band (76 of 553 vertices > 20 % low) could not be
+ * rebuilt exactly; planes x, y, z at 0.3, 0.5, 0.7 of the box and two
+ * iso-distance bands, sources on and off the band, give 0 band vertices
+ * > 20 % low now (bench/sweep_cost_bands.py). */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -181,8 +190,10 @@ static void check_against_subdivided(const char *name, const double *V, int32_t 
             fail_msg("%s per %s: the default solve is %.4f below the subdivided one, the plain "
                      "stencil only %.4f",
                      name, per_vertex ? "vertex" : "face", -r, -rp);
-        if (band)
+        if (band) { /* the measure: no band vertex > 20 % low */
             assert_true(below <= below_plain);
+            assert_int_equal(below, 0);
+        }
         worst_out[per_vertex] = r;
     }
     free(d);
@@ -249,15 +260,15 @@ static void test_lattice(void **state)
     int32_t band[3] = {78, 79, 91};
     check_against_subdivided("lattice", V, NV, F, NF, fcost, vcost, 65, band, 3, worst);
     assert_true(worst[0] >= -0.02); /* per face: the plain stencil's -0.97 %, rounded up */
+    assert_true(worst[1] >= -0.02); /* per vertex: was -96 % with F(C) over the triangle */
 }
 
 /* camelhead with a one-face-wide band of cost 1 in cost 100: the faces that
- * the plane x = (bounding box centre) crosses (a corner strictly on each
+ * the plane x (or y) = (bounding box centre) crosses (a corner strictly on each
  * side); per vertex, the band faces' vertices cost 1. Source: the band's
  * lowest vertex id. */
-static void test_camelhead_band(void **state)
+static void camelhead_band(int axis, int32_t expect_band)
 {
-    (void)state;
     char path[1024];
     tm_data_path(path, sizeof path, "meshes/camelhead.off");
     double *V = NULL;
@@ -267,8 +278,8 @@ static void test_camelhead_band(void **state)
         fail_msg("%s: %s", path, err.message);
     double lo = INFINITY, hi = -INFINITY;
     for (int32_t v = 0; v < nv; v++) {
-        lo = fmin(lo, V[3 * v]);
-        hi = fmax(hi, V[3 * v]);
+        lo = fmin(lo, V[3 * v + axis]);
+        hi = fmax(hi, V[3 * v + axis]);
     }
     double x0 = 0.5 * (lo + hi);
     double *fcost = malloc((size_t)nf * sizeof *fcost), *vcost = malloc((size_t)nv * sizeof *vcost);
@@ -277,7 +288,8 @@ static void test_camelhead_band(void **state)
     for (int32_t v = 0; v < nv; v++)
         vcost[v] = 100.0;
     for (int32_t f = 0; f < nf; f++) {
-        double a = V[3 * F[3 * f]], b = V[3 * F[3 * f + 1]], c = V[3 * F[3 * f + 2]];
+        double a = V[3 * F[3 * f] + axis], b = V[3 * F[3 * f + 1] + axis],
+               c = V[3 * F[3 * f + 2] + axis];
         int in = fmin(a, fmin(b, c)) < x0 && fmax(a, fmax(b, c)) > x0;
         fcost[f] = in ? 1.0 : 100.0;
         for (int k = 0; in && k < 3; k++)
@@ -289,9 +301,9 @@ static void test_camelhead_band(void **state)
             if (source < 0)
                 source = v;
         }
-    assert_int_equal(n_band, 488);
+    assert_int_equal(n_band, expect_band);
     double worst[2];
-    check_against_subdivided("camelhead band", V, nv, F, nf, fcost, vcost, source, band, n_band,
+    check_against_subdivided(axis == 0 ? "camelhead band x" : "camelhead band y", V, nv, F, nf, fcost, vcost, source, band, n_band,
                              worst);
     free(fcost);
     free(vcost);
@@ -300,11 +312,25 @@ static void test_camelhead_band(void **state)
     mfmm_free(F);
 }
 
+static void test_camelhead_band_x(void **state)
+{
+    (void)state;
+    camelhead_band(0, 488);
+}
+
+/* per vertex before the trapezoid costs: 2 band vertices > 20 % low, worst -36 % */
+static void test_camelhead_band_y(void **state)
+{
+    (void)state;
+    camelhead_band(1, 366);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_lattice),
-        cmocka_unit_test(test_camelhead_band),
+        cmocka_unit_test(test_camelhead_band_x),
+        cmocka_unit_test(test_camelhead_band_y),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

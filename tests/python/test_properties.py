@@ -98,9 +98,8 @@ def edge_bound(V, F, T, c, where):
     if where == "face":
         f = c[fid]
     elif where == "vertex":
-        # the vertex updated last (larger T) is the one whose cost counts
-        later = np.where(T[e[:, 0]] >= T[e[:, 1]], e[:, 0], e[:, 1])
-        f = c[later]
+        # F linear along the edge: the mean of its ends (march.h)
+        f = 0.5 * (c[e[:, 0]] + c[e[:, 1]])
     else:
         f = np.ones(len(e))
     # per face cost: the cheapest of the edge's faces

@@ -484,7 +484,8 @@ class Mesh:
             or a sequence mixing those (an integer array is read as vertex ids).
         cost: the slowness F (``|grad T| = F``), per vertex (n_vertices,) or per
             face (n_faces,), finite and > 0; None for plain geodesic distance.
-            When the mesh has as many vertices as faces, ``cost_location``
+            Per face, F is constant on each face; per vertex, F is linear
+            along each edge and local path (trapezoid means). When the mesh has as many vertices as faces, ``cost_location``
             ('vertex' or 'face') must say which.
         max_distance: stop marching past it; vertices beyond are +inf.
         targets: vertex ids; the march stops once all of them are settled
