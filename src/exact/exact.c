@@ -77,7 +77,7 @@
 
 #include "exact/exact.h"
 #include "core/mesh.h"
-#include "core/solve.h"
+#include "core/check.h"
 
 #define EX_PI 3.14159265358979323846264338328
 #define EX_TWO_PI 6.283185307179586476925286766559
