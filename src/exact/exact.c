@@ -333,12 +333,14 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
             double L = r->len[k];
             const double *a = X + 3 * (size_t)fv[(k + 1) % 3], *b = X + 3 * (size_t)fv[(k + 2) % 3],
                          *c = X + 3 * (size_t)fv[k];
-            double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+            /* e a unit vector, so that no product is a length to the 4th
+             * power (which underflows at 1e-90 and overflows at 1e90) */
+            double e[3] = {(b[0] - a[0]) / L, (b[1] - a[1]) / L, (b[2] - a[2]) / L};
             double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
             double cr[3] = {e[1] * w[2] - e[2] * w[1], e[2] * w[0] - e[0] * w[2],
                             e[0] * w[1] - e[1] * w[0]};
-            double x = (e[0] * w[0] + e[1] * w[1] + e[2] * w[2]) / L;
-            double y = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]) / L;
+            double x = e[0] * w[0] + e[1] * w[1] + e[2] * w[2];
+            double y = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
             r->cx[k] = x;
             r->cy[k] = y;
             if (!(L > 0.0) || !(y > 0.0) || !isfinite(x) || !isfinite(y))

@@ -62,9 +62,25 @@ mfmm_status mfmm_exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const mf
             if (s.bary[k] > s.bary[top])
                 top = k;
         }
+        int32_t g0 = n_zero == 1 ? mesh->face_neighbor[3 * (size_t)s.face + zero] : -1;
         if (n_zero >= 2) {
             s.face = -1;
             s.vertex = center = fv[top];
+        } else if (g0 >= 0 && g0 < s.face && !mesh->degenerate[g0]) {
+            /* on an edge: named by the lower of its two faces, so that the
+             * patch does not depend on which face names the point */
+            const int32_t *gv = mesh->faces + 3 * (size_t)g0;
+            double b[3] = {0.0, 0.0, 0.0};
+            for (int k = 0; k < 3; k++)
+                for (int j = 0; j < 3; j++)
+                    if (gv[j] == fv[k] && k != zero)
+                        b[j] = s.bary[k];
+            s.face = g0;
+            s.bary[0] = b[0];
+            s.bary[1] = b[1];
+            s.bary[2] = b[2];
+            return mfmm_exact_start(mesh, ws, &s, radius, cost, uniform, n, vertices, distances,
+                                    F);
         } else {
             center = fv[top];
             for (int k = 0; k < 3; k++)
