@@ -60,7 +60,7 @@ inline void mfmm_row_march(int nv, __global const int *update_offset,
     }
     if (seeds) {
         for (int j = seeds[row]; j < seeds[row + 1]; j++)
-            mfmm_march_seed(&s, seeds[j], seed_value[j]);
+            mfmm_march_seed_fixed(&s, seeds[j], seed_value[j]);
     } else {
         mfmm_march_seed(&s, source, 0.0);
     }

@@ -170,9 +170,11 @@ void mfmm_solver_fix_cost(mfmm_solver *solver, const double *cost, int cost_loca
 }
 
 /* Seeds one source: its exact start where that applies (seed.h), else the
- * straight start. -1 when out of memory. */
+ * straight start. fixed: the exact values are final (one source; with
+ * several, a vertex in one's patch may be nearer another, whose march must
+ * be able to lower it). -1 when out of memory. */
 static int seed_source(mfmm_solver *solver, mfmm_march_state *s, const mfmm_source *src,
-                       double radius)
+                       double radius, int fixed)
 {
     int32_t n = 0;
     const int32_t *pv = NULL;
@@ -181,8 +183,12 @@ static int seed_source(mfmm_solver *solver, mfmm_march_state *s, const mfmm_sour
     if (mfmm_exact_start(solver->mesh, &solver->exact, src, radius, s->cost,
                          s->cost ? solver->uniform : NULL, &n, &pv, &pd, &f) != MFMM_OK)
         return -1;
-    for (int32_t i = 0; i < n; i++)
-        mfmm_march_seed(s, pv[i], src->value + f * pd[i]);
+    for (int32_t i = 0; i < n; i++) {
+        if (fixed)
+            mfmm_march_seed_fixed(s, pv[i], src->value + f * pd[i]);
+        else
+            mfmm_march_seed(s, pv[i], src->value + f * pd[i]);
+    }
     if (n == 0)
         mfmm_start_seed(solver->mesh, s, src);
     return 0;
@@ -229,7 +235,7 @@ static int32_t solver_march(mfmm_solver *solver, const mfmm_source *sources, int
         }
     }
     for (int32_t i = 0; i < n_sources; i++) {
-        if (seed_source(solver, &s, sources + i, opt.exact_start_radius) < 0) {
+        if (seed_source(solver, &s, sources + i, opt.exact_start_radius, n_sources == 1) < 0) {
             for (int32_t j = 0; j < opt.n_targets; j++)
                 s.label[opt.targets[j]] &= (uint8_t)MFMM_STATE_MASK;
             for (int32_t j = 0; j < s.n_touched; j++) {
