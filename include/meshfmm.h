@@ -235,7 +235,7 @@ typedef struct mfmm_solve_options {
 
 /* Default exact_start_radius, in mean edge lengths (chosen by measurement:
  * bench/RESULTS.md, "Exact start"). */
-#define MFMM_EXACT_START_RADIUS 5.0
+#define MFMM_EXACT_START_RADIUS 6.0
 
 /* Fills `options` with the defaults: no cost, no limit, no targets, unfolding on,
  * exact start within MFMM_EXACT_START_RADIUS mean edge lengths. */

@@ -132,7 +132,7 @@ typedef struct cli_sources_and_cost {
 /* The help lines of the start options (distance, path, allpairs). */
 #define CLI_START_HELP                                                                       \
     "  --exact-start-radius R  start the march from exact distances within R mean\n"        \
-    "                          edge lengths of each source (default 5)\n"                   \
+    "                          edge lengths of each source (default 6)\n"                   \
     "  --plain-start           the paper's start (as --exact-start-radius 0)\n"
 /* Parses --exact-start-radius's value: CLI_OK, or CLI_USAGE with the error printed. */
 int cli_parse_start_radius(const char *sub, const char *arg, double *radius);

@@ -41,7 +41,7 @@ static void help(FILE *out)
             "                      meshfmm distance\n"
             "  --max-distance X    stop each row past X; farther vertices get inf\n"
             "  --exact-start-radius R  each row's march starts from exact distances within\n"
-            "                      R mean edge lengths of its source (default 5)\n"
+            "                      R mean edge lengths of its source (default 6)\n"
             "  --plain-start       the paper's start (as --exact-start-radius 0)\n"
             "  --threads N         threads for the threads backend (0, the default: all cores)\n"
             "  --memory MB         memory for workspaces and blocks in flight\n"

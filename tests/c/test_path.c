@@ -137,6 +137,12 @@ static void test_plane_straight(void **state)
 {
     (void)state;
     double prev_dev = INFINITY;
+    /* the shrinking deviation is calibrated on the paper's plain start (the
+     * exact start makes T exact near the source, which changes the
+     * characteristics' lean there; the sphere test compares the two) */
+    mfmm_solve_options plain;
+    mfmm_solve_options_init(&plain);
+    plain.exact_start_radius = 0.0;
     for (int n = 20; n <= 80; n *= 2) {
         tm_fixture fx = tm_fixture_make(mfmm_gen_grid(n), CAP);
         double h = 1.0 / n;
@@ -150,7 +156,7 @@ static void test_plane_straight(void **state)
                 for (int32_t v = 0; v < fx.g.nv; v++)
                     fx.d[v] = dist3(fx.g.V + 3 * v, s);
             } else {
-                solve1(&fx, &src, NULL);
+                solve1(&fx, &src, &plain);
             }
             /* [0] the traced path, [1] straightened */
             double max_dev[2] = {0, 0}, max_rel[2] = {0, 0}, mean_rel[2] = {0, 0};
