@@ -152,16 +152,6 @@ MFMM_INLINE void mfmm_march_seed(mfmm_march_state *s, mfmm_i32 v, double value)
     }
 }
 
-/* Seeds v at an exact value (the exact start, src/solve/seed.h): as
- * mfmm_march_seed, and the march never lowers it, since an update from
- * first-order neighbours can only add error to an exact value. */
-MFMM_INLINE void mfmm_march_seed_fixed(mfmm_march_state *s, mfmm_i32 v, double value)
-{
-    mfmm_march_seed(s, v, value);
-    if (s->T[v] == value)
-        s->label[v] = (mfmm_u8)(s->label[v] | MFMM_FIXED);
-}
-
 /* The cost F for updating vertex c through corner cr. */
 MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, MFMM_GLOBAL const mfmm_corner *cr,
                                    mfmm_i32 c)
@@ -192,6 +182,16 @@ MFMM_INLINE int mfmm_march_virt_ok(const mfmm_march_state *s, const mfmm_march_m
         if (U[m->strip[i]] != f)
             return 0;
     return 1;
+}
+
+/* Seeds v at an exact value (the exact start, src/solve/seed.h): as
+ * mfmm_march_seed, and the march never lowers it, since an update from
+ * first-order neighbours can only add error to an exact value. */
+MFMM_INLINE void mfmm_march_seed_fixed(mfmm_march_state *s, mfmm_i32 v, double value)
+{
+    mfmm_march_seed(s, v, value);
+    if (s->T[v] == value)
+        s->label[v] = (mfmm_u8)(s->label[v] | MFMM_FIXED);
 }
 
 /* Section 2's loop: settle the Close vertex of least T, recompute its
