@@ -39,6 +39,8 @@ step "accuracy against the stored exact references (pytest)"
 MESHFMM_ACCURACY_JSON="$PWD/bench/results/accuracy_python.json" "$py" -m pytest -q tests/python/test_accuracy.py
 step "per-source accuracy and time against the peers"
 "$py" bench/compare_peers.py
+"$py" bench/bench_exact_start.py   # the exact start: radii, robust heat, time per source
+"$py" bench/convergence_exact_start.py
 step "all pairs"
 "$py" bench/compare_allpairs.py
 step "paper figures 8b and 10"

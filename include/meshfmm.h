@@ -163,11 +163,15 @@ MFMM_API int32_t mfmm_mesh_face_count(const mfmm_mesh *mesh);
 /* A source: a vertex (face == -1), or a point inside a face given by
  * barycentric coordinates (w0, w1, w2) of the face's corners (>= 0, summing
  * to 1 within 1e-9). `value` is T at the source (usually 0): the result is
- * T(x) = min over sources of (value + cost-weighted distance). A point source
- * starts the march from straight-segment distances to the vertices near it
- * (through the faces within about two mean edge lengths); a point on an edge
- * or at a corner is a point of every face holding it, so T does not depend
- * on which face names it, and moves continuously with the point. */
+ * T(x) = min over sources of (value + cost-weighted distance). By default
+ * the march starts from the exact distances of the vertices within
+ * exact_start_radius mean edge lengths of each source (see
+ * mfmm_solve_options); with that option 0, or where the cost is not uniform
+ * near the source, a vertex source starts at its vertex and a point source
+ * from straight-segment distances to the vertices near it (through the faces
+ * within about two mean edge lengths). Either way a point on an edge or at a
+ * corner is a point of every face holding it, so T does not depend on which
+ * face names it, and moves continuously with the point. */
 typedef struct mfmm_source {
     int32_t vertex;     /* vertex id when face == -1; ignored otherwise */
     int32_t face;       /* face id, or -1 for a vertex source */
@@ -188,7 +192,11 @@ typedef enum mfmm_cost_location {
 typedef struct mfmm_solver mfmm_solver;
 
 /* A reusable workspace (heap, labels, a touched list) for one mesh and one
- * thread: about 40 bytes per vertex. Solving allocates nothing. Between
+ * thread: about 40 bytes per vertex, plus, made by the first solve that uses
+ * the exact start, an exact solver's workspace (about 180 bytes per face and
+ * 45 per vertex, see mfmm_exact_solver_create). After that first solve,
+ * solving allocates nothing (the exact start's queue grows only for a
+ * larger patch than any before). Between
  * solves the workspace is kept clean by resetting only the vertices the
  * last march reached, so a local solve (max_distance, targets) costs in
  * proportion to what it reaches, apart from filling `distances`. */
@@ -207,9 +215,31 @@ typedef struct mfmm_solve_options {
     int32_t n_targets;
     int32_t unfolding;               /* 1 (default): obtuse corners update through their
                                         virtual edges; 0: plain stencils (for comparison) */
+    /* Appended fields. */
+    /* The exact start (issue 12): the march starts from the exact polyhedral
+     * distances (mfmm_solve_exact's) of the vertices within this many mean
+     * edge lengths of each source (at least the corners of the faces holding
+     * it), T = value + F * distance, instead of from the source's vertex (a
+     * vertex source) or straight segments (a point source). A first-order
+     * march makes most of its error at the source's point singularity and
+     * carries it on: this start lowers the mean error by about half at the
+     * default (bench/RESULTS.md), for a few hundred microseconds per source.
+     * Exact distances hold for F = 1, so with a cost it applies to a source
+     * only where the cost is one F over the patch (per vertex: every patch
+     * vertex and its neighbours; per face: every face around a patch vertex;
+     * then T = value + F * distance); elsewhere that source takes the
+     * straight start. Default MFMM_EXACT_START_RADIUS; 0: the paper's plain
+     * start, as before this option existed. Finite and >= 0, else
+     * MFMM_ERR_BAD_ARGUMENT. */
+    double exact_start_radius;
 } mfmm_solve_options;
 
-/* Fills `options` with the defaults: no cost, no limit, no targets, unfolding on. */
+/* Default exact_start_radius, in mean edge lengths (chosen by measurement:
+ * bench/RESULTS.md, "Exact start"). */
+#define MFMM_EXACT_START_RADIUS 6.0
+
+/* Fills `options` with the defaults: no cost, no limit, no targets, unfolding on,
+ * exact start within MFMM_EXACT_START_RADIUS mean edge lengths. */
 MFMM_API void mfmm_solve_options_init(mfmm_solve_options *options);
 
 /* Marches from the sources and writes T for every vertex.
@@ -492,6 +522,11 @@ typedef struct mfmm_matrix_options {
      * NULL. Serial and threads backends; OPENCL fails with
      * MFMM_ERR_BAD_ARGUMENT, AUTO runs threads. */
     mfmm_sparse_callback on_sparse;
+    /* as in mfmm_solve_options (appended field): each row's march starts from
+     * the exact distances within this many mean edge lengths of its source, on
+     * every backend (OpenCL: computed on the host, uploaded with the batch).
+     * Default MFMM_EXACT_START_RADIUS; 0: the plain start */
+    double exact_start_radius;
 } mfmm_matrix_options;
 
 MFMM_API void mfmm_matrix_options_init(mfmm_matrix_options *options);

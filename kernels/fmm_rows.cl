@@ -5,6 +5,11 @@
  * targets (n_targets > 0) a row marches until its targets settle (the
  * serial solver's early stop, the same flags) and writes only their columns.
  *
+ * A row starts from its source's vertex, or (exact start, n_seeds > 0) from
+ * the seeds the host computed for it (src/solve/seed.h): for the batch's row
+ * i, vertices seeds[j] at values seed_value[j] for j in [seeds[i],
+ * seeds[i + 1]), seeded in that order, as the serial solver does.
+ *
  * Built without -cl-mad-enable / -cl-fast-relaxed-math; local_update.h sets
  * FP_CONTRACT OFF, so rows equal the C core's bit for bit in float64.
  * The host embeds this file with the #include lines replaced by the headers.
@@ -20,7 +25,9 @@ inline void mfmm_row_march(int nv, __global const int *update_offset,
                            __global double *heap_key, __global int *heap_vertex,
                            __global int *heap_pos, __global const int *strip,
                            __global const double *uniform,
-                           __global const int *targets, int n_targets)
+                           __global const int *targets, int n_targets,
+                           __global const int *seeds, int row,
+                           __global const double *seed_value)
 {
     mfmm_march_mesh m;
     m.nv = nv;
@@ -51,7 +58,12 @@ inline void mfmm_row_march(int nv, __global const int *update_offset,
             s.targets_left++;
         }
     }
-    mfmm_march_seed(&s, source, 0.0);
+    if (seeds) {
+        for (int j = seeds[row]; j < seeds[row + 1]; j++)
+            mfmm_march_seed_fixed(&s, seeds[j], seed_value[j]);
+    } else {
+        mfmm_march_seed(&s, source, 0.0);
+    }
     mfmm_march_run(&s, &m);
 }
 
@@ -65,7 +77,9 @@ __kernel void fmm_rows_f64(int nv, __global const int *update_offset,
                            __global uchar *label_ws, __global double *key_ws,
                            __global int *vert_ws, __global int *pos_ws, __global double *out,
                            __global const int *strip, __global const double *uniform,
-                           __global const int *targets, int n_targets, __global double *T_ws)
+                           __global const int *targets, int n_targets, __global double *T_ws,
+                           int n_seeds, __global const int *seeds,
+                           __global const double *seed_value)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
@@ -74,7 +88,8 @@ __kernel void fmm_rows_f64(int nv, __global const int *update_offset,
     __global double *T = n_targets > 0 ? T_ws + o : out + o;
     mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
-                   key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets);
+                   key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets,
+                   n_seeds > 0 ? seeds : 0, i, seed_value);
     if (n_targets > 0) {
         __global double *row = out + (ulong)i * (ulong)n_targets;
         for (int j = 0; j < n_targets; j++)
@@ -92,7 +107,9 @@ __kernel void fmm_rows_f32(int nv, __global const int *update_offset,
                            __global int *vert_ws, __global int *pos_ws,
                            __global double *T_ws, __global float *out,
                            __global const int *strip, __global const double *uniform,
-                           __global const int *targets, int n_targets, __global double *unused)
+                           __global const int *targets, int n_targets, __global double *unused,
+                           int n_seeds, __global const int *seeds,
+                           __global const double *seed_value)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
@@ -101,7 +118,8 @@ __kernel void fmm_rows_f32(int nv, __global const int *update_offset,
     __global double *T = T_ws + o;
     mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
-                   key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets);
+                   key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets,
+                   n_seeds > 0 ? seeds : 0, i, seed_value);
     (void)unused;
     if (n_targets > 0) {
         __global float *row = out + (ulong)i * (ulong)n_targets;

@@ -50,7 +50,7 @@ enum {
     OPT_SOURCE = 256, OPT_FACE_SOURCE, OPT_COST, OPT_COST_PER_FACE, OPT_MAX_DISTANCE,
     OPT_NO_UNFOLDING, OPT_EXACT, OPT_TARGET, OPT_TARGET_FACE, OPT_MAX_POINTS, OPT_NO_STRAIGHTEN,
     OPT_JSON, OPT_MAX_UNFOLD_STEPS, OPT_STRETCH, OPT_RADII, OPT_DTYPE, OPT_BACKEND,
-    OPT_SOURCES, OPT_THREADS, OPT_MEMORY, OPT_TARGETS
+    OPT_SOURCES, OPT_THREADS, OPT_MEMORY, OPT_TARGETS, OPT_PLAIN_START, OPT_EXACT_START_RADIUS
 };
 /* Prints the usage error for getopt_long's '?' or ':' (opterr is 0; the
  * optstring starts with ':'); returns CLI_USAGE. */
@@ -117,6 +117,7 @@ typedef struct cli_sources_and_cost {
     mfmm_source *src; /* room for one source per argument */
     int32_t n_src;
     double *cost;     /* loaded by cli_sources_and_cost_load */
+    double exact_start_radius; /* --exact-start-radius R, --plain-start (0) */
 } cli_sources_and_cost;
 
 /* The shared options, for a command's getopt_long table. */
@@ -125,7 +126,16 @@ typedef struct cli_sources_and_cost {
         {"source", required_argument, NULL, OPT_SOURCE},                                     \
         {"face-source", required_argument, NULL, OPT_FACE_SOURCE},                           \
         {"cost", required_argument, NULL, OPT_COST},                                         \
-        {"cost-per-face", no_argument, NULL, OPT_COST_PER_FACE}
+        {"cost-per-face", no_argument, NULL, OPT_COST_PER_FACE},                             \
+        {"plain-start", no_argument, NULL, OPT_PLAIN_START},                                 \
+        {"exact-start-radius", required_argument, NULL, OPT_EXACT_START_RADIUS}
+/* The help lines of the start options (distance, path, allpairs). */
+#define CLI_START_HELP                                                                       \
+    "  --exact-start-radius R  start the march from exact distances within R mean\n"        \
+    "                          edge lengths of each source (default 6)\n"                   \
+    "  --plain-start           the paper's start (as --exact-start-radius 0)\n"
+/* Parses --exact-start-radius's value: CLI_OK, or CLI_USAGE with the error printed. */
+int cli_parse_start_radius(const char *sub, const char *arg, double *radius);
 #define CLI_SHARED_SHORT_OPTIONS ":ho:"
 
 /* 0, or -1 with "out of memory" printed. argc: the subcommand's. */

@@ -18,6 +18,7 @@ static void help(FILE *out)
             "                        [--backend auto|opencl|serial|threads] [--sources FILE]\n"
             "                        [--targets FILE]\n"
             "                        [--cost FILE [--cost-per-face]] [--max-distance X]\n"
+            "                        [--exact-start-radius R | --plain-start]\n"
             "                        [--threads N] [--memory MB] [--quiet]\n\n"
             "The geodesic distance matrix: one row per source (default every vertex), one\n"
             "column per vertex, streamed into a .npy file block by block (the matrix is\n"
@@ -39,6 +40,9 @@ static void help(FILE *out)
             "                      vertex (default) or per face (--cost-per-face), as in\n"
             "                      meshfmm distance\n"
             "  --max-distance X    stop each row past X; farther vertices get inf\n"
+            "  --exact-start-radius R  each row's march starts from exact distances within\n"
+            "                      R mean edge lengths of its source (default 6)\n"
+            "  --plain-start       the paper's start (as --exact-start-radius 0)\n"
             "  --threads N         threads for the threads backend (0, the default: all cores)\n"
             "  --memory MB         memory for workspaces and blocks in flight\n"
             "  --quiet             no progress lines\n\n"
@@ -203,6 +207,8 @@ int cmd_allpairs(int argc, char **argv)
         {"max-distance", required_argument, NULL, OPT_MAX_DISTANCE},
         {"threads", required_argument, NULL, OPT_THREADS},
         {"memory", required_argument, NULL, OPT_MEMORY},
+        {"plain-start", no_argument, NULL, OPT_PLAIN_START},
+        {"exact-start-radius", required_argument, NULL, OPT_EXACT_START_RADIUS},
         {NULL, 0, NULL, 0}};
     int c;
     opterr = 0;
@@ -249,6 +255,13 @@ int cmd_allpairs(int argc, char **argv)
         case OPT_THREADS:
             if (!cli_parse_int32(val, &o.n_threads) || o.n_threads < 0)
                 return cli_usage_error("allpairs", "--threads needs a count >= 0 (0: all cores)");
+            break;
+        case OPT_PLAIN_START:
+            o.exact_start_radius = 0.0;
+            break;
+        case OPT_EXACT_START_RADIUS:
+            if (cli_parse_start_radius("allpairs", val, &o.exact_start_radius) != CLI_OK)
+                return CLI_USAGE;
             break;
         case OPT_MEMORY: {
             double mb;

@@ -13,6 +13,7 @@ static void help(FILE *out)
             "usage: meshfmm path MESH --source I [--source J ...] [--face-source F W0 W1 W2 ...]\n"
             "                    (--target J | --target-face F W0 W1 W2)\n"
             "                    [--cost FILE [--cost-per-face]] [--max-points N] [--no-straighten]\n"
+            "                    [--exact-start-radius R | --plain-start]\n"
             "                    -o OUT\n\n"
             "The minimal geodesic from the target back to the nearest source: distances by\n"
             "Fast Marching, then backtracking along -grad T (Heun's method). Prints the\n"
@@ -24,6 +25,7 @@ static void help(FILE *out)
             "  --cost FILE             slowness F (.npy or .txt), per vertex (default) or per\n"
             "                          face (--cost-per-face)\n"
             "  --max-points N          most points the path may have (default 100000)\n"
+            CLI_START_HELP
             "  --no-straighten         keep the traced path of section 5 (by default it is\n"
             "                          straightened inside the strip of faces it crossed)\n"
             "  -o, --output OUT        .csv (face,b0,b1,b2,x,y,z per point, with a header) or\n"

@@ -1,6 +1,7 @@
 /* Options shared by `distance` and `path`: the mesh, the sources, the cost
  * file and the output; their checks and the cost loader. */
 #include <getopt.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -12,6 +13,7 @@ int cli_sources_and_cost_init(cli_sources_and_cost *o, const char *sub, void (*h
     memset(o, 0, sizeof *o);
     o->sub = sub;
     o->help = help;
+    o->exact_start_radius = MFMM_EXACT_START_RADIUS;
     o->src = malloc((size_t)argc * sizeof *o->src); /* at most one per argument */
     if (!o->src) {
         cli_error("out of memory");
@@ -58,6 +60,11 @@ int cli_sources_and_cost_opt(cli_sources_and_cost *o, int c, int argc, char **ar
     case 'o':
         o->out_path = optarg;
         return CLI_OK;
+    case OPT_PLAIN_START:
+        o->exact_start_radius = 0.0;
+        return CLI_OK;
+    case OPT_EXACT_START_RADIUS:
+        return cli_parse_start_radius(o->sub, optarg, &o->exact_start_radius);
     default:
         return cli_getopt_error(o->sub, c, argv);
     }
@@ -144,7 +151,13 @@ double *cli_solve_distances(const mfmm_mesh *mesh, const cli_sources_and_cost *o
         return NULL;
     }
     mfmm_error err;
-    st = mfmm_solve(solver, o->src, o->n_src, opt, dist, &err);
+    mfmm_solve_options so;
+    if (opt)
+        so = *opt;
+    else
+        mfmm_solve_options_init(&so);
+    so.exact_start_radius = o->exact_start_radius;
+    st = mfmm_solve(solver, o->src, o->n_src, &so, dist, &err);
     mfmm_solver_destroy(solver);
     if (st != MFMM_OK) {
         cli_error("%s", err.message);
@@ -152,4 +165,12 @@ double *cli_solve_distances(const mfmm_mesh *mesh, const cli_sources_and_cost *o
         return NULL;
     }
     return dist;
+}
+
+int cli_parse_start_radius(const char *sub, const char *arg, double *radius)
+{
+    if (!cli_parse_double(arg, radius) || !(*radius >= 0) || !(*radius < INFINITY))
+        return cli_usage_error(sub, "--exact-start-radius needs a finite number >= 0, not '%s'",
+                               arg);
+    return CLI_OK;
 }

@@ -56,6 +56,7 @@ typedef struct mfmm_corner {
 #define MFMM_ALIVE 2
 #define MFMM_STATE_MASK 3
 #define MFMM_TARGET 4
+#define MFMM_FIXED 8 /* a seed whose value is exact (the exact start): never lowered */
 
 /* A hint to fetch memory early (the march is bound by cache misses); a
  * no-op where the compiler has no such builtin. PoCL compiles with clang. */

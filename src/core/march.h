@@ -202,6 +202,16 @@ MFMM_INLINE int mfmm_march_virt_ok(const mfmm_march_state *s, const mfmm_march_m
     return 1;
 }
 
+/* Seeds v at an exact value (the exact start, src/solve/seed.h): as
+ * mfmm_march_seed, and the march never lowers it, since an update from
+ * first-order neighbours can only add error to an exact value. */
+MFMM_INLINE void mfmm_march_seed_fixed(mfmm_march_state *s, mfmm_i32 v, double value)
+{
+    mfmm_march_seed(s, v, value);
+    if (s->T[v] == value)
+        s->label[v] = (mfmm_u8)(s->label[v] | MFMM_FIXED);
+}
+
 /* Section 2's loop: settle the Close vertex of least T, recompute its
  * neighbours from settled values, until the heap is empty, T passes
  * max_distance, or every target is settled. Vertices not settled are set
@@ -233,8 +243,8 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
         }
         for (mfmm_i32 j = m->update_offset[x]; j < end; j++) {
             mfmm_i32 c = m->update_corner[2 * j + 1];
-            mfmm_u8 st = s->label[c] & MFMM_STATE_MASK;
-            if (st == MFMM_ALIVE)
+            mfmm_u8 lc = s->label[c], st = lc & MFMM_STATE_MASK;
+            if (st == MFMM_ALIVE || (lc & MFMM_FIXED))
                 continue;
             mfmm_i32 r = m->update_corner[2 * j];
             MFMM_GLOBAL const mfmm_corner *cr = m->corners + r;

@@ -1,4 +1,4 @@
-/* The exact start around a point source (start.h). Issue 9.3: seeding only
+/* The straight start around a point source (start.h). Issue 9.3: seeding only
  * the source face's corners and the far vertices across its edges made T
  * depend on which face names a point on an edge and jump when the point
  * moves off the edge. Here the faces holding the point are all start faces,
@@ -9,7 +9,8 @@
  * from; where the corner's angle sum exceeds 2 pi, the start from the corner
  * reaches vertices behind it (through it) that a point beside it does not,
  * and T jumps by the march's own error there (hand: 16 % of sampled corner
- * approaches, up to 0.6 % of the diagonal). */
+ * approaches, up to 0.6 % of the diagonal); the exact start (src/solve)
+ * removes that where it applies. */
 #include <math.h>
 #include <string.h>
 
@@ -292,4 +293,28 @@ void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double
     start_face(&w, first, p);
     if (second >= 0 && !w.stop)
         start_face(&w, second, p);
+}
+
+typedef struct seed_ctx {
+    mfmm_march_state *st;
+    double value;
+} seed_ctx;
+
+static int seed_point_hit(void *user, const mfmm_start_hit *h)
+{
+    seed_ctx *c = user;
+    mfmm_march_seed(c->st, h->vertex, c->value + h->cost_length);
+    return 0;
+}
+
+void mfmm_start_seed(const mfmm_mesh *mesh, mfmm_march_state *st, const mfmm_source *src)
+{
+    if (src->face < 0) {
+        mfmm_march_seed(st, src->vertex, src->value);
+        return;
+    }
+    /* a point on the surface: every vertex a straight segment reaches near
+     * it starts at that segment's cost */
+    seed_ctx c = {st, src->value};
+    mfmm_start_walk(mesh, src, st->cost, st->cost_location, seed_point_hit, &c);
 }

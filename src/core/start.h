@@ -1,6 +1,7 @@
-/* The exact start around a point source (private to the library): every
+/* The straight start around a point source (private to the library): every
  * vertex that a straight segment from the point reaches through the unfolded
- * faces near it, with that segment. Used to seed a march (solve.c) and by the
+ * faces near it, with that segment. Used to seed a march (the paper's plain
+ * start, and where the exact start of src/solve does not apply) and by the
  * tracer to end a path at the source (paths/trace.c). */
 #ifndef MFMM_START_H
 #define MFMM_START_H
@@ -39,5 +40,10 @@ typedef int (*mfmm_start_fn)(void *user, const mfmm_start_hit *hit);
  * in that face. */
 void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double *cost,
                      int cost_location, mfmm_start_fn fn, void *user);
+
+/* Seeds a checked source into a reset march state (cost fields set): a
+ * vertex at its value, a point through mfmm_start_walk at value plus each
+ * segment's cost. */
+void mfmm_start_seed(const mfmm_mesh *mesh, mfmm_march_state *st, const mfmm_source *src);
 
 #endif

@@ -77,7 +77,7 @@
 
 #include "exact/exact.h"
 #include "core/mesh.h"
-#include "core/solve.h"
+#include "core/check.h"
 
 #define EX_PI 3.14159265358979323846264338328
 #define EX_TWO_PI 6.283185307179586476925286766559
@@ -93,6 +93,9 @@
 #define EX_MIN_WIDTH 1e-13
 /* a point of an edge this close (relative) to a window's end is in it */
 #define EX_POS_TOL 1e-12
+/* a vertex this near (in edge lengths) to the pseudo-source of the path
+ * that reached it starts windows all around (ex_set_in) */
+#define EX_NEAR 1e-3
 /* a vertex whose angle sum exceeds 2 pi by this much is a saddle */
 #define EX_SADDLE_TOL 1e-12
 
@@ -333,12 +336,14 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
             double L = r->len[k];
             const double *a = X + 3 * (size_t)fv[(k + 1) % 3], *b = X + 3 * (size_t)fv[(k + 2) % 3],
                          *c = X + 3 * (size_t)fv[k];
-            double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+            /* e a unit vector, so that no product is a length to the 4th
+             * power (which underflows at 1e-90 and overflows at 1e90) */
+            double e[3] = {(b[0] - a[0]) / L, (b[1] - a[1]) / L, (b[2] - a[2]) / L};
             double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
             double cr[3] = {e[1] * w[2] - e[2] * w[1], e[2] * w[0] - e[0] * w[2],
                             e[0] * w[1] - e[1] * w[0]};
-            double x = (e[0] * w[0] + e[1] * w[1] + e[2] * w[2]) / L;
-            double y = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]) / L;
+            double x = e[0] * w[0] + e[1] * w[1] + e[2] * w[2];
+            double y = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
             r->cx[k] = x;
             r->cy[k] = y;
             if (!(L > 0.0) || !(y > 0.0) || !isfinite(x) || !isfinite(y))
@@ -594,9 +599,18 @@ static int ex_update(mfmm_exact_ws *ws, int32_t v, double dist, int force)
 }
 
 /* in_angle of v = corner c's vertex from the angle psi inside the corner,
- * measured from the direction to the corner's first vertex. */
-static void ex_set_in(mfmm_exact_ws *ws, int32_t v, int32_t c, double psi)
+ * measured from the direction to the corner's first vertex; r: the length of
+ * the path's last straight piece (from its pseudo-source to v), L: an edge
+ * length of the face. */
+static void ex_set_in(mfmm_exact_ws *ws, int32_t v, int32_t c, double psi, double r, double L)
 {
+    /* a pseudo-source (a point source) almost at v: the windows passing
+     * beside v then tie with the paths through v to rounding and are trimmed
+     * away near the straight-on direction, wider than the shadow's margin
+     * (a point 1e-9 beside a saddle of hand left vertices at +inf): v starts
+     * windows all around, as a source does (sound: they are real paths) */
+    if (r < EX_NEAR * L)
+        return;
     /* a direction outside the corner (rounding at a grazing ray) is not
      * trusted: in_angle stays NaN and v starts windows all around */
     if (!(psi >= -1e-9 && psi <= ws->angle[c] + 1e-9))
@@ -655,12 +669,12 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
     if (s1 > L)
         s1 = L;
     double iy2 = iy * iy;
-    if (s0 <= EX_POS_TOL * L && ex_update(ws, va, sigma + sqrt(ix * ix + iy2), 0))
-        ex_set_in(ws, va, h - k + (k == 2 ? 0 : k + 1), atan2(iy, ix));
-    if (s1 >= L - EX_POS_TOL * L &&
-        ex_update(ws, vb, sigma + sqrt((ix - L) * (ix - L) + iy2), 0)) {
+    double ra = sqrt(ix * ix + iy2), rb = sqrt((ix - L) * (ix - L) + iy2);
+    if (s0 <= EX_POS_TOL * L && ex_update(ws, va, sigma + ra, 0))
+        ex_set_in(ws, va, h - k + (k == 2 ? 0 : k + 1), atan2(iy, ix), ra, L);
+    if (s1 >= L - EX_POS_TOL * L && ex_update(ws, vb, sigma + rb, 0)) {
         int32_t c = h - k + (k == 0 ? 2 : k - 1);
-        ex_set_in(ws, vb, c, ws->angle[c] - atan2(iy, L - ix));
+        ex_set_in(ws, vb, c, ws->angle[c] - atan2(iy, L - ix), rb, L);
     }
     int32_t g = r->across[k];
     if (g < 0 || !(s1 - s0 > EX_MIN_WIDTH * L))
@@ -733,10 +747,11 @@ static void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
     double tol = EX_POS_TOL * L;
     if (tc >= b0 - tol && tc <= b1 + tol) {
         double ex = cx - px, ey = cy - py;
-        if (ex_update(ws, vc, sigma + sqrt(ex * ex + ey * ey), 0)) {
+        double rc = sqrt(ex * ex + ey * ey);
+        if (ex_update(ws, vc, sigma + rc, 0)) {
             /* angle at C between C -> A = (-cx, -cy) and C -> I = (-ex, -ey) */
             double cr = cx * ey - cy * ex, dt = cx * ex + cy * ey;
-            ex_set_in(ws, vc, h, atan2(fabs(cr), dt));
+            ex_set_in(ws, vc, h, atan2(fabs(cr), dt), rc, L);
         }
     }
     int m1 = m == 2 ? 0 : m + 1, m2 = m == 0 ? 2 : m - 1;

@@ -8,7 +8,8 @@
 #include <unistd.h>
 
 #include "rows.h"
-#include "core/solve.h"
+#include "solve/seed.h"
+#include "solve/solve.h"
 
 const char *mfmm_backend_name(mfmm_backend backend)
 {
@@ -40,6 +41,7 @@ void mfmm_matrix_options_init(mfmm_matrix_options *options)
     options->user = NULL;
     options->backend_used = MFMM_BACKEND_AUTO;
     options->opencl = NULL;
+    options->exact_start_radius = MFMM_EXACT_START_RADIUS;
 }
 
 /* Rows per block for the CPU engines: the budget less the solvers'
@@ -49,6 +51,8 @@ static int32_t cpu_block_rows(const mfmm_rows_job *job, int n_workers, int ring)
     size_t nv = (size_t)job->mesh->nv;
     size_t row_bytes = job->slot_bytes;
     size_t work = (size_t)n_workers * nv * 32; /* solver + a float64 row */
+    if (job->opt->exact_start_radius > 0.0) /* each solver's exact start */
+        work += (size_t)n_workers * mfmm_exact_start_bytes(job->mesh);
     size_t left = job->budget > work ? job->budget - work : 0;
     /* ring 0: rows go straight into the caller's buffer */
     size_t rows = left / ((size_t)(ring > 0 ? ring : 1) * row_bytes);
@@ -70,6 +74,7 @@ static void fill_solve_options(const mfmm_rows_job *job, mfmm_solve_options *so)
     so->unfolding = job->opt->unfolding != 0;
     so->targets = job->targets;
     so->n_targets = job->targets ? job->width : 0;
+    so->exact_start_radius = job->opt->exact_start_radius;
 }
 
 static int cmp_i32(const void *a, const void *b)
@@ -106,6 +111,8 @@ static int64_t solve_row(const mfmm_rows_job *job, mfmm_solver *solver,
         if (job->elem_size == sizeof(double))
             return mfmm_solve_checked(solver, &src, 1, so, (double *)dst);
         int32_t settled = mfmm_solve_checked(solver, &src, 1, so, tmp);
+        if (settled < 0)
+            return -1;
         float *f = (float *)dst;
         for (int32_t v = 0; v < nv; v++)
             f[v] = (float)tmp[v];
@@ -115,6 +122,8 @@ static int64_t solve_row(const mfmm_rows_job *job, mfmm_solver *solver,
     const int32_t *touched;
     int32_t n_touched;
     int32_t settled = mfmm_solve_local(solver, &src, 1, so, &T, &touched, &n_touched);
+    if (settled < 0)
+        return -1;
     if (!job->sparse) {
         for (int32_t j = 0; j < job->width; j++)
             put_value(job, dst, (size_t)j, T[job->targets[j]]);
@@ -463,6 +472,8 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     if (o->max_distance < 0.0)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
                          "max_distance is %g; it must be >= 0 (+inf: no limit)", o->max_distance);
+    if (mfmm_check_exact_start(o->exact_start_radius, err) != MFMM_OK)
+        return MFMM_ERR_BAD_ARGUMENT;
     if (o->n_threads < 0)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "n_threads is %d, must be >= 0",
                          (int)o->n_threads);

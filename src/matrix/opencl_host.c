@@ -10,6 +10,7 @@
 
 #include "rows.h"
 #include "opencl_loader.h"
+#include "solve/seed.h"
 
 void mfmm_opencl_options_init(mfmm_opencl_options *options)
 {
@@ -725,6 +726,75 @@ static int starved(const ocl *cl, int32_t batch, int32_t rows)
     return batch < want;
 }
 
+/* A batch's exact-start seeds (solve/seed.h), as the kernel reads them:
+ * idx[0 .. count] the rows' ranges [idx[i], idx[i + 1]) of idx (vertices)
+ * and val (values; its first count + 1 entries unused); n entries used. */
+typedef struct seed_buf {
+    int32_t *idx;
+    double *val;
+    size_t cap, n;
+} seed_buf;
+
+static int seed_room(seed_buf *b, size_t need)
+{
+    if (need <= b->cap)
+        return 0;
+    size_t cap = b->cap ? b->cap : 1024;
+    while (cap < need)
+        cap *= 2;
+    int32_t *idx = realloc(b->idx, cap * sizeof *idx);
+    if (idx)
+        b->idx = idx;
+    double *val = idx ? realloc(b->val, cap * sizeof *val) : NULL;
+    if (val)
+        b->val = val;
+    if (!idx || !val)
+        return -1;
+    b->cap = cap;
+    return 0;
+}
+
+/* The seeds of rows [first, first + count), computed as the serial solver
+ * computes them (solve.c's seed_source with a vertex source at value 0). */
+static mfmm_status batch_seeds(const mfmm_rows_job *job, mfmm_exact_ws **ws,
+                               const double *uniform, int32_t first, int32_t count, seed_buf *b)
+{
+    size_t pos = (size_t)count + 1;
+    if (seed_room(b, pos))
+        return MFMM_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < pos; i++)
+        b->val[i] = 0.0;
+    for (int32_t i = 0; i < count; i++) {
+        mfmm_source src;
+        memset(&src, 0, sizeof src);
+        src.vertex = job->sources[first + i];
+        src.face = -1;
+        src.value = 0.0;
+        int32_t n = 0;
+        const int32_t *pv = NULL;
+        const double *pd = NULL;
+        double f = 1.0;
+        mfmm_status st = mfmm_exact_start(job->mesh, ws, &src, job->opt->exact_start_radius,
+                                          job->cost, job->cost ? uniform : NULL, &n, &pv, &pd, &f);
+        if (st != MFMM_OK)
+            return st;
+        b->idx[i] = (int32_t)pos;
+        if (seed_room(b, pos + (size_t)(n > 0 ? n : 1)))
+            return MFMM_ERR_OUT_OF_MEMORY;
+        if (n == 0) { /* the straight start of a vertex: the vertex */
+            b->idx[pos] = src.vertex;
+            b->val[pos++] = src.value;
+        }
+        for (int32_t j = 0; j < n; j++) {
+            b->idx[pos] = pv[j];
+            b->val[pos++] = src.value + f * pd[j];
+        }
+    }
+    b->idx[count] = (int32_t)pos;
+    b->n = pos;
+    return MFMM_OK;
+}
+
 /* Rows [start, n_sources) of the job on `shared`'s device and program, with
  * this call's own queue, kernel and buffers. */
 static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t start,
@@ -755,6 +825,10 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     double one = 1.0;
     int32_t no_target = 0;
     cl_int n_targets = job->targets ? (cl_int)job->width : 0;
+    int exact = job->opt->exact_start_radius > 0.0;
+    mfmm_exact_ws *ews = NULL;
+    seed_buf sb;
+    memset(&sb, 0, sizeof sb);
 
     /* the mesh, read-only, used in place where the driver allows */
     cl_mem_flags ro = CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR;
@@ -782,7 +856,7 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
                                        mesh->strip, &e);
     /* with a cost: the cost around each vertex, for the virtual stencils
      * (march.h), once for the job */
-    if (e == CL_SUCCESS && job->cost && job->opt->unfolding) {
+    if (e == CL_SUCCESS && job->cost && (job->opt->unfolding || exact)) {
         uniform = malloc(nv * sizeof *uniform);
         if (!uniform) {
             st = mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for %d costs", (int)nv);
@@ -882,6 +956,12 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         e |= api->clSetKernelArg(cl.kernel, 20, sizeof n_targets, &n_targets);
         e |= api->clSetKernelArg(cl.kernel, 21, sizeof(cl_mem), &t_ws);
     }
+    /* the seeds (set per batch with the exact start; else unused) */
+    cl_uint seed_arg = f64 ? 21 : 22;
+    cl_int n_seeds = exact;
+    e |= api->clSetKernelArg(cl.kernel, seed_arg, sizeof n_seeds, &n_seeds);
+    e |= api->clSetKernelArg(cl.kernel, seed_arg + 1, sizeof(cl_mem), &mem[MB_SOURCES]);
+    e |= api->clSetKernelArg(cl.kernel, seed_arg + 2, sizeof(cl_mem), &mem[MB_COST]);
     if (e != CL_SUCCESS) {
         st = runtime_fail(err, "clSetKernelArg", e);
         goto done;
@@ -894,18 +974,56 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         if (k < n_batches) {
             cl_int first = start + k * batch;
             cl_int count = job->n_sources - first < batch ? job->n_sources - first : batch;
-            size_t global = (size_t)count, local = 1;
+            int kernel_queued = 0;
             e = api->clSetKernelArg(cl.kernel, 9, sizeof first, &first);
             e |= api->clSetKernelArg(cl.kernel, 10, sizeof count, &count);
             if (e != CL_SUCCESS) {
                 st = runtime_fail(err, "clSetKernelArg", e);
                 goto done;
             }
-            e = api->clEnqueueNDRangeKernel(cl.queue, cl.kernel, 1, NULL, &global, &local, 0, NULL,
-                                       NULL);
-            if (e != CL_SUCCESS) {
-                st = runtime_fail(err, "clEnqueueNDRangeKernel", e);
-                goto done;
+            if (exact) {
+                seed_buf *b = &sb;
+                st = batch_seeds(job, &ews, uniform, first, count, b);
+                if (st != MFMM_OK) {
+                    st = mfmm_fail(err, st, first, "out of memory for the exact start of rows "
+                                                   "from %d", (int)first);
+                    goto done;
+                }
+                /* copied at creation; released now, freed by OpenCL once the
+                 * kernel that uses them is done */
+                cl_mem m_idx = api->clCreateBuffer(cl.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                                   b->n * sizeof(int32_t), b->idx, &e);
+                cl_mem m_val = NULL;
+                if (e == CL_SUCCESS)
+                    m_val = api->clCreateBuffer(cl.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                                b->n * sizeof(double), b->val, &e);
+                if (e == CL_SUCCESS)
+                    e = api->clSetKernelArg(cl.kernel, seed_arg + 1, sizeof(cl_mem), &m_idx);
+                if (e == CL_SUCCESS)
+                    e = api->clSetKernelArg(cl.kernel, seed_arg + 2, sizeof(cl_mem), &m_val);
+                if (e == CL_SUCCESS) {
+                    size_t global = (size_t)count, local = 1;
+                    e = api->clEnqueueNDRangeKernel(cl.queue, cl.kernel, 1, NULL, &global, &local,
+                                                    0, NULL, NULL);
+                    kernel_queued = 1;
+                }
+                if (m_idx)
+                    api->clReleaseMemObject(m_idx);
+                if (m_val)
+                    api->clReleaseMemObject(m_val);
+                if (e != CL_SUCCESS) {
+                    st = runtime_fail(err, "uploading the exact start's seeds", e);
+                    goto done;
+                }
+            }
+            if (!kernel_queued) {
+                size_t global = (size_t)count, local = 1;
+                e = api->clEnqueueNDRangeKernel(cl.queue, cl.kernel, 1, NULL, &global, &local, 0,
+                                                NULL, NULL);
+                if (e != CL_SUCCESS) {
+                    st = runtime_fail(err, "clEnqueueNDRangeKernel", e);
+                    goto done;
+                }
             }
             void *dst = direct ? (char *)job->opt->out + (size_t)first * row_bytes
                                : host + (size_t)(k & 1) * (size_t)batch * row_bytes;
@@ -956,6 +1074,9 @@ done:
             api->clReleaseMemObject(mem[i]);
     free(host);
     free(uniform);
+    free(sb.idx);
+    free(sb.val);
+    mfmm_exact_ws_destroy(ews);
     ocl_release_call(&cl);
     return st;
 }

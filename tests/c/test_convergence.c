@@ -1,6 +1,8 @@
 /* Convergence against analytic distances: flat grid (Euclidean), unit
  * icosphere (great circle), and the stretched lattice whose corners are all
- * 120 degrees, with and without the unfolding of section 4.2. */
+ * 120 degrees, with and without the unfolding of section 4.2. The calibrated
+ * orders are the paper's plain start's (exact_start_radius 0); the exact
+ * start (issue 12) is checked against it on the same meshes. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -12,8 +14,8 @@
 
 /* Mean relative error (%) of a solve from the vertex nearest `src` against
  * Euclidean (sphere = 0) or great-circle (sphere = 1) distance. */
-static double solve_error(mfmm_gen_mesh *g, const double src[3], int sphere, int unfolding,
-                          double *max_err)
+static double solve_error_r(mfmm_gen_mesh *g, const double src[3], int sphere, int unfolding,
+                            double exact_r, double *max_err)
 {
     mfmm_mesh *mesh = tm_make(g);
     mfmm_solver *solver = NULL;
@@ -26,6 +28,7 @@ static double solve_error(mfmm_gen_mesh *g, const double src[3], int sphere, int
     mfmm_solve_options opt;
     mfmm_solve_options_init(&opt);
     opt.unfolding = unfolding;
+    opt.exact_start_radius = exact_r;
     assert_int_equal(mfmm_solve(solver, &source, 1, &opt, d, NULL), MFMM_OK);
     const double *p = g->V + 3 * (size_t)s;
     for (int32_t v = 0; v < g->nv; v++) {
@@ -46,6 +49,13 @@ static double solve_error(mfmm_gen_mesh *g, const double src[3], int sphere, int
     mfmm_solver_destroy(solver);
     mfmm_mesh_destroy(mesh);
     return mre;
+}
+
+/* The plain start (the paper's), whose orders the tests below calibrate. */
+static double solve_error(mfmm_gen_mesh *g, const double src[3], int sphere, int unfolding,
+                          double *max_err)
+{
+    return solve_error_r(g, src, sphere, unfolding, 0.0, max_err);
 }
 
 static void test_flat_grid_converges(void **state)
@@ -119,12 +129,69 @@ static void test_obtuse_lattice_needs_unfolding(void **state)
     assert_true(order_plain < 0.2);
 }
 
+/* The exact start (default radius) against the plain start on the meshes
+ * above: never worse in mean error; on the icospheres of 2.5k and 10k
+ * vertices at most 0.6x (issue 12's target). Prints the rows of the
+ * convergence table of bench/RESULTS.md. */
+static void test_exact_start_lowers_error(void **state)
+{
+    (void)state;
+    double h[4], plain[4], exact[4];
+    for (int i = 0; i < 4; i++) {
+        mfmm_gen_mesh g = mfmm_gen_icosphere(4 + i);
+        const double top[3] = {g.V[0], g.V[1], g.V[2]};
+        h[i] = 1.0 / sqrt((double)g.nv);
+        double mx_p, mx_e;
+        plain[i] = solve_error_r(&g, top, 1, 1, 0.0, &mx_p);
+        exact[i] = solve_error_r(&g, top, 1, 1, MFMM_EXACT_START_RADIUS, &mx_e);
+        print_message("icosphere nv=%d: plain %.4f%% (max %.4f%% of pi), exact start %.4f%% "
+                      "(max %.4f%%), ratio %.3f\n",
+                      g.nv, plain[i], mx_p, exact[i], mx_e, exact[i] / plain[i]);
+        assert_true(exact[i] <= plain[i]);
+        assert_true(mx_e <= mx_p);
+        if (i < 2)
+            assert_true(exact[i] <= 0.6 * plain[i]);
+        mfmm_gen_free(&g);
+    }
+    print_message("icosphere fitted order: plain %.3f, exact start %.3f\n",
+                  tm_fitted_order(h, plain, 4), tm_fitted_order(h, exact, 4));
+    const double c[3] = {1.5, 0.43, 0.0};
+    for (int i = 0; i < 4; i++) {
+        int n = 20 << i;
+        mfmm_gen_mesh g = mfmm_gen_lattice(n, 3.0);
+        h[i] = 1.0 / n;
+        plain[i] = solve_error_r(&g, c, 0, 1, 0.0, NULL);
+        exact[i] = solve_error_r(&g, c, 0, 1, MFMM_EXACT_START_RADIUS, NULL);
+        print_message("lattice n=%d: plain %.4f%%, exact start %.4f%%, ratio %.3f\n", n, plain[i],
+                      exact[i], exact[i] / plain[i]);
+        assert_true(exact[i] <= plain[i]);
+        mfmm_gen_free(&g);
+    }
+    print_message("lattice fitted order: plain %.3f, exact start %.3f\n",
+                  tm_fitted_order(h, plain, 4), tm_fitted_order(h, exact, 4));
+    const double cg[3] = {0.5, 0.5, 0.0};
+    for (int i = 0; i < 4; i++) {
+        int n = 20 << i;
+        mfmm_gen_mesh g = mfmm_gen_grid(n);
+        h[i] = 1.0 / n;
+        plain[i] = solve_error_r(&g, cg, 0, 1, 0.0, NULL);
+        exact[i] = solve_error_r(&g, cg, 0, 1, MFMM_EXACT_START_RADIUS, NULL);
+        print_message("grid n=%d: plain %.4f%%, exact start %.4f%%, ratio %.3f\n", n, plain[i],
+                      exact[i], exact[i] / plain[i]);
+        assert_true(exact[i] <= plain[i]);
+        mfmm_gen_free(&g);
+    }
+    print_message("grid fitted order: plain %.3f, exact start %.3f\n",
+                  tm_fitted_order(h, plain, 4), tm_fitted_order(h, exact, 4));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_flat_grid_converges),
         cmocka_unit_test(test_icosphere_converges),
         cmocka_unit_test(test_obtuse_lattice_needs_unfolding),
+        cmocka_unit_test(test_exact_start_lowers_error),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -52,6 +52,7 @@ static int check_opencl(const mfmm_mesh *mesh, const int32_t *src, int32_t n, co
         o.cost_location = so->cost_location;
         o.max_distance = so->max_distance;
         o.unfolding = so->unfolding;
+        o.exact_start_radius = so->exact_start_radius;
     }
     mfmm_error err;
     mfmm_status st = mfmm_distance_matrix(mesh, src, n, &o, &err);
@@ -119,23 +120,33 @@ static void test_generated_meshes(void **state)
             assert_int_equal(count_files(cache_dir), 1);
         check_opencl(mesh, src, n, ref, MFMM_FLOAT32, 1, (size_t)nv * 60 * 3, NULL);
         free(ref);
-        /* per-vertex cost, and plain stencils (no unfolding) */
-        double *vcost = malloc((size_t)nv * sizeof *vcost);
+        /* per-vertex cost (varied: the straight start), plain stencils (no
+         * unfolding), the paper's plain start, a uniform cost (the exact
+         * start at F = 2), a larger exact start */
+        double *vcost = malloc((size_t)nv * sizeof *vcost), *ucost = malloc((size_t)nv * sizeof *ucost);
         assert_non_null(vcost);
-        for (int32_t v = 0; v < nv; v++)
+        assert_non_null(ucost);
+        for (int32_t v = 0; v < nv; v++) {
             vcost[v] = 0.5 + 0.1 * (double)(v % 13);
-        mfmm_solve_options so[2];
-        mfmm_solve_options_init(&so[0]);
-        mfmm_solve_options_init(&so[1]);
+            ucost[v] = 2.0;
+        }
+        mfmm_solve_options so[5];
+        for (int k = 0; k < 5; k++)
+            mfmm_solve_options_init(&so[k]);
         so[0].cost = vcost;
         so[0].cost_location = MFMM_COST_PER_VERTEX;
         so[1].unfolding = 0;
-        for (int k = 0; k < 2; k++) {
+        so[2].exact_start_radius = 0.0;
+        so[3].cost = ucost;
+        so[3].cost_location = MFMM_COST_PER_VERTEX;
+        so[4].exact_start_radius = 12.0;
+        for (int k = 0; k < 5; k++) {
             ref = tm_reference_rows(mesh, src, n, &so[k]);
             assert_true(check_opencl(mesh, src, n, ref, MFMM_FLOAT64, 0, 0, &so[k]));
             free(ref);
         }
         free(vcost);
+        free(ucost);
         free(src);
         mfmm_mesh_destroy(mesh);
         mfmm_gen_free(&g[m]);

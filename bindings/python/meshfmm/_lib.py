@@ -166,6 +166,7 @@ class mfmm_solve_options(Structure):
         ("targets", c_void_p),  # const int32_t *
         ("n_targets", c_int32),
         ("unfolding", c_int32),
+        ("exact_start_radius", c_double),  # appended: the exact start, in mean edge lengths
     ]
 
 
@@ -248,6 +249,7 @@ class mfmm_matrix_options(Structure):
         ("n_targets", c_int32),
         ("vertices_settled", c_int64),  # out
         ("on_sparse", mfmm_sparse_callback),
+        ("exact_start_radius", c_double),  # appended: as in mfmm_solve_options
     ]
 
 

@@ -236,6 +236,24 @@ def _cost_array(cost: Any, cost_location: Optional[str], nv: int, nf: int) -> Tu
     return c, loc
 
 
+def _exact_start(x: Any) -> Optional[float]:
+    """The exact_start option: True (the library's default radius) -> None,
+    False -> 0.0 (the paper's plain start), a number -> that radius in mean
+    edge lengths (finite, >= 0)."""
+    if x is True:
+        return None
+    if x is False:
+        return 0.0
+    if isinstance(x, (bool, np.bool_)):
+        return None if x else 0.0
+    if isinstance(x, (str, bytes)) or not isinstance(x, (int, float, np.integer, np.floating)):
+        raise ValueError(f"exact_start must be True, False or a radius in mean edge lengths, not {x!r}")
+    r = float(x)
+    if not np.isfinite(r) or r < 0:
+        raise ValueError(f"exact_start radius must be finite and >= 0, not {r}")
+    return r
+
+
 def _max_distance(x: Any) -> float:
     """max_distance as a C double: None -> +inf; a real number >= 0 (+inf
     allowed). Strings, bools and other types are a TypeError (no silent
@@ -477,6 +495,7 @@ class Mesh:
         unfolding: bool = True,
         cost_location: Optional[str] = None,
         method: str = "fmm",
+        exact_start: Any = True,
     ) -> np.ndarray:
         """Distance from the nearest source to every vertex, float64 (n_vertices,).
 
@@ -491,6 +510,12 @@ class Mesh:
         targets: vertex ids; the march stops once all of them are settled
             (then only settled vertices are final, the rest may be +inf).
         unfolding: False uses plain stencils at obtuse corners (for comparison).
+        exact_start: True (default): the march starts from the exact
+            distances of the vertices within 6 mean edge lengths of each
+            source (about half the mean error of the paper's start); a
+            number: that radius in mean edge lengths; False (or 0): the
+            paper's plain start. With a cost, it applies where the cost is
+            uniform around the source (else the plain start).
         method: "fmm" (the Fast Marching Method, the default) or "exact":
             exact polyhedral geodesic distances by window propagation
             (mfmm_solve_exact; no cost, targets or unfolding options).
@@ -499,9 +524,9 @@ class Mesh:
         Raises ValueError (bad source, barycentric coordinates, cost, ...).
         """
         if method == "exact":
-            if cost is not None or targets is not None or not unfolding:
+            if cost is not None or targets is not None or not unfolding or exact_start is not True:
                 raise ValueError("method='exact' computes geodesic distance: it takes no cost, "
-                                 "targets or unfolding")
+                                 "targets, unfolding or exact_start")
             return self._distance_exact(sources, max_distance)
         if method != "fmm":
             raise ValueError(f"method must be 'fmm' or 'exact', not {method!r}")
@@ -512,8 +537,9 @@ class Mesh:
             src = _source_records(sources)
             src_addr, n_src = _addr(src), src.shape[0]
         opts = None
+        radius = _exact_start(exact_start)
         if (cost is not None or max_distance is not None or targets is not None
-                or not unfolding or cost_location is not None):
+                or not unfolding or cost_location is not None or radius is not None):
             opts = _lib.mfmm_solve_options.from_buffer_copy(self._opts_template)
             c, loc = _cost_array(cost, cost_location, self._nv, self._nf)
             if c is not None:
@@ -527,6 +553,8 @@ class Mesh:
                 opts.n_targets = t.shape[0]
             if not unfolding:
                 opts.unfolding = 0
+            if radius is not None:
+                opts.exact_start_radius = radius
             opts = byref(opts)
         out = np.empty(self._nv, dtype=np.float64)
         err = _lib.mfmm_error()
@@ -666,6 +694,7 @@ class Mesh:
         cost: Any = None,
         cost_location: Optional[str] = None,
         unfolding: bool = True,
+        exact_start: Any = True,
         n_threads: int = 0,
         memory_limit: int = 0,
         progress: Optional[Callable[[int, int], Any]] = None,
@@ -685,7 +714,9 @@ class Mesh:
         out: a preallocated C-contiguous writable array (a numpy.memmap
             works) of shape (len(sources) or n_vertices, n_vertices) and the
             given dtype, written in place and returned; None allocates one.
-        max_distance, cost, cost_location, unfolding: as in :meth:`distance`.
+        max_distance, cost, cost_location, unfolding, exact_start: as in
+            :meth:`distance` (every backend starts each row alike; OpenCL rows
+            still equal the serial rows bit for bit).
         n_threads: threads for the threads backend, 0 for all cores.
         memory_limit: bytes the library may use for blocks in flight (0: default).
         progress: called as ``progress(rows_done, n_rows)`` as blocks of rows
@@ -788,6 +819,9 @@ class Mesh:
         if max_distance is not None:
             opts.max_distance = _max_distance(max_distance)
         opts.unfolding = 1 if unfolding else 0
+        radius = _exact_start(exact_start)
+        if radius is not None:
+            opts.exact_start_radius = radius
         opts.n_threads = _as_index(n_threads, "n_threads")
         if memory_limit < 0:
             raise ValueError("memory_limit must be >= 0")

@@ -3,22 +3,13 @@
 #ifndef MFMM_SOLVE_H
 #define MFMM_SOLVE_H
 
-#include "mesh.h"
-
-/* Checks a cost array (NULL is fine): every entry finite and > 0. */
-mfmm_status mfmm_check_cost(const mfmm_mesh *mesh, const double *cost,
-                            mfmm_cost_location where, mfmm_error *err);
-
-/* Checks source i: ids in range, face not degenerate, barycentric valid. */
-mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int32_t i,
-                              mfmm_error *err);
-
-/* Seeds a checked source into a reset march state (cost fields set). */
-void mfmm_seed_source(const mfmm_mesh *mesh, mfmm_march_state *st, const mfmm_source *src);
+#include "core/check.h"
+#include "core/mesh.h"
 
 /* mfmm_solve without the checks, for callers that checked the arguments
  * once for many solves (the matrix backends). options must not be NULL.
- * Returns the number of vertices settled. */
+ * Returns the number of vertices settled, -1 when out of memory (the exact
+ * start's workspace). */
 int32_t mfmm_solve_checked(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
                            const mfmm_solve_options *options, double *distances);
 
@@ -26,7 +17,7 @@ int32_t mfmm_solve_checked(mfmm_solver *solver, const mfmm_source *sources, int3
  * stays in the solver's own (nv,) array, +inf except at the n_touched
  * vertices of `touched` (every vertex the march took off Far; settled ones
  * hold their T, the others +inf). Valid until the solver's next solve.
- * Returns the number of vertices settled. */
+ * Returns the number of vertices settled, -1 when out of memory. */
 int32_t mfmm_solve_local(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
                          const mfmm_solve_options *options, const double **T,
                          const int32_t **touched, int32_t *n_touched);

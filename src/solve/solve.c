@@ -1,12 +1,15 @@
-/* The serial solver: a reusable workspace and the checks around one march
- * (src/march.h). */
+/* The public solver: a reusable workspace, the checks, and one march
+ * (core/march.h) from the exact start (seed.h) or the straight one
+ * (core/start.h). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "mesh.h"
+#include "core/check.h"
+#include "core/mesh.h"
+#include "core/start.h"
+#include "seed.h"
 #include "solve.h"
-#include "start.h"
 
 struct mfmm_solver {
     const mfmm_mesh *mesh;
@@ -21,6 +24,7 @@ struct mfmm_solver {
     /* a cost whose `uniform` is computed once for many solves (matrix jobs) */
     const double *fixed_cost;
     int fixed_location;
+    mfmm_exact_ws *exact; /* the exact start's workspace, made on first use */
 };
 
 mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out)
@@ -66,6 +70,7 @@ void mfmm_solver_destroy(mfmm_solver *solver)
     free(solver->uniform);
     free(solver->T);
     free(solver->touched);
+    mfmm_exact_ws_destroy(solver->exact);
     free(solver);
 }
 
@@ -81,81 +86,7 @@ void mfmm_solve_options_init(mfmm_solve_options *options)
     options->targets = NULL;
     options->n_targets = 0;
     options->unfolding = 1;
-}
-
-mfmm_status mfmm_check_cost(const mfmm_mesh *mesh, const double *cost,
-                            mfmm_cost_location where, mfmm_error *err)
-{
-    if (!cost)
-        return MFMM_OK;
-    if (where != MFMM_COST_PER_VERTEX && where != MFMM_COST_PER_FACE)
-        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
-                         "a cost array was given without a cost location (per vertex or per face)");
-    int32_t n = where == MFMM_COST_PER_VERTEX ? mesh->nv : mesh->nf;
-    for (int32_t i = 0; i < n; i++)
-        if (!isfinite(cost[i]) || !(cost[i] > 0.0))
-            return mfmm_fail(err, MFMM_ERR_BAD_COST, i, "cost of %s %ld is %g; costs must be finite and > 0",
-                             where == MFMM_COST_PER_VERTEX ? "vertex" : "face", (long)i, cost[i]);
-    return MFMM_OK;
-}
-
-mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int32_t i,
-                              mfmm_error *err)
-{
-    if (!isfinite(src->value))
-        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, i, "source %ld has a value that is not finite",
-                         (long)i);
-    if (src->face < 0) {
-        if (src->face != -1 || src->vertex < 0 || src->vertex >= mesh->nv)
-            return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, i,
-                             "source %ld: vertex %ld is outside [0, %ld)", (long)i,
-                             (long)src->vertex, (long)mesh->nv);
-        return MFMM_OK;
-    }
-    if (src->face >= mesh->nf)
-        return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, i, "source %ld: face %ld is outside [0, %ld)",
-                         (long)i, (long)src->face, (long)mesh->nf);
-    if (mesh->degenerate[src->face])
-        return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, i,
-                         "source %ld lies on face %ld, which has zero area", (long)i,
-                         (long)src->face);
-    double sum = 0.0;
-    for (int k = 0; k < 3; k++) {
-        double w = src->bary[k];
-        if (!isfinite(w) || w < -1e-12)
-            return mfmm_fail(err, MFMM_ERR_BAD_BARYCENTRIC, i,
-                             "source %ld: barycentric coordinate %d is %g (must be >= 0)",
-                             (long)i, k, w);
-        sum += w;
-    }
-    if (fabs(sum - 1.0) > 1e-9)
-        return mfmm_fail(err, MFMM_ERR_BAD_BARYCENTRIC, i,
-                         "source %ld: barycentric coordinates sum to %.17g, not 1", (long)i, sum);
-    return MFMM_OK;
-}
-
-typedef struct seed_ctx {
-    mfmm_march_state *st;
-    double value;
-} seed_ctx;
-
-static int seed_point_hit(void *user, const mfmm_start_hit *h)
-{
-    seed_ctx *c = user;
-    mfmm_march_seed(c->st, h->vertex, c->value + h->cost_length);
-    return 0;
-}
-
-void mfmm_seed_source(const mfmm_mesh *mesh, mfmm_march_state *st, const mfmm_source *src)
-{
-    if (src->face < 0) {
-        mfmm_march_seed(st, src->vertex, src->value);
-        return;
-    }
-    /* a point on the surface: every vertex a straight segment reaches near
-     * it starts at that segment's cost (start.c) */
-    seed_ctx c = {st, src->value};
-    mfmm_start_walk(mesh, src, st->cost, st->cost_location, seed_point_hit, &c);
+    options->exact_start_radius = MFMM_EXACT_START_RADIUS;
 }
 
 mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
@@ -194,12 +125,17 @@ mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources, int32_t 
         if (opt.targets[i] < 0 || opt.targets[i] >= mesh->nv)
             return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, i, "target %ld: vertex %ld is outside [0, %ld)",
                              (long)i, (long)opt.targets[i], (long)mesh->nv);
+    st = mfmm_check_exact_start(opt.exact_start_radius, err);
+    if (st != MFMM_OK)
+        return st;
     for (int32_t i = 0; i < n_sources; i++) {
         st = mfmm_check_source(mesh, sources + i, i, err);
         if (st != MFMM_OK)
             return st;
     }
-    mfmm_solve_checked(solver, sources, n_sources, &opt, distances);
+    if (mfmm_solve_checked(solver, sources, n_sources, &opt, distances) < 0)
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1,
+                         "out of memory for the exact start's workspace");
     return MFMM_OK;
 }
 
@@ -233,8 +169,34 @@ void mfmm_solver_fix_cost(mfmm_solver *solver, const double *cost, int cost_loca
     }
 }
 
+/* Seeds one source: its exact start where that applies (seed.h), else the
+ * straight start. fixed: the exact values are final (one source; with
+ * several, a vertex in one's patch may be nearer another, whose march must
+ * be able to lower it). -1 when out of memory. */
+static int seed_source(mfmm_solver *solver, mfmm_march_state *s, const mfmm_source *src,
+                       double radius, int fixed)
+{
+    int32_t n = 0;
+    const int32_t *pv = NULL;
+    const double *pd = NULL;
+    double f = 1.0;
+    if (mfmm_exact_start(solver->mesh, &solver->exact, src, radius, s->cost,
+                         s->cost ? solver->uniform : NULL, &n, &pv, &pd, &f) != MFMM_OK)
+        return -1;
+    for (int32_t i = 0; i < n; i++) {
+        if (fixed)
+            mfmm_march_seed_fixed(s, pv[i], src->value + f * pd[i]);
+        else
+            mfmm_march_seed(s, pv[i], src->value + f * pd[i]);
+    }
+    if (n == 0)
+        mfmm_start_seed(solver->mesh, s, src);
+    return 0;
+}
+
 /* One march into T (the caller's +inf-filled row, or the solver's own T);
- * leaves the touched list pending. Returns the vertices settled. */
+ * leaves the touched list pending. Returns the vertices settled, -1 when out
+ * of memory (nothing pending then). */
 static int32_t solver_march(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
                             const mfmm_solve_options *options, double *T)
 {
@@ -259,7 +221,8 @@ static int32_t solver_march(mfmm_solver *solver, const mfmm_source *sources, int
     s.touched = solver->touched;
     s.n_touched = 0;
     s.targets_left = 0;
-    if (s.cost && s.unfolding) {
+    int exact = opt.exact_start_radius > 0.0;
+    if (s.cost && (s.unfolding || exact)) {
         if (solver->fixed_cost != s.cost || solver->fixed_location != s.cost_location)
             mfmm_uniform_cost(mesh, s.cost, s.cost_location, solver->uniform);
         s.uniform = solver->uniform;
@@ -271,8 +234,17 @@ static int32_t solver_march(mfmm_solver *solver, const mfmm_source *sources, int
             s.targets_left++;
         }
     }
-    for (int32_t i = 0; i < n_sources; i++)
-        mfmm_seed_source(mesh, &s, sources + i);
+    for (int32_t i = 0; i < n_sources; i++) {
+        if (seed_source(solver, &s, sources + i, opt.exact_start_radius, n_sources == 1) < 0) {
+            for (int32_t j = 0; j < opt.n_targets; j++)
+                s.label[opt.targets[j]] &= (uint8_t)MFMM_STATE_MASK;
+            for (int32_t j = 0; j < s.n_touched; j++) {
+                s.T[s.touched[j]] = INFINITY;
+                s.label[s.touched[j]] = MFMM_FAR;
+            }
+            return -1;
+        }
+    }
     mfmm_march_mesh mm = mfmm_mesh_march_view(mesh);
     int32_t settled = mfmm_march_run(&s, &mm);
     /* target flags on vertices never touched (touched ones: reset below) */
@@ -289,6 +261,8 @@ int32_t mfmm_solve_checked(mfmm_solver *solver, const mfmm_source *sources, int3
     for (int32_t v = 0; v < nv; v++)
         distances[v] = INFINITY;
     int32_t settled = solver_march(solver, sources, n_sources, options, distances);
+    if (settled < 0)
+        return -1;
     /* the row was the caller's: only the labels need resetting */
     if (solver->n_pending >= nv / 8)
         memset(solver->label, MFMM_FAR, (size_t)nv);

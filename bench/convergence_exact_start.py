@@ -1,0 +1,68 @@
+#!/usr/bin/env python3
+"""Convergence with and without the exact start (issue 12.2): mean relative
+error and fitted order on icospheres (levels 4-7, source at an icosahedron
+vertex, great-circle distance) and on the obtuse lattice (x stretched 3x,
+n = 20..160, source nearest (1.5, 0.43), Euclidean distance), the meshes and
+sources of tests/c/test_convergence.c. Writes bench/results/convergence.json.
+
+    python bench/convergence_exact_start.py
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import benchlib as bl  # noqa: E402
+
+import meshfmm  # noqa: E402
+
+
+def mre(d, e):
+    k = np.isfinite(e) & (e > 0)
+    return float(100 * np.mean(np.abs(d[k] - e[k]) / e[k]))
+
+
+def order(h, err):
+    return float(np.polyfit(np.log(h), np.log(err), 1)[0])
+
+
+def main():
+    radii = {"plain": 0.0, "exact start (default)": None}
+    out = {"what": __doc__.split("\n\n")[0], "machine": bl.machine_info(), "families": []}
+    with tempfile.TemporaryDirectory() as wd:
+        fams = [("icosphere", [4, 5, 6, 7], "sphere"), ("obtuse lattice", [20, 40, 80, 160], "lattice")]
+        for fam, sizes, shape in fams:
+            rows = []
+            for n in sizes:
+                V, F = bl.generate(shape, n, wd)
+                m = meshfmm.Mesh(V, F)
+                if shape == "sphere":
+                    s = 0
+                    e = bl.sphere_distance(V, s)
+                    h = 1 / np.sqrt(len(V))
+                else:
+                    s = int(np.argmin(np.linalg.norm(V - np.array([1.5, 0.43, 0.0]), axis=1)))
+                    e = bl.plane_distance(V, s)
+                    h = 1 / n
+                row = {"n": n, "n_vertices": len(V), "h": h}
+                for label, r in radii.items():
+                    d = m.distance(s, exact_start=True if r is None else r)
+                    row[label] = mre(d, e)
+                rows.append(row)
+                print(fam, n, len(V), {k: round(row[k], 4) for k in radii}, flush=True)
+            orders = {k: order([r["h"] for r in rows], [r[k] for r in rows]) for k in radii}
+            out["families"].append({"family": fam, "rows": rows, "order": orders})
+            print(fam, "order", orders)
+    path = bl.RESULTS / "convergence.json"
+    path.write_text(json.dumps(out, indent=1) + "\n")
+    print("wrote", path)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,55 @@
+/* The checks of a solve's arguments (check.h). */
+#include <math.h>
+
+#include "check.h"
+
+mfmm_status mfmm_check_cost(const mfmm_mesh *mesh, const double *cost,
+                            mfmm_cost_location where, mfmm_error *err)
+{
+    if (!cost)
+        return MFMM_OK;
+    if (where != MFMM_COST_PER_VERTEX && where != MFMM_COST_PER_FACE)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "a cost array was given without a cost location (per vertex or per face)");
+    int32_t n = where == MFMM_COST_PER_VERTEX ? mesh->nv : mesh->nf;
+    for (int32_t i = 0; i < n; i++)
+        if (!isfinite(cost[i]) || !(cost[i] > 0.0))
+            return mfmm_fail(err, MFMM_ERR_BAD_COST, i, "cost of %s %ld is %g; costs must be finite and > 0",
+                             where == MFMM_COST_PER_VERTEX ? "vertex" : "face", (long)i, cost[i]);
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int32_t i,
+                              mfmm_error *err)
+{
+    if (!isfinite(src->value))
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, i, "source %ld has a value that is not finite",
+                         (long)i);
+    if (src->face < 0) {
+        if (src->face != -1 || src->vertex < 0 || src->vertex >= mesh->nv)
+            return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, i,
+                             "source %ld: vertex %ld is outside [0, %ld)", (long)i,
+                             (long)src->vertex, (long)mesh->nv);
+        return MFMM_OK;
+    }
+    if (src->face >= mesh->nf)
+        return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, i, "source %ld: face %ld is outside [0, %ld)",
+                         (long)i, (long)src->face, (long)mesh->nf);
+    if (mesh->degenerate[src->face])
+        return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, i,
+                         "source %ld lies on face %ld, which has zero area", (long)i,
+                         (long)src->face);
+    double sum = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double w = src->bary[k];
+        if (!isfinite(w) || w < -1e-12)
+            return mfmm_fail(err, MFMM_ERR_BAD_BARYCENTRIC, i,
+                             "source %ld: barycentric coordinate %d is %g (must be >= 0)",
+                             (long)i, k, w);
+        sum += w;
+    }
+    if (fabs(sum - 1.0) > 1e-9)
+        return mfmm_fail(err, MFMM_ERR_BAD_BARYCENTRIC, i,
+                         "source %ld: barycentric coordinates sum to %.17g, not 1", (long)i, sum);
+    return MFMM_OK;
+}

@@ -1,0 +1,129 @@
+/* The exact start of a march (seed.h). */
+#include <math.h>
+
+#include "seed.h"
+
+mfmm_status mfmm_check_exact_start(double radius, mfmm_error *err)
+{
+    if (!isfinite(radius) || radius < 0.0)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "exact_start_radius is %g; it must be finite and >= 0 (0: the plain start)",
+                         radius);
+    return MFMM_OK;
+}
+
+size_t mfmm_exact_start_bytes(const mfmm_mesh *mesh)
+{
+    /* exact.h: about 180 bytes per face and 45 per vertex */
+    return 192 * (size_t)mesh->nf + 48 * (size_t)mesh->nv;
+}
+
+static double dist3(const double *p, const double *q)
+{
+    double a = p[0] - q[0], b = p[1] - q[1], c = p[2] - q[2];
+    return sqrt(a * a + b * b + c * c);
+}
+
+/* The longest distance from p to a corner of a face around vertex v. */
+static double reach_around(const mfmm_mesh *m, int32_t v, const double *p)
+{
+    double r = 0.0;
+    for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
+        const int32_t *f = m->faces + 3 * (size_t)(m->vertex_face_corner[i] / 3);
+        for (int k = 0; k < 3; k++)
+            r = fmax(r, dist3(p, m->xyz + 3 * (size_t)f[k]));
+    }
+    return r;
+}
+
+mfmm_status mfmm_exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const mfmm_source *src,
+                             double radius, const double *cost, const double *uniform,
+                             int32_t *n, const int32_t **vertices, const double **distances,
+                             double *F)
+{
+    *n = 0;
+    *F = 1.0;
+    if (!(radius > 0.0))
+        return MFMM_OK;
+    /* the patch around the source at value 0; a point at a corner is that
+     * vertex, whichever face names it */
+    mfmm_source s = *src;
+    s.value = 0.0;
+    int32_t center = s.vertex;
+    double p[3] = {0.0, 0.0, 0.0}, reach = 0.0;
+    if (s.face >= 0) {
+        const int32_t *fv = mesh->faces + 3 * (size_t)s.face;
+        int n_zero = 0, top = 0, zero = -1;
+        for (int k = 0; k < 3; k++) {
+            if (s.bary[k] <= 0.0) {
+                n_zero++;
+                zero = k;
+            }
+            if (s.bary[k] > s.bary[top])
+                top = k;
+        }
+        int32_t g0 = n_zero == 1 ? mesh->face_neighbor[3 * (size_t)s.face + zero] : -1;
+        if (n_zero >= 2) {
+            s.face = -1;
+            s.vertex = center = fv[top];
+        } else if (g0 >= 0 && g0 < s.face && !mesh->degenerate[g0]) {
+            /* on an edge: named by the lower of its two faces, so that the
+             * patch does not depend on which face names the point */
+            const int32_t *gv = mesh->faces + 3 * (size_t)g0;
+            double b[3] = {0.0, 0.0, 0.0};
+            for (int k = 0; k < 3; k++)
+                for (int j = 0; j < 3; j++)
+                    if (gv[j] == fv[k] && k != zero)
+                        b[j] = s.bary[k];
+            s.face = g0;
+            s.bary[0] = b[0];
+            s.bary[1] = b[1];
+            s.bary[2] = b[2];
+            return mfmm_exact_start(mesh, ws, &s, radius, cost, uniform, n, vertices, distances,
+                                    F);
+        } else {
+            center = fv[top];
+            for (int k = 0; k < 3; k++)
+                for (int c = 0; c < 3; c++)
+                    p[c] += (s.bary[k] > 0.0 ? s.bary[k] : 0.0) * mesh->xyz[3 * (size_t)fv[k] + c];
+            /* its own faces' corners (both faces of an edge it lies on) */
+            for (int k = 0; k < 3; k++)
+                reach = fmax(reach, dist3(p, mesh->xyz + 3 * (size_t)fv[k]));
+            int32_t g = zero >= 0 ? mesh->face_neighbor[3 * (size_t)s.face + zero] : -1;
+            if (g >= 0)
+                for (int k = 0; k < 3; k++)
+                    reach = fmax(reach, dist3(p, mesh->xyz + 3 * (size_t)mesh->faces[3 * (size_t)g + k]));
+        }
+    }
+    if (s.face < 0)
+        reach = reach_around(mesh, center, mesh->xyz + 3 * (size_t)center);
+    double f = 1.0;
+    if (cost) {
+        f = uniform[center];
+        if (!(f > 0.0))
+            return MFMM_OK; /* costs differ around the source: straight start */
+    }
+    if (!*ws) {
+        mfmm_status st = mfmm_exact_ws_create(mesh, ws);
+        if (st != MFMM_OK)
+            return st;
+    }
+    double R = fmax(radius * mesh->info.mean_edge_length, reach * (1.0 + 1e-12));
+    int32_t np = 0;
+    const int32_t *pv = NULL;
+    const double *pd = NULL;
+    mfmm_status st = mfmm_exact_patch(*ws, &s, 1, R, 0, &np, &pv, &pd, NULL);
+    if (st == MFMM_ERR_OUT_OF_MEMORY || st == MFMM_ERR_MEMORY_LIMIT)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    if (st != MFMM_OK) /* a face the exact solver skips: straight start */
+        return MFMM_OK;
+    if (cost)
+        for (int32_t i = 0; i < np; i++)
+            if (uniform[pv[i]] != f)
+                return MFMM_OK;
+    *n = np;
+    *vertices = pv;
+    *distances = pd;
+    *F = f;
+    return MFMM_OK;
+}

@@ -1,0 +1,36 @@
+/* The exact start of a march (private to the library; issue 12.2): the
+ * exact distances of the vertices near a point source seed the march in
+ * place of the paper's start, which creates most of a first-order march's
+ * error at the source's point singularity. Shared by the solver (solve.c)
+ * and the OpenCL host (matrix/opencl_host.c), which computes each row's
+ * seeds and uploads them, so that every backend seeds alike. */
+#ifndef MFMM_SOLVE_SEED_H
+#define MFMM_SOLVE_SEED_H
+
+#include "core/mesh.h"
+#include "exact/exact.h"
+
+/* Validates an exact_start_radius option (finite and >= 0). */
+mfmm_status mfmm_check_exact_start(double radius, mfmm_error *err);
+
+/* The exact start of one checked source: the vertices within `radius` mean
+ * edge lengths of it (at least its own faces' corners) and their exact
+ * distances d; the march is seeded with value + F * d at each, in this
+ * order. Applies only where the cost is one F over the patch: uniform (see
+ * mfmm_uniform_cost, NULL when cost is NULL) equal at every patch vertex;
+ * elsewhere, and for radius 0, *n is 0 and the caller takes the straight
+ * start (core/start.h). *ws is the exact workspace, made here on first use
+ * (the caller frees it with mfmm_exact_ws_destroy).
+ *   n, vertices, distances: the patch (arrays of *ws, valid until its next
+ *   use); F: the cost there (1 without a cost).
+ * MFMM_ERR_OUT_OF_MEMORY when the workspace or its queue cannot grow. */
+mfmm_status mfmm_exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const mfmm_source *src,
+                             double radius, const double *cost, const double *uniform,
+                             int32_t *n, const int32_t **vertices, const double **distances,
+                             double *F);
+
+/* Bytes an exact workspace takes for this mesh (its tables; the queue of a
+ * patch is small), for memory budgets. */
+size_t mfmm_exact_start_bytes(const mfmm_mesh *mesh);
+
+#endif
