@@ -55,8 +55,9 @@ inline void mfmm_row_march(int nv, __global const int *update_offset,
     mfmm_march_run(&s, &m);
 }
 
-/* float64 rows: the output row is the march's T (with targets: T in
- * T_ws, the target columns copied out). */
+/* float64 rows: T in a workspace slice, the row gathered from it in the
+ * caller's vertex order (order: internal id of each input vertex, as
+ * src/core/order.h), or the target columns copied out. */
 __kernel void fmm_rows_f64(int nv, __global const int *update_offset,
                            __global const int *update_corner,
                            __global const mfmm_corner *corners, __global const double *cost,
@@ -65,13 +66,14 @@ __kernel void fmm_rows_f64(int nv, __global const int *update_offset,
                            __global uchar *label_ws, __global double *key_ws,
                            __global int *vert_ws, __global int *pos_ws, __global double *out,
                            __global const int *strip, __global const double *uniform,
-                           __global const int *targets, int n_targets, __global double *T_ws)
+                           __global const int *targets, int n_targets, __global double *T_ws,
+                           __global const int *order)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
         return;
     ulong o = (ulong)i * (ulong)nv;
-    __global double *T = n_targets > 0 ? T_ws + o : out + o;
+    __global double *T = T_ws + o;
     mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
                    key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets);
@@ -79,10 +81,15 @@ __kernel void fmm_rows_f64(int nv, __global const int *update_offset,
         __global double *row = out + (ulong)i * (ulong)n_targets;
         for (int j = 0; j < n_targets; j++)
             row[j] = T[targets[j]];
+        return;
     }
+    __global double *row = out + o;
+    for (int v = 0; v < nv; v++)
+        row[v] = T[order[v]];
 }
 
-/* float32 rows: T in a workspace slice, converted (round to nearest). */
+/* float32 rows: T in a workspace slice, converted (round to nearest) in
+ * the caller's vertex order (as float64). */
 __kernel void fmm_rows_f32(int nv, __global const int *update_offset,
                            __global const int *update_corner,
                            __global const mfmm_corner *corners, __global const double *cost,
@@ -92,7 +99,8 @@ __kernel void fmm_rows_f32(int nv, __global const int *update_offset,
                            __global int *vert_ws, __global int *pos_ws,
                            __global double *T_ws, __global float *out,
                            __global const int *strip, __global const double *uniform,
-                           __global const int *targets, int n_targets, __global double *unused)
+                           __global const int *targets, int n_targets, __global double *unused,
+                           __global const int *order)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
@@ -111,5 +119,5 @@ __kernel void fmm_rows_f32(int nv, __global const int *update_offset,
     }
     __global float *row = out + o;
     for (int v = 0; v < nv; v++)
-        row[v] = (float)T[v];
+        row[v] = (float)T[order[v]];
 }

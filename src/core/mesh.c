@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "mesh.h"
+#include "order.h"
 
 /* Largest coordinate magnitude accepted, and smallest extent: lengths are
  * squared once (1e200 and 1e-200 are far from overflow and underflow). */
@@ -26,6 +27,8 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
 {
     if (!mesh)
         return;
+    free(mesh->to_internal);
+    free(mesh->to_external);
     free(mesh->xyz);
     free(mesh->faces);
     free(mesh->face_neighbor);
@@ -250,37 +253,6 @@ static void build_corners(mfmm_mesh *m)
     m->info.n_obtuse_corners = n_obtuse;
 }
 
-/* Vertices in breadth-first order over edges, component after component:
- * neighbours end up near each other. order[i] is the i-th vertex. */
-static mfmm_status bfs_order(const mfmm_mesh *m, int32_t *order)
-{
-    uint8_t *seen = calloc((size_t)m->nv, 1);
-    if (!seen)
-        return MFMM_ERR_OUT_OF_MEMORY;
-    int32_t head = 0, tail = 0;
-    for (int32_t s = 0; s < m->nv; s++) {
-        if (seen[s])
-            continue;
-        seen[s] = 1;
-        order[tail++] = s;
-        while (head < tail) {
-            int32_t v = order[head++];
-            for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
-                int32_t c = m->vertex_face_corner[i], f = c / 3, k = c % 3;
-                for (int t = 1; t < 3; t++) {
-                    int32_t w = m->faces[3 * f + (k + t) % 3];
-                    if (!seen[w]) {
-                        seen[w] = 1;
-                        order[tail++] = w;
-                    }
-                }
-            }
-        }
-    }
-    free(seen);
-    return MFMM_OK;
-}
-
 /* The strip vertices of each obtuse corner's virtual stencil (section 4.2),
  * by corner record (the order build_update_lists groups them in): the
  * vertices unfolded up to V (A and B are in the record). *out: offsets
@@ -309,7 +281,7 @@ static mfmm_status build_footprints(const mfmm_mesh *m, const int32_t *order, in
     return MFMM_OK;
 }
 
-/* Stores the corner records grouped by vertex, the groups in breadth-first
+/* Stores the corner records grouped by vertex, the groups in the internal
  * order, so that the corners a settling vertex touches share cache lines
  * (measured: the march is bound by misses on these records), and builds the
  * update lists: when a vertex settles, the pairs (corner record, its vertex C)
@@ -322,8 +294,10 @@ static mfmm_status build_update_lists(mfmm_mesh *m)
     int32_t *order = malloc((size_t)m->nv * sizeof *order);
     int32_t *record_vertex = malloc(nc * sizeof *record_vertex);
     mfmm_corner *grouped = malloc(nc * sizeof *grouped);
-    mfmm_status st = off && order && record_vertex && grouped ? bfs_order(m, order)
-                                                              : MFMM_ERR_OUT_OF_MEMORY;
+    mfmm_status st = off && order && record_vertex && grouped ? MFMM_OK : MFMM_ERR_OUT_OF_MEMORY;
+    /* groups in the internal vertex order (already local, order.c) */
+    for (int32_t i = 0; st == MFMM_OK && i < m->nv; i++)
+        order[i] = i;
     if (st != MFMM_OK) {
         free(off);
         free(order);
@@ -466,8 +440,15 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
     }
-    memcpy(m->xyz, vertices, (size_t)nv * 3 * sizeof *m->xyz);
-    memcpy(m->faces, faces, nc * sizeof *m->faces);
+    /* renumbered: coordinates in internal order, face corners' ids mapped */
+    if (mfmm_order_build(vertices, nv, &m->to_internal, &m->to_external) != MFMM_OK) {
+        mfmm_mesh_destroy(m);
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
+    }
+    for (int32_t v = 0; v < nv; v++)
+        memcpy(m->xyz + 3 * (size_t)v, vertices + 3 * (size_t)m->to_external[v], 3 * sizeof *m->xyz);
+    for (size_t c = 0; c < nc; c++)
+        m->faces[c] = m->to_internal[faces[c]];
     m->info.n_vertices = nv;
     m->info.n_faces = nf;
 

@@ -15,6 +15,11 @@ typedef struct mfmm_virt_step {
 
 struct mfmm_mesh {
     int32_t nv, nf;
+    /* Vertices are numbered internally along a space-filling curve (order.h):
+     * every per-vertex array below, and the vertex ids in faces, are in
+     * that order; faces keep their input ids and corner order. */
+    int32_t *to_internal;      /* (nv,) internal id of each input vertex */
+    int32_t *to_external;      /* (nv,) input id of each internal vertex */
     double *xyz;               /* (nv, 3) */
     int32_t *faces;            /* (nf, 3) */
     int32_t *face_neighbor;    /* (nf, 3): face across the edge opposite corner k,

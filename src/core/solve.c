@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "mesh.h"
+#include "order.h"
 #include "solve.h"
 #include "start.h"
 
@@ -21,6 +22,7 @@ struct mfmm_solver {
     /* a cost whose `uniform` is computed once for many solves (matrix jobs) */
     const double *fixed_cost;
     int fixed_location;
+    mfmm_mapped_args args; /* mfmm_solve's arguments in internal order (order.h) */
 };
 
 mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out)
@@ -66,6 +68,7 @@ void mfmm_solver_destroy(mfmm_solver *solver)
     free(solver->uniform);
     free(solver->T);
     free(solver->touched);
+    free(solver->args.block);
     free(solver);
 }
 
@@ -199,8 +202,7 @@ mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources, int32_t 
         if (st != MFMM_OK)
             return st;
     }
-    mfmm_solve_checked(solver, sources, n_sources, &opt, distances);
-    return MFMM_OK;
+    return mfmm_solve_mapped(solver, sources, n_sources, &opt, distances, err);
 }
 
 /* Puts the vertices the last march touched back to Far (and the solver's
@@ -308,4 +310,25 @@ int32_t mfmm_solve_local(mfmm_solver *solver, const mfmm_source *sources, int32_
     *touched = solver->touched;
     *n_touched = solver->n_pending;
     return settled;
+}
+
+mfmm_status mfmm_solve_mapped(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
+                              const mfmm_solve_options *options, double *distances,
+                              mfmm_error *err)
+{
+    const mfmm_mesh *mesh = solver->mesh;
+    mfmm_mapped_args *a = &solver->args;
+    if (mfmm_order_map_args(mesh, sources, n_sources, options->targets, options->n_targets,
+                            options->cost, (int)options->cost_location, NULL, a) != MFMM_OK)
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the arguments");
+    mfmm_solve_options opt = *options;
+    opt.targets = a->targets;
+    opt.cost = a->cost;
+    const double *T;
+    const int32_t *touched;
+    int32_t n_touched;
+    mfmm_solve_local(solver, a->sources, n_sources, &opt, &T, &touched, &n_touched);
+    /* the one pass over the row: gathered into input order */
+    mfmm_order_values_out(mesh, T, distances);
+    return MFMM_OK;
 }
