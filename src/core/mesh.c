@@ -36,7 +36,10 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh->vertex_face_corner);
     free(mesh->component);
     free(mesh->degenerate);
+    free(mesh->full);
     free(mesh->corners);
+    free(mesh->virt_index);
+    free(mesh->virt);
     free(mesh->update_offset);
     free(mesh->update_corner);
     free(mesh->virt_offset);
@@ -226,7 +229,7 @@ static void build_corners(mfmm_mesh *m)
         m->degenerate[f] = (uint8_t)degenerate;
         n_degenerate += degenerate;
         for (int k = 0; k < 3; k++) {
-            mfmm_corner *c = m->corners + 3 * (size_t)f + k;
+            mfmm_corner_full *c = m->full + 3 * (size_t)f + k;
             int ka = (k + 1) % 3, kb = (k + 2) % 3;
             c->face = f;
             c->a = fv[ka];
@@ -253,88 +256,72 @@ static void build_corners(mfmm_mesh *m)
     m->info.n_obtuse_corners = n_obtuse;
 }
 
-/* The strip vertices of each obtuse corner's virtual stencil (section 4.2),
- * by corner record (the order build_update_lists groups them in): the
- * vertices unfolded up to V (A and B are in the record). *out: offsets
- * (3 nf + 1) into *out itself, then the vertices; an empty run for corners
- * without a virtual edge. */
-static mfmm_status build_footprints(const mfmm_mesh *m, const int32_t *order, int32_t **out)
-{
-    size_t nc = 3 * (size_t)m->nf, n_steps = (size_t)m->virt_offset[nc];
-    if (n_steps > (size_t)INT32_MAX - nc - 1)
-        return MFMM_ERR_BAD_COUNT;
-    int32_t *buf = malloc((nc + 1 + n_steps) * sizeof *buf);
-    if (!buf)
-        return MFMM_ERR_OUT_OF_MEMORY;
-    size_t r = 0, at = nc + 1;
-    for (int32_t i = 0; i < m->nv; i++) {
-        int32_t v = order[i];
-        for (int32_t t = m->vertex_face_offset[v]; t < m->vertex_face_offset[v + 1]; t++, r++) {
-            int32_t fc = m->vertex_face_corner[t];
-            buf[r] = (int32_t)at;
-            for (int32_t k = m->virt_offset[fc]; k < m->virt_offset[fc + 1]; k++)
-                buf[at++] = m->virt_steps[k].far;
-        }
-    }
-    buf[nc] = (int32_t)at;
-    *out = buf;
-    return MFMM_OK;
-}
-
-/* Stores the corner records grouped by vertex, the groups in the internal
- * order, so that the corners a settling vertex touches share cache lines
- * (measured: the march is bound by misses on these records), and builds the
- * update lists: when a vertex settles, the pairs (corner record, its vertex C)
- * to recompute are the other two corners of each incident face, and each
- * obtuse corner whose virtual edge starts there. */
-static mfmm_status build_update_lists(mfmm_mesh *m)
+/* The march's records from the build's corners: one 32-byte mfmm_corner per
+ * corner, grouped by vertex in the vertex_face CSR order (so a vertex's
+ * records are contiguous and in vertex order, as the vertices are numbered
+ * along a space-filling curve: the march is bound by misses on them); the
+ * obtuse corners' virtual edges apart (mfmm_virt, with their strips'
+ * vertices, A and B aside, for the virtual stencils' cost test); a
+ * zero-area face's records get cos_c = NaN. Then the update lists: when a
+ * vertex settles, the pairs (corner record, its vertex C) to recompute are
+ * the other two corners of each incident face, and each obtuse corner whose
+ * virtual edge starts there. Frees m->full. */
+static mfmm_status build_records(mfmm_mesh *m)
 {
     size_t nc = (size_t)m->nf * 3;
+    int32_t n_virt = m->info.n_virtual_edges;
+    size_t n_steps = (size_t)m->virt_offset[nc];
+    if (n_steps > (size_t)INT32_MAX)
+        return MFMM_ERR_BAD_COUNT;
+    m->corners = malloc(nc * sizeof *m->corners);
+    m->virt_index = malloc(nc * sizeof *m->virt_index);
+    m->virt = malloc(((size_t)n_virt + 1) * sizeof *m->virt);
+    m->strip = malloc((n_steps ? n_steps : 1) * sizeof *m->strip);
     int32_t *off = calloc((size_t)m->nv + 1, sizeof *off);
-    int32_t *order = malloc((size_t)m->nv * sizeof *order);
     int32_t *record_vertex = malloc(nc * sizeof *record_vertex);
-    mfmm_corner *grouped = malloc(nc * sizeof *grouped);
-    mfmm_status st = off && order && record_vertex && grouped ? MFMM_OK : MFMM_ERR_OUT_OF_MEMORY;
-    /* groups in the internal vertex order (already local, order.c) */
-    for (int32_t i = 0; st == MFMM_OK && i < m->nv; i++)
-        order[i] = i;
-    if (st != MFMM_OK) {
+    if (!m->corners || !m->virt_index || !m->virt || !m->strip || !off || !record_vertex) {
         free(off);
-        free(order);
         free(record_vertex);
-        free(grouped);
-        return st;
+        return MFMM_ERR_OUT_OF_MEMORY;
     }
-    /* the strips' vertices in record order (march.h) */
-    int32_t *strip = NULL;
-    st = build_footprints(m, order, &strip);
-    if (st != MFMM_OK) {
-        free(off);
-        free(order);
-        free(record_vertex);
-        free(grouped);
-        return st;
-    }
-    size_t j = 0;
-    for (int32_t i = 0; i < m->nv; i++) {
-        int32_t c = order[i];
-        for (int32_t t = m->vertex_face_offset[c]; t < m->vertex_face_offset[c + 1]; t++) {
-            record_vertex[j] = c;
-            grouped[j++] = m->corners[m->vertex_face_corner[t]];
+    int32_t nvirt = 0, at = 0;
+    for (int32_t c = 0; c < m->nv; c++)
+        for (int32_t r = m->vertex_face_offset[c]; r < m->vertex_face_offset[c + 1]; r++) {
+            int32_t fc = m->vertex_face_corner[r];
+            const mfmm_corner_full *x = m->full + fc;
+            mfmm_corner *cr = m->corners + r;
+            record_vertex[r] = c;
+            cr->a = x->a;
+            cr->b = x->b;
+            cr->len_a = x->len_a;
+            cr->len_b = x->len_b;
+            cr->cos_c = x->virt == MFMM_VIRT_DEGENERATE ? NAN : x->cos_c;
+            m->virt_index[r] = -1;
+            if (x->virt < 0)
+                continue;
+            mfmm_virt *v = m->virt + nvirt;
+            v->v = x->virt;
+            v->strip = at;
+            v->len = x->virt_len;
+            v->cos_a = x->virt_cos_a;
+            v->cos_b = x->virt_cos_b;
+            for (int32_t k = m->virt_offset[fc]; k < m->virt_offset[fc + 1]; k++)
+                m->strip[at++] = m->virt_steps[k].far;
+            m->virt_index[r] = nvirt++;
         }
-    }
-    m->strip = strip;
-    free(order);
-    free(m->corners);
-    m->corners = grouped;
+    memset(m->virt + nvirt, 0, sizeof *m->virt);
+    m->virt[nvirt].strip = at;
+    free(m->full);
+    m->full = NULL;
+    /* the update lists */
     size_t total = 0;
-    for (j = 0; j < nc; j++) {
+    for (size_t j = 0; j < nc; j++) {
         const mfmm_corner *cr = m->corners + j;
         off[cr->a + 1]++;
         off[cr->b + 1]++;
         total += 2;
-        if (cr->virt >= 0) {
-            off[cr->virt + 1]++;
+        if (m->virt_index[j] >= 0) {
+            off[m->virt[m->virt_index[j]].v + 1]++;
             total++;
         }
     }
@@ -346,10 +333,11 @@ static mfmm_status build_update_lists(mfmm_mesh *m)
     }
     for (int32_t v = 0; v < m->nv; v++)
         off[v + 1] += off[v];
-    for (j = 0; j < nc; j++) {
+    for (size_t j = 0; j < nc; j++) {
         const mfmm_corner *cr = m->corners + j;
-        int32_t to[3] = {cr->a, cr->b, cr->virt};
-        for (int t = 0; t < (cr->virt >= 0 ? 3 : 2); t++) {
+        int32_t vi = m->virt_index[j];
+        int32_t to[3] = {cr->a, cr->b, vi >= 0 ? m->virt[vi].v : -1};
+        for (int t = 0; t < (vi >= 0 ? 3 : 2); t++) {
             int32_t e = off[to[t]]++;
             list[2 * e] = (int32_t)j;
             list[2 * e + 1] = record_vertex[j];
@@ -434,9 +422,9 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
     m->face_neighbor = malloc(nc * sizeof *m->face_neighbor);
     m->component = malloc((size_t)nv * sizeof *m->component);
     m->degenerate = malloc((size_t)nf * sizeof *m->degenerate);
-    m->corners = malloc(nc * sizeof *m->corners);
+    m->full = malloc(nc * sizeof *m->full);
     if (!m->xyz || !m->faces || !m->face_neighbor || !m->component || !m->degenerate ||
-        !m->corners) {
+        !m->full) {
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
     }
@@ -462,7 +450,7 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
         st = mfmm_mesh_unfold_obtuse(m, opt.max_unfold_steps);
     }
     if (st == MFMM_OK)
-        st = build_update_lists(m);
+        st = build_records(m);
     if (st != MFMM_OK) {
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, st, -1, NULL);

@@ -13,6 +13,19 @@ typedef struct mfmm_virt_step {
     double t;       /* CV crosses it at e1 + t (e2 - e1) */
 } mfmm_virt_step;
 
+/* A corner while the mesh is built (mesh.c, unfold.c), by corner id 3f+k;
+ * the march gets compact records (mfmm_corner, mfmm_virt) from these. virt:
+ * V's id >= 0 (the obtuse corner is split by the virtual edge to V), or one
+ * of the MFMM_VIRT_ codes. */
+#define MFMM_VIRT_NONE (-1)       /* not obtuse: the plain stencil */
+#define MFMM_VIRT_FAILED (-2)     /* obtuse, walk failed: plain stencil */
+#define MFMM_VIRT_DEGENERATE (-3) /* zero-area face: edge updates only */
+typedef struct mfmm_corner_full {
+    int32_t face, a, b, virt;
+    double len_a, len_b, cos_c;
+    double virt_len, virt_cos_a, virt_cos_b;
+} mfmm_corner_full;
+
 struct mfmm_mesh {
     int32_t nv, nf;
     /* Vertices are numbered internally along a space-filling curve (order.h):
@@ -28,15 +41,19 @@ struct mfmm_mesh {
     int32_t *vertex_face_corner;
     int32_t *component;        /* (nv,) component id, -1 for unreferenced vertices */
     uint8_t *degenerate;       /* (nf,) 1 for zero-area faces */
-    mfmm_corner *corners;      /* (3 nf,) records for the march, grouped by vertex,
-                                  groups in breadth-first order (see mesh.c) */
+    mfmm_corner_full *full;    /* (3 nf,) while building only, then NULL */
+    mfmm_corner *corners;      /* (3 nf,) records for the march, grouped by vertex in
+                                  the vertex_face CSR order (record r is corner
+                                  vertex_face_corner[r]) */
+    int32_t *virt_index;       /* (3 nf,) by record: index into virt, or -1 */
+    mfmm_virt *virt;           /* (n_virtual_edges + 1,) the virtual edges */
     int32_t *update_offset;    /* (nv+1,) CSR: corners to recompute when a vertex settles */
     int32_t *update_corner;    /* pairs (index into corners, its vertex C) */
     int32_t *virt_offset;      /* (3 nf + 1,) CSR by corner 3f+k into virt_steps: the
                                   strip of an obtuse corner's virtual edge */
     mfmm_virt_step *virt_steps;
-    int32_t *strip;            /* the strips' vertices for the march, by corner
-                                  record (see mfmm_march_mesh.strip) */
+    int32_t *strip;            /* the strips' vertices for the march, by virtual
+                                  edge (see mfmm_march_mesh.strip) */
     mfmm_mesh_info info;
 };
 
@@ -48,12 +65,15 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
     m.update_offset = mesh->update_offset;
     m.update_corner = mesh->update_corner;
     m.corners = mesh->corners;
+    m.record_corner = mesh->vertex_face_corner;
+    m.virt_index = mesh->virt_index;
+    m.virt = mesh->virt;
     m.strip = mesh->strip;
     return m;
 }
 
 /* Finds the virtual edge of every obtuse corner by unfolding (section 4.2);
- * fills corners[].virt, virt_len, virt_cos_a, virt_cos_b, the strips
+ * fills full[].virt, virt_len, virt_cos_a, virt_cos_b, the strips
  * (virt_offset, virt_steps) and the counts.
  * Needs faces, xyz, face_neighbor, corners' lengths and cosines, with the
  * corners still in face order (corner 3f+k), as mesh creation has them then.

@@ -6,7 +6,8 @@
 
 #include "order.h"
 
-/* MFMM_VERTEX_ORDER: 1 Morton (default), 0 the input order (for A/B runs) */
+/* MFMM_VERTEX_ORDER: 1 Morton (default), 2 Hilbert, 0 the input order
+ * (for A/B runs) */
 #ifndef MFMM_VERTEX_ORDER
 #define MFMM_VERTEX_ORDER 1
 #endif
@@ -36,6 +37,35 @@ static uint64_t spread3(uint64_t x)
     return x;
 }
 
+/* Hilbert key of 21-bit coordinates x[3] (J. Skilling, "Programming the
+ * Hilbert curve", AIP Conf. Proc. 707, 2004: axes to transpose, then the
+ * bits interleaved as Morton's). */
+static uint64_t hilbert3(uint32_t x[3])
+{
+    const uint32_t top = 1u << 20;
+    for (uint32_t q = top; q > 1; q >>= 1) { /* inverse undo */
+        uint32_t p = q - 1;
+        for (int i = 0; i < 3; i++) {
+            if (x[i] & q) {
+                x[0] ^= p;
+            } else {
+                uint32_t t = (x[0] ^ x[i]) & p;
+                x[0] ^= t;
+                x[i] ^= t;
+            }
+        }
+    }
+    for (int i = 1; i < 3; i++) /* Gray encode */
+        x[i] ^= x[i - 1];
+    uint32_t t = 0;
+    for (uint32_t q = top; q > 1; q >>= 1)
+        if (x[2] & q)
+            t ^= q - 1;
+    for (int i = 0; i < 3; i++)
+        x[i] ^= t;
+    return spread3(x[2]) | spread3(x[1]) << 1 | spread3(x[0]) << 2;
+}
+
 mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_internal,
                              int32_t **to_external)
 {
@@ -63,12 +93,14 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_interna
          * proportions; 21 bits per axis */
         double scale = ext > 0.0 ? 2097151.0 / ext : 0.0;
         for (int32_t v = 0; v < nv; v++) {
-            uint64_t key = 0;
+            uint32_t u[3];
             for (int k = 0; k < 3; k++) {
                 double q = (xyz[3 * (size_t)v + k] - lo[k]) * scale;
-                uint64_t u = q > 2097151.0 ? 2097151u : (uint64_t)q;
-                key |= spread3(u) << k;
+                u[k] = q > 2097151.0 ? 2097151u : (uint32_t)q;
             }
+            uint64_t key = MFMM_VERTEX_ORDER == 2
+                               ? hilbert3(u)
+                               : spread3(u[0]) | spread3(u[1]) << 1 | spread3(u[2]) << 2;
             keys[v].key = key;
             keys[v].id = v;
         }

@@ -665,7 +665,7 @@ const char *mfmm_opencl_context_device_name(const mfmm_opencl_context *context)
 
 /* ---- rows ---- */
 
-enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_ORDER, MB_LABEL, MB_KEY, MB_VERT,
+enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_ORDER, MB_RCORNER, MB_VINDEX, MB_VIRT, MB_LABEL, MB_KEY, MB_VERT,
        MB_POS, MB_T, MB_OUT, MB_COUNT };
 
 /* Bytes per work-item on the device (workspace and output row), and on the
@@ -775,10 +775,21 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     if (e == CL_SUCCESS)
         mem[MB_SOURCES] = api->clCreateBuffer(cl.context, ro, (size_t)job->n_sources * sizeof(int32_t),
                                          (void *)job->sources, &e);
-    if (e == CL_SUCCESS) /* virtual edges' strips (march.h) */
-        mem[MB_STRIP] = api->clCreateBuffer(cl.context, ro,
-                                       (size_t)mesh->strip[3 * (size_t)mesh->nf] * sizeof(int32_t),
-                                       mesh->strip, &e);
+    /* virtual edges apart from the corner records, their strips (march.h) */
+    size_t n_virt = (size_t)mesh->info.n_virtual_edges;
+    size_t n_strip = (size_t)mesh->virt[n_virt].strip;
+    if (e == CL_SUCCESS)
+        mem[MB_STRIP] = api->clCreateBuffer(cl.context, ro, (n_strip ? n_strip : 1) * sizeof(int32_t),
+                                            mesh->strip, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_RCORNER] = api->clCreateBuffer(cl.context, ro, (size_t)mesh->nf * 3 * sizeof(int32_t),
+                                              mesh->vertex_face_corner, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_VINDEX] = api->clCreateBuffer(cl.context, ro, (size_t)mesh->nf * 3 * sizeof(int32_t),
+                                             mesh->virt_index, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_VIRT] = api->clCreateBuffer(cl.context, ro, (n_virt + 1) * sizeof(mfmm_virt),
+                                           mesh->virt, &e);
     /* with a cost: the cost around each vertex, for the virtual stencils
      * (march.h), once for the job */
     if (e == CL_SUCCESS && job->cost && job->opt->unfolding) {
@@ -875,6 +886,9 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         e |= api->clSetKernelArg(cl.kernel, 19, sizeof n_targets, &n_targets);
         e |= api->clSetKernelArg(cl.kernel, 20, sizeof(cl_mem), &t_ws);
         e |= api->clSetKernelArg(cl.kernel, 21, sizeof(cl_mem), &mem[MB_ORDER]);
+        e |= api->clSetKernelArg(cl.kernel, 22, sizeof(cl_mem), &mem[MB_RCORNER]);
+        e |= api->clSetKernelArg(cl.kernel, 23, sizeof(cl_mem), &mem[MB_VINDEX]);
+        e |= api->clSetKernelArg(cl.kernel, 24, sizeof(cl_mem), &mem[MB_VIRT]);
     } else {
         e |= api->clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_T]);
         e |= api->clSetKernelArg(cl.kernel, 16, sizeof(cl_mem), &mem[MB_OUT]);
@@ -884,6 +898,9 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         e |= api->clSetKernelArg(cl.kernel, 20, sizeof n_targets, &n_targets);
         e |= api->clSetKernelArg(cl.kernel, 21, sizeof(cl_mem), &t_ws);
         e |= api->clSetKernelArg(cl.kernel, 22, sizeof(cl_mem), &mem[MB_ORDER]);
+        e |= api->clSetKernelArg(cl.kernel, 23, sizeof(cl_mem), &mem[MB_RCORNER]);
+        e |= api->clSetKernelArg(cl.kernel, 24, sizeof(cl_mem), &mem[MB_VINDEX]);
+        e |= api->clSetKernelArg(cl.kernel, 25, sizeof(cl_mem), &mem[MB_VIRT]);
     }
     if (e != CL_SUCCESS) {
         st = runtime_fail(err, "clSetKernelArg", e);
