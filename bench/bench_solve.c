@@ -145,6 +145,15 @@ static void bench(const char *name, const double *V, int32_t nv, const int32_t *
         return;
     }
     double t_build = now() - t0;
+    /* issue 13.3: bytes per vertex of the built mesh, each array's share */
+    const char *names[32];
+    size_t bytes[32], total = 0;
+    int n_arrays = mfmm_mesh_memory(mesh, names, bytes, 32);
+    for (int i = 0; i < n_arrays && i < 32; i++)
+        total += bytes[i];
+    printf("%-22s nv=%7d mesh %.1f bytes/vertex:", name, nv, (double)total / nv);
+    for (int i = 0; i < n_arrays && i < 32; i++)
+        printf(" %s %.1f%s", names[i], (double)bytes[i] / nv, i + 1 < n_arrays ? "," : "\n");
     mfmm_solver *solver = NULL;
     double *d = malloc((size_t)nv * sizeof *d);
     double *times = malloc((size_t)repeats * n_sources * sizeof *times);

@@ -123,7 +123,12 @@ MFMM_API void mfmm_mesh_options_init(mfmm_mesh_options *options);
  * (MFMM_ERR_BAD_ARGUMENT: rescale), indices out of
  * range, a face that repeats a vertex. Results do not depend on the mesh's
  * scale (a mesh scaled by s gives distances scaled by s). Accepted: boundaries, several components,
- * unreferenced vertices, non-manifold edges, zero-area and needle faces. */
+ * unreferenced vertices, non-manifold edges, zero-area and needle faces.
+ * Inside, vertices are renumbered along a space-filling curve (for memory
+ * locality); every function takes and returns the caller's vertex ids and
+ * per-vertex arrays in the caller's order, and faces keep their ids, so
+ * results do not depend on the order the vertices are given in (but for
+ * vertices that share a position). */
 MFMM_API mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv,
                                       const int32_t *faces, int32_t nf,
                                       const mfmm_mesh_options *options,
@@ -188,7 +193,9 @@ typedef enum mfmm_cost_location {
 typedef struct mfmm_solver mfmm_solver;
 
 /* A reusable workspace (heap, labels, a touched list) for one mesh and one
- * thread: about 40 bytes per vertex. Solving allocates nothing. Between
+ * thread: about 40 bytes per vertex. Solving allocates nothing beyond a copy
+ * of its arguments in the mesh's internal vertex order (sources, targets, a
+ * per-vertex cost), kept and reused while large enough. Between
  * solves the workspace is kept clean by resetting only the vertices the
  * last march reached, so a local solve (max_distance, targets) costs in
  * proportion to what it reaches, apart from filling `distances`. */

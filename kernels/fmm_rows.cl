@@ -21,17 +21,15 @@ inline void mfmm_row_march(int nv, __global const int *update_offset,
                            __global int *heap_pos, __global const int *strip,
                            __global const double *uniform,
                            __global const int *targets, int n_targets,
-                           __global const int *record_corner, __global const int *virt_index,
-                           __global const mfmm_virt *virt)
+                           __global const int *slot_corner, __global const int *strip_offset)
 {
     mfmm_march_mesh m;
     m.nv = nv;
     m.update_offset = update_offset;
     m.update_corner = update_corner;
     m.corners = corners;
-    m.record_corner = record_corner;
-    m.virt_index = virt_index;
-    m.virt = virt;
+    m.slot_corner = slot_corner;
+    m.strip_offset = strip_offset;
     m.strip = strip;
     mfmm_march_state s;
     s.T = T_row;
@@ -72,8 +70,8 @@ __kernel void fmm_rows_f64(int nv, __global const int *update_offset,
                            __global int *vert_ws, __global int *pos_ws, __global double *out,
                            __global const int *strip, __global const double *uniform,
                            __global const int *targets, int n_targets, __global double *T_ws,
-                           __global const int *order, __global const int *record_corner,
-                           __global const int *virt_index, __global const mfmm_virt *virt)
+                           __global const int *order, __global const int *slot_corner,
+                           __global const int *strip_offset)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
@@ -83,7 +81,7 @@ __kernel void fmm_rows_f64(int nv, __global const int *update_offset,
     mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
                    key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets,
-                   record_corner, virt_index, virt);
+                   slot_corner, strip_offset);
     if (n_targets > 0) {
         __global double *row = out + (ulong)i * (ulong)n_targets;
         for (int j = 0; j < n_targets; j++)
@@ -107,8 +105,8 @@ __kernel void fmm_rows_f32(int nv, __global const int *update_offset,
                            __global double *T_ws, __global float *out,
                            __global const int *strip, __global const double *uniform,
                            __global const int *targets, int n_targets, __global double *unused,
-                           __global const int *order, __global const int *record_corner,
-                           __global const int *virt_index, __global const mfmm_virt *virt)
+                           __global const int *order, __global const int *slot_corner,
+                           __global const int *strip_offset)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
@@ -118,7 +116,7 @@ __kernel void fmm_rows_f32(int nv, __global const int *update_offset,
     mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
                    key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets,
-                   record_corner, virt_index, virt);
+                   slot_corner, strip_offset);
     (void)unused;
     if (n_targets > 0) {
         __global float *row = out + (ulong)i * (ulong)n_targets;

@@ -28,28 +28,30 @@ typedef int32_t mfmm_i32;
 typedef uint8_t mfmm_u8;
 #endif
 
+/* A corner is obtuse (section 4.2) when cos theta is below this. */
+#define MFMM_OBTUSE_COS (-1e-9)
+
 /* One corner C of a face, with what its update needs: its other vertices A
  * and B (a = |BC|, b = |AC|, angle theta at C). C itself and the face are
- * known from where the record is stored (records are grouped by vertex, in
- * the vertex -> corner CSR order). cos_c is NaN on a zero-area face (no
- * triangle update: Eq. 4 then yields +inf), and < 0 at an obtuse corner,
- * whose virtual edge, if unfolding found one, is an mfmm_virt record apart
- * (march.h). 32 bytes (was 64 with the virtual-edge data in every record),
- * the same layout in C and OpenCL C. */
+ * known from where the record is stored (march.h). cos_c is NaN on a
+ * zero-area face (no triangle update: Eq. 4 then yields +inf, at no cost).
+ * An obtuse corner's record is followed by an mfmm_virt in the next slot,
+ * so that its virtual edge comes in the same fetch, and only obtuse corners
+ * pay for one. 32 bytes (was 64 for every corner), C and OpenCL C. */
 typedef struct mfmm_corner {
     mfmm_i32 a, b;
     double len_a;      /* |BC| */
     double len_b;      /* |AC| */
-    double cos_c;      /* cos theta at C */
+    double cos_c;      /* cos theta at C (NaN: zero area) */
 } mfmm_corner;
 
-/* The virtual edge C -> V of an obtuse corner (section 4.2): V of the
- * unfolded patch, |CV| and the cosines of the two angles it splits theta
- * into (A-C-V and V-C-B); strip: where its strip's vertices start (they end
- * where the next record's start). 32 bytes, C and OpenCL C. */
+/* The virtual edge C -> V of an obtuse corner (section 4.2), in the slot
+ * after its mfmm_corner: V of the unfolded patch (-1: the walk failed, the
+ * plain stencil), |CV| and the cosines of the two angles it splits theta
+ * into (A-C-V and V-C-B). 32 bytes, C and OpenCL C. */
 typedef struct mfmm_virt {
     mfmm_i32 v;
-    mfmm_i32 strip;
+    mfmm_i32 unused;
     double len;   /* |CV| in the unfolded plane */
     double cos_a; /* cos of angle A-C-V */
     double cos_b; /* cos of angle V-C-B */

@@ -19,16 +19,15 @@ typedef struct mfmm_march_mesh {
      * 2 * update_offset[nv] entries; C is here so that settled neighbours are
      * skipped without touching their corner records */
     MFMM_GLOBAL const mfmm_i32 *update_corner;
-    MFMM_GLOBAL const mfmm_corner *corners; /* (3 nf,) grouped by vertex C */
-    /* record r is corner record_corner[r] = 3 f + k (the vertex -> corner
-     * CSR), read for the face's cost only */
-    MFMM_GLOBAL const mfmm_i32 *record_corner;
-    /* (3 nf,) by record: its mfmm_virt in virt, or -1 (not obtuse, or the
-     * walk failed: the plain stencil); read at obtuse corners only */
-    MFMM_GLOBAL const mfmm_i32 *virt_index;
-    MFMM_GLOBAL const mfmm_virt *virt; /* n_virt + 1 (the last: strip end) */
-    /* the vertices each virtual edge's strip unfolds up to V (A and B aside):
-     * strip[virt[i].strip] .. strip[virt[i + 1].strip - 1] */
+    /* corner records in slots of 32 bytes, grouped by vertex C; an obtuse
+     * corner's record takes two (its mfmm_virt in the second) */
+    MFMM_GLOBAL const mfmm_corner *corners;
+    /* slot r's corner 3 f + k: for the face's cost and the strip only */
+    MFMM_GLOBAL const mfmm_i32 *slot_corner;
+    /* the vertices each virtual edge's strip unfolds up to V (A and B
+     * aside): strip[strip_offset[k]] .. strip[strip_offset[k + 1] - 1] for
+     * corner k = 3 f + k' */
+    MFMM_GLOBAL const mfmm_i32 *strip_offset;
     MFMM_GLOBAL const mfmm_i32 *strip;
 } mfmm_march_mesh;
 
@@ -182,7 +181,7 @@ MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, const mfmm_march_m
         return f;
     }
     if (s->cost_location == 2)
-        f = s->cost[m->record_corner[r] / 3];
+        f = s->cost[m->slot_corner[r] / 3];
     *f_a = f;
     *f_b = f;
     *f_t = f;
@@ -199,13 +198,13 @@ MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, const mfmm_march_m
  * takes the plain stencil, as with unfolding off (issue 9.1: a cost-1 face's
  * virtual edge through cost-100 faces made T 50x too low). */
 MFMM_INLINE int mfmm_march_virt_ok(const mfmm_march_state *s, const mfmm_march_mesh *m,
-                                   MFMM_GLOBAL const mfmm_corner *cr,
-                                   MFMM_GLOBAL const mfmm_virt *vr, double f)
+                                   MFMM_GLOBAL const mfmm_corner *cr, mfmm_i32 r, double f)
 {
     MFMM_GLOBAL const double *U = s->uniform;
     if (U[cr->a] != f || U[cr->b] != f)
         return 0;
-    for (mfmm_i32 i = vr->strip; i < vr[1].strip; i++)
+    mfmm_i32 k = m->slot_corner[r];
+    for (mfmm_i32 i = m->strip_offset[k]; i < m->strip_offset[k + 1]; i++)
         if (U[m->strip[i]] != f)
             return 0;
     return 1;
@@ -251,18 +250,16 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
             double f = mfmm_march_cost(s, m, cr, r, c, &f_a, &f_b, &f_t);
             /* an obtuse corner's virtual stencil (section 4.2), if it has one */
             MFMM_GLOBAL const mfmm_virt *vr = 0;
-            if (cr->cos_c < 0.0 && s->unfolding) {
-                mfmm_i32 vi = m->virt_index[r];
-                if (vi >= 0) {
-                    vr = m->virt + vi;
-                    /* (the footprint matters once V, or both A and B, have settled) */
-                    if (s->cost_location != 0 &&
-                        ((s->label[vr->v] & MFMM_STATE_MASK) == MFMM_ALIVE ||
-                         ((s->label[cr->a] & MFMM_STATE_MASK) == MFMM_ALIVE &&
-                          (s->label[cr->b] & MFMM_STATE_MASK) == MFMM_ALIVE)) &&
-                        !mfmm_march_virt_ok(s, m, cr, vr, f))
-                        vr = 0;
-                }
+            if (cr->cos_c < MFMM_OBTUSE_COS && s->unfolding) {
+                vr = (MFMM_GLOBAL const mfmm_virt *)(cr + 1);
+                /* (the footprint matters once V, or both A and B, have settled) */
+                if (vr->v < 0 ||
+                    (s->cost_location != 0 &&
+                     ((s->label[vr->v] & MFMM_STATE_MASK) == MFMM_ALIVE ||
+                      ((s->label[cr->a] & MFMM_STATE_MASK) == MFMM_ALIVE &&
+                       (s->label[cr->b] & MFMM_STATE_MASK) == MFMM_ALIVE)) &&
+                     !mfmm_march_virt_ok(s, m, cr, r, f)))
+                    vr = 0;
             }
             double t = mfmm_corner_update(cr, vr, s->T, s->label, f_a, f_b, f_t);
             if (t < s->T[c]) {

@@ -42,18 +42,19 @@ struct mfmm_mesh {
     int32_t *component;        /* (nv,) component id, -1 for unreferenced vertices */
     uint8_t *degenerate;       /* (nf,) 1 for zero-area faces */
     mfmm_corner_full *full;    /* (3 nf,) while building only, then NULL */
-    mfmm_corner *corners;      /* (3 nf,) records for the march, grouped by vertex in
-                                  the vertex_face CSR order (record r is corner
-                                  vertex_face_corner[r]) */
-    int32_t *virt_index;       /* (3 nf,) by record: index into virt, or -1 */
-    mfmm_virt *virt;           /* (n_virtual_edges + 1,) the virtual edges */
+    mfmm_corner *corners;      /* (n_slots,) records for the march, grouped by vertex in
+                                  the vertex_face CSR order; an obtuse corner's
+                                  record is followed by its mfmm_virt */
+    void *corners_block;       /* the allocation corners lies in (cache-line aligned) */
+    int32_t n_slots;
+    int32_t *slot_corner;      /* (n_slots,) the corner 3f+k of each slot */
     int32_t *update_offset;    /* (nv+1,) CSR: corners to recompute when a vertex settles */
     int32_t *update_corner;    /* pairs (index into corners, its vertex C) */
     int32_t *virt_offset;      /* (3 nf + 1,) CSR by corner 3f+k into virt_steps: the
                                   strip of an obtuse corner's virtual edge */
     mfmm_virt_step *virt_steps;
-    int32_t *strip;            /* the strips' vertices for the march, by virtual
-                                  edge (see mfmm_march_mesh.strip) */
+    int32_t *strip;            /* virt_steps[].far, for the march (see
+                                  mfmm_march_mesh.strip) */
     mfmm_mesh_info info;
 };
 
@@ -65,9 +66,8 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
     m.update_offset = mesh->update_offset;
     m.update_corner = mesh->update_corner;
     m.corners = mesh->corners;
-    m.record_corner = mesh->vertex_face_corner;
-    m.virt_index = mesh->virt_index;
-    m.virt = mesh->virt;
+    m.slot_corner = mesh->slot_corner;
+    m.strip_offset = mesh->virt_offset;
     m.strip = mesh->strip;
     return m;
 }
@@ -86,6 +86,11 @@ mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *mesh, int32_t max_steps);
  * cost_location 1 per vertex, 2 per face. */
 void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_location,
                        double *uniform);
+
+/* The bytes a built mesh holds, array by array (issue 13.3): up to `max`
+ * entries of (name, bytes) into names/bytes; returns the number of arrays
+ * (all of them, even past max). */
+int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, int max);
 
 /* Fills err (if any) and returns status. */
 mfmm_status mfmm_fail(mfmm_error *err, mfmm_status status, int64_t index, const char *fmt, ...)

@@ -665,7 +665,7 @@ const char *mfmm_opencl_context_device_name(const mfmm_opencl_context *context)
 
 /* ---- rows ---- */
 
-enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_ORDER, MB_RCORNER, MB_VINDEX, MB_VIRT, MB_LABEL, MB_KEY, MB_VERT,
+enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_ORDER, MB_SLOTCORNER, MB_STRIPOFF, MB_LABEL, MB_KEY, MB_VERT,
        MB_POS, MB_T, MB_OUT, MB_COUNT };
 
 /* Bytes per work-item on the device (workspace and output row), and on the
@@ -765,7 +765,7 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
                                         n_upd ? (void *)mesh->update_corner : (void *)&one, &e);
     if (e == CL_SUCCESS)
         mem[MB_CORNERS] = api->clCreateBuffer(cl.context, ro,
-                                         (size_t)mesh->nf * 3 * sizeof(mfmm_corner),
+                                         (size_t)mesh->n_slots * sizeof(mfmm_corner),
                                          mesh->corners, &e);
     if (e == CL_SUCCESS) {
         size_t nc = job->cost_location == 1 ? nv : job->cost_location == 2 ? (size_t)mesh->nf : 1;
@@ -775,21 +775,17 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     if (e == CL_SUCCESS)
         mem[MB_SOURCES] = api->clCreateBuffer(cl.context, ro, (size_t)job->n_sources * sizeof(int32_t),
                                          (void *)job->sources, &e);
-    /* virtual edges apart from the corner records, their strips (march.h) */
-    size_t n_virt = (size_t)mesh->info.n_virtual_edges;
-    size_t n_strip = (size_t)mesh->virt[n_virt].strip;
+    /* each slot's corner, virtual edges' strips (march.h) */
+    size_t nc = (size_t)mesh->nf * 3, n_strip = (size_t)mesh->virt_offset[nc];
     if (e == CL_SUCCESS)
         mem[MB_STRIP] = api->clCreateBuffer(cl.context, ro, (n_strip ? n_strip : 1) * sizeof(int32_t),
                                             mesh->strip, &e);
     if (e == CL_SUCCESS)
-        mem[MB_RCORNER] = api->clCreateBuffer(cl.context, ro, (size_t)mesh->nf * 3 * sizeof(int32_t),
-                                              mesh->vertex_face_corner, &e);
+        mem[MB_SLOTCORNER] = api->clCreateBuffer(cl.context, ro, (size_t)mesh->n_slots * sizeof(int32_t),
+                                              mesh->slot_corner, &e);
     if (e == CL_SUCCESS)
-        mem[MB_VINDEX] = api->clCreateBuffer(cl.context, ro, (size_t)mesh->nf * 3 * sizeof(int32_t),
-                                             mesh->virt_index, &e);
-    if (e == CL_SUCCESS)
-        mem[MB_VIRT] = api->clCreateBuffer(cl.context, ro, (n_virt + 1) * sizeof(mfmm_virt),
-                                           mesh->virt, &e);
+        mem[MB_STRIPOFF] = api->clCreateBuffer(cl.context, ro, (nc + 1) * sizeof(int32_t),
+                                           mesh->virt_offset, &e);
     /* with a cost: the cost around each vertex, for the virtual stencils
      * (march.h), once for the job */
     if (e == CL_SUCCESS && job->cost && job->opt->unfolding) {
@@ -886,9 +882,8 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         e |= api->clSetKernelArg(cl.kernel, 19, sizeof n_targets, &n_targets);
         e |= api->clSetKernelArg(cl.kernel, 20, sizeof(cl_mem), &t_ws);
         e |= api->clSetKernelArg(cl.kernel, 21, sizeof(cl_mem), &mem[MB_ORDER]);
-        e |= api->clSetKernelArg(cl.kernel, 22, sizeof(cl_mem), &mem[MB_RCORNER]);
-        e |= api->clSetKernelArg(cl.kernel, 23, sizeof(cl_mem), &mem[MB_VINDEX]);
-        e |= api->clSetKernelArg(cl.kernel, 24, sizeof(cl_mem), &mem[MB_VIRT]);
+        e |= api->clSetKernelArg(cl.kernel, 22, sizeof(cl_mem), &mem[MB_SLOTCORNER]);
+        e |= api->clSetKernelArg(cl.kernel, 23, sizeof(cl_mem), &mem[MB_STRIPOFF]);
     } else {
         e |= api->clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_T]);
         e |= api->clSetKernelArg(cl.kernel, 16, sizeof(cl_mem), &mem[MB_OUT]);
@@ -898,9 +893,8 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         e |= api->clSetKernelArg(cl.kernel, 20, sizeof n_targets, &n_targets);
         e |= api->clSetKernelArg(cl.kernel, 21, sizeof(cl_mem), &t_ws);
         e |= api->clSetKernelArg(cl.kernel, 22, sizeof(cl_mem), &mem[MB_ORDER]);
-        e |= api->clSetKernelArg(cl.kernel, 23, sizeof(cl_mem), &mem[MB_RCORNER]);
-        e |= api->clSetKernelArg(cl.kernel, 24, sizeof(cl_mem), &mem[MB_VINDEX]);
-        e |= api->clSetKernelArg(cl.kernel, 25, sizeof(cl_mem), &mem[MB_VIRT]);
+        e |= api->clSetKernelArg(cl.kernel, 23, sizeof(cl_mem), &mem[MB_SLOTCORNER]);
+        e |= api->clSetKernelArg(cl.kernel, 24, sizeof(cl_mem), &mem[MB_STRIPOFF]);
     }
     if (e != CL_SUCCESS) {
         st = runtime_fail(err, "clSetKernelArg", e);
