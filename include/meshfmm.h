@@ -123,7 +123,12 @@ MFMM_API void mfmm_mesh_options_init(mfmm_mesh_options *options);
  * (MFMM_ERR_BAD_ARGUMENT: rescale), indices out of
  * range, a face that repeats a vertex. Results do not depend on the mesh's
  * scale (a mesh scaled by s gives distances scaled by s). Accepted: boundaries, several components,
- * unreferenced vertices, non-manifold edges, zero-area and needle faces. */
+ * unreferenced vertices, non-manifold edges, zero-area and needle faces.
+ * Inside, vertices are renumbered along a space-filling curve (for memory
+ * locality); every function takes and returns the caller's vertex ids and
+ * per-vertex arrays in the caller's order, and faces keep their ids, so
+ * results do not depend on the order the vertices are given in (but for
+ * vertices that share a position). */
 MFMM_API mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv,
                                       const int32_t *faces, int32_t nf,
                                       const mfmm_mesh_options *options,
@@ -195,7 +200,9 @@ typedef struct mfmm_solver mfmm_solver;
  * thread: about 40 bytes per vertex, plus, made by the first solve that uses
  * the exact start, an exact solver's workspace (about 180 bytes per face and
  * 45 per vertex, see mfmm_exact_solver_create). After that first solve,
- * solving allocates nothing (the exact start's queue grows only for a
+ * solving allocates nothing beyond a copy of its arguments in the mesh's
+ * internal vertex order (sources, targets, a per-vertex cost), kept and
+ * reused while large enough (the exact start's queue grows only for a
  * larger patch than any before). Between
  * solves the workspace is kept clean by resetting only the vertices the
  * last march reached, so a local solve (max_distance, targets) costs in

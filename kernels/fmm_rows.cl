@@ -26,6 +26,7 @@ inline void mfmm_row_march(int nv, __global const int *update_offset,
                            __global int *heap_pos, __global const int *strip,
                            __global const double *uniform,
                            __global const int *targets, int n_targets,
+                           __global const int *slot_corner, __global const int *strip_offset,
                            __global const int *seeds, int row,
                            __global const double *seed_value)
 {
@@ -34,6 +35,8 @@ inline void mfmm_row_march(int nv, __global const int *update_offset,
     m.update_offset = update_offset;
     m.update_corner = update_corner;
     m.corners = corners;
+    m.slot_corner = slot_corner;
+    m.strip_offset = strip_offset;
     m.strip = strip;
     mfmm_march_state s;
     s.T = T_row;
@@ -67,8 +70,9 @@ inline void mfmm_row_march(int nv, __global const int *update_offset,
     mfmm_march_run(&s, &m);
 }
 
-/* float64 rows: the output row is the march's T (with targets: T in
- * T_ws, the target columns copied out). */
+/* float64 rows: T in a workspace slice, the row gathered from it in the
+ * caller's vertex order (order: internal id of each input vertex, as
+ * src/core/order.h), or the target columns copied out. */
 __kernel void fmm_rows_f64(int nv, __global const int *update_offset,
                            __global const int *update_corner,
                            __global const mfmm_corner *corners, __global const double *cost,
@@ -78,36 +82,8 @@ __kernel void fmm_rows_f64(int nv, __global const int *update_offset,
                            __global int *vert_ws, __global int *pos_ws, __global double *out,
                            __global const int *strip, __global const double *uniform,
                            __global const int *targets, int n_targets, __global double *T_ws,
-                           int n_seeds, __global const int *seeds,
-                           __global const double *seed_value)
-{
-    int i = (int)get_global_id(0);
-    if (i >= count)
-        return;
-    ulong o = (ulong)i * (ulong)nv;
-    __global double *T = n_targets > 0 ? T_ws + o : out + o;
-    mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
-                   max_distance, unfolding, sources[first + i], T, label_ws + o,
-                   key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets,
-                   n_seeds > 0 ? seeds : 0, i, seed_value);
-    if (n_targets > 0) {
-        __global double *row = out + (ulong)i * (ulong)n_targets;
-        for (int j = 0; j < n_targets; j++)
-            row[j] = T[targets[j]];
-    }
-}
-
-/* float32 rows: T in a workspace slice, converted (round to nearest). */
-__kernel void fmm_rows_f32(int nv, __global const int *update_offset,
-                           __global const int *update_corner,
-                           __global const mfmm_corner *corners, __global const double *cost,
-                           int cost_location, double max_distance, int unfolding,
-                           __global const int *sources, int first, int count,
-                           __global uchar *label_ws, __global double *key_ws,
-                           __global int *vert_ws, __global int *pos_ws,
-                           __global double *T_ws, __global float *out,
-                           __global const int *strip, __global const double *uniform,
-                           __global const int *targets, int n_targets, __global double *unused,
+                           __global const int *order, __global const int *slot_corner,
+                           __global const int *strip_offset,
                            int n_seeds, __global const int *seeds,
                            __global const double *seed_value)
 {
@@ -119,7 +95,44 @@ __kernel void fmm_rows_f32(int nv, __global const int *update_offset,
     mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
                    key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets,
-                   n_seeds > 0 ? seeds : 0, i, seed_value);
+                   slot_corner, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value);
+    if (n_targets > 0) {
+        __global double *row = out + (ulong)i * (ulong)n_targets;
+        for (int j = 0; j < n_targets; j++)
+            row[j] = T[targets[j]];
+        return;
+    }
+    __global double *row = out + o;
+    for (int v = 0; v < nv; v++)
+        row[v] = T[order[v]];
+}
+
+/* float32 rows: T in a workspace slice, converted (round to nearest) in
+ * the caller's vertex order (as float64). */
+__kernel void fmm_rows_f32(int nv, __global const int *update_offset,
+                           __global const int *update_corner,
+                           __global const mfmm_corner *corners, __global const double *cost,
+                           int cost_location, double max_distance, int unfolding,
+                           __global const int *sources, int first, int count,
+                           __global uchar *label_ws, __global double *key_ws,
+                           __global int *vert_ws, __global int *pos_ws,
+                           __global double *T_ws, __global float *out,
+                           __global const int *strip, __global const double *uniform,
+                           __global const int *targets, int n_targets, __global double *unused,
+                           __global const int *order, __global const int *slot_corner,
+                           __global const int *strip_offset,
+                           int n_seeds, __global const int *seeds,
+                           __global const double *seed_value)
+{
+    int i = (int)get_global_id(0);
+    if (i >= count)
+        return;
+    ulong o = (ulong)i * (ulong)nv;
+    __global double *T = T_ws + o;
+    mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
+                   max_distance, unfolding, sources[first + i], T, label_ws + o,
+                   key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets,
+                   slot_corner, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value);
     (void)unused;
     if (n_targets > 0) {
         __global float *row = out + (ulong)i * (ulong)n_targets;
@@ -129,5 +142,5 @@ __kernel void fmm_rows_f32(int nv, __global const int *update_offset,
     }
     __global float *row = out + o;
     for (int v = 0; v < nv; v++)
-        row[v] = (float)T[v];
+        row[v] = (float)T[order[v]];
 }

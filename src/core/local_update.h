@@ -14,7 +14,7 @@
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 #pragma OPENCL FP_CONTRACT OFF
 #define MFMM_GLOBAL __global
-#define MFMM_INLINE inline
+#define MFMM_INLINE inline __attribute__((always_inline)) /* PoCL makes calls of plain inline (issue 13.4) */
 #define MFMM_INF ((double)INFINITY)
 typedef int mfmm_i32;
 typedef uchar mfmm_u8;
@@ -28,27 +28,34 @@ typedef int32_t mfmm_i32;
 typedef uint8_t mfmm_u8;
 #endif
 
-/* virt of a corner: a vertex id >= 0 (the corner is obtuse and split by the
- * virtual edge to that vertex, section 4.2), or one of these. */
-#define MFMM_VIRT_NONE (-1)       /* not obtuse: the plain stencil */
-#define MFMM_VIRT_FAILED (-2)     /* obtuse, walk failed: plain stencil */
-#define MFMM_VIRT_DEGENERATE (-3) /* zero-area face: edge updates only */
+/* A corner is obtuse (section 4.2) when cos theta is below this. */
+#define MFMM_OBTUSE_COS (-1e-9)
 
-/* One corner C of a face, with what its update needs: the face, its other
- * vertices A and B (a = |BC|, b = |AC|, angle theta at C) and, for an
- * obtuse corner, the virtual vertex V of the unfolded patch, with |CV| and the
- * cosines of the two angles the virtual edge splits theta into (A-C-V and
- * V-C-B). C itself is known from where the corner is stored (corners are
- * grouped by vertex). 64 bytes, the same layout in C and OpenCL C. */
+/* One corner C of a face, with what its update needs: its other vertices A
+ * and B (a = |BC|, b = |AC|, angle theta at C). C itself and the face are
+ * known from where the record is stored (march.h). cos_c is NaN on a
+ * zero-area face (no triangle update: Eq. 4 then yields +inf, at no cost).
+ * An obtuse corner's record is followed by an mfmm_virt in the next slot,
+ * so that its virtual edge comes in the same fetch, and only obtuse corners
+ * pay for one. 32 bytes (was 64 for every corner), C and OpenCL C. */
 typedef struct mfmm_corner {
-    mfmm_i32 face, a, b, virt;
+    mfmm_i32 a, b;
     double len_a;      /* |BC| */
     double len_b;      /* |AC| */
-    double cos_c;      /* cos theta at C */
-    double virt_len;   /* |CV| in the unfolded plane */
-    double virt_cos_a; /* cos of angle A-C-V */
-    double virt_cos_b; /* cos of angle V-C-B */
+    double cos_c;      /* cos theta at C (NaN: zero area) */
 } mfmm_corner;
+
+/* The virtual edge C -> V of an obtuse corner (section 4.2), in the slot
+ * after its mfmm_corner: V of the unfolded patch (-1: the walk failed, the
+ * plain stencil), |CV| and the cosines of the two angles it splits theta
+ * into (A-C-V and V-C-B). 32 bytes, C and OpenCL C. */
+typedef struct mfmm_virt {
+    mfmm_i32 v;
+    mfmm_i32 unused;
+    double len;   /* |CV| in the unfolded plane */
+    double cos_a; /* cos of angle A-C-V */
+    double cos_b; /* cos of angle V-C-B */
+} mfmm_virt;
 
 /* Vertex labels of section 2 (Far, Close, Alive), plus a flag for targets. */
 #define MFMM_FAR 0
@@ -129,34 +136,37 @@ MFMM_INLINE double mfmm_triangle_update(double ta, double tb, double a, double b
 
 /* The best T(C) that corner `cr` offers from its settled neighbours; +inf if
  * none. Costs: f_b along edge CA, f_a along edge CB, f_t across the
- * triangle and over the virtual stencil (which is used only where the cost
- * is the same all around, march.h); unfolding 0 ignores virtual edges. */
+ * triangle and over the virtual stencil vr (which is used only where the
+ * cost is the same all around, march.h); vr NULL: the plain stencil. */
 MFMM_INLINE double mfmm_corner_update(MFMM_GLOBAL const mfmm_corner *cr,
+                                      MFMM_GLOBAL const mfmm_virt *vr,
                                       MFMM_GLOBAL const double *T,
                                       MFMM_GLOBAL const mfmm_u8 *label,
-                                      double f_a, double f_b, double f_t, int unfolding)
+                                      double f_a, double f_b, double f_t)
 {
-    mfmm_i32 ia = cr->a, ib = cr->b, iv = cr->virt;
+    mfmm_i32 ia = cr->a, ib = cr->b;
     int alive_a = (label[ia] & MFMM_STATE_MASK) == MFMM_ALIVE;
     int alive_b = (label[ib] & MFMM_STATE_MASK) == MFMM_ALIVE;
     double best = MFMM_INF;
     if (alive_a) best = mfmm_min(best, T[ia] + cr->len_b * f_b);
     if (alive_b) best = mfmm_min(best, T[ib] + cr->len_a * f_a);
-    if (iv >= 0 && unfolding) {
+    if (vr) {
         /* section 4.2: the obtuse angle split into two acute virtual
          * triangles A-C-V and V-C-B */
+        mfmm_i32 iv = vr->v;
         if ((label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE) {
             double tv = T[iv];
-            best = mfmm_min(best, tv + cr->virt_len * f_t);
+            best = mfmm_min(best, tv + vr->len * f_t);
             if (alive_a)
-                best = mfmm_min(best, mfmm_triangle_update(T[ia], tv, cr->virt_len, cr->len_b,
-                                                       cr->virt_cos_a, f_t));
+                best = mfmm_min(best, mfmm_triangle_update(T[ia], tv, vr->len, cr->len_b,
+                                                       vr->cos_a, f_t));
             if (alive_b)
-                best = mfmm_min(best, mfmm_triangle_update(tv, T[ib], cr->len_a, cr->virt_len,
-                                                       cr->virt_cos_b, f_t));
+                best = mfmm_min(best, mfmm_triangle_update(tv, T[ib], cr->len_a, vr->len,
+                                                       vr->cos_b, f_t));
         }
-    } else if (alive_a && alive_b && iv != MFMM_VIRT_DEGENERATE) {
-        /* the edge updates are above, each with its own edge's cost */
+    } else if (alive_a && alive_b) {
+        /* the edge updates are above, each with its own edge's cost; a
+         * zero-area face's NaN cos_c makes this +inf */
         best = mfmm_min(best, mfmm_triangle_interior(T[ia], T[ib], cr->len_a, cr->len_b,
                                                  cr->cos_c, f_t));
     }

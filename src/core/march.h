@@ -19,9 +19,15 @@ typedef struct mfmm_march_mesh {
      * 2 * update_offset[nv] entries; C is here so that settled neighbours are
      * skipped without touching their corner records */
     MFMM_GLOBAL const mfmm_i32 *update_corner;
-    MFMM_GLOBAL const mfmm_corner *corners; /* (3 nf,) grouped by vertex C */
-    /* the vertices each virtual edge's strip unfolds up to V (A and B aside):
-     * strip[strip[r]] .. strip[strip[r + 1] - 1] for corner record r */
+    /* corner records in slots of 32 bytes, grouped by vertex C; an obtuse
+     * corner's record takes two (its mfmm_virt in the second) */
+    MFMM_GLOBAL const mfmm_corner *corners;
+    /* slot r's corner 3 f + k: for the face's cost and the strip only */
+    MFMM_GLOBAL const mfmm_i32 *slot_corner;
+    /* the vertices each virtual edge's strip unfolds up to V (A and B
+     * aside): strip[strip_offset[k]] .. strip[strip_offset[k + 1] - 1] for
+     * corner k = 3 f + k' */
+    MFMM_GLOBAL const mfmm_i32 *strip_offset;
     MFMM_GLOBAL const mfmm_i32 *strip;
 } mfmm_march_mesh;
 
@@ -161,8 +167,9 @@ MFMM_INLINE void mfmm_march_seed(mfmm_march_state *s, mfmm_i32 v, double value)
  * characteristic from AB to C has it. (F(C) alone over the whole triangle,
  * the paper's F_ij, made a cheap vertex pull T down through costly
  * neighbours: -96 % against a finer mesh, issue 9.1.) */
-MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, MFMM_GLOBAL const mfmm_corner *cr,
-                                   mfmm_i32 c, double *f_a, double *f_b, double *f_t)
+MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, const mfmm_march_mesh *m,
+                                   MFMM_GLOBAL const mfmm_corner *cr, mfmm_i32 r, mfmm_i32 c,
+                                   double *f_a, double *f_b, double *f_t)
 {
     double f = 1.0;
     if (s->cost_location == 1) {
@@ -174,14 +181,14 @@ MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, MFMM_GLOBAL const 
         return f;
     }
     if (s->cost_location == 2)
-        f = s->cost[cr->face];
+        f = s->cost[m->slot_corner[r] / 3];
     *f_a = f;
     *f_b = f;
     *f_t = f;
     return f;
 }
 
-/* Whether the virtual stencil of corner record r (vertex c) may be used
+/* Whether the virtual stencil vr of corner record cr may be used
  * under the march's cost. Its virtual edge and triangles charge the corner's
  * own F over the unfolded strip between C and V and over the virtual
  * triangles A-C-V, V-C-B, which lie over faces other than the corner's: it
@@ -196,7 +203,8 @@ MFMM_INLINE int mfmm_march_virt_ok(const mfmm_march_state *s, const mfmm_march_m
     MFMM_GLOBAL const double *U = s->uniform;
     if (U[cr->a] != f || U[cr->b] != f)
         return 0;
-    for (mfmm_i32 i = m->strip[r]; i < m->strip[r + 1]; i++)
+    mfmm_i32 k = m->slot_corner[r];
+    for (mfmm_i32 i = m->strip_offset[k]; i < m->strip_offset[k + 1]; i++)
         if (U[m->strip[i]] != f)
             return 0;
     return 1;
@@ -248,16 +256,22 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
                 continue;
             mfmm_i32 r = m->update_corner[2 * j];
             MFMM_GLOBAL const mfmm_corner *cr = m->corners + r;
-            int unfold = s->unfolding;
             double f_a, f_b, f_t;
-            double f = mfmm_march_cost(s, cr, c, &f_a, &f_b, &f_t);
-            /* (the footprint matters once V, or both A and B, have settled) */
-            if (unfold && s->cost_location != 0 && cr->virt >= 0 &&
-                ((s->label[cr->virt] & MFMM_STATE_MASK) == MFMM_ALIVE ||
-                 ((s->label[cr->a] & MFMM_STATE_MASK) == MFMM_ALIVE &&
-                  (s->label[cr->b] & MFMM_STATE_MASK) == MFMM_ALIVE)))
-                unfold = mfmm_march_virt_ok(s, m, cr, r, f);
-            double t = mfmm_corner_update(cr, s->T, s->label, f_a, f_b, f_t, unfold);
+            double f = mfmm_march_cost(s, m, cr, r, c, &f_a, &f_b, &f_t);
+            /* an obtuse corner's virtual stencil (section 4.2), if it has one */
+            MFMM_GLOBAL const mfmm_virt *vr = 0;
+            if (cr->cos_c < MFMM_OBTUSE_COS && s->unfolding) {
+                vr = (MFMM_GLOBAL const mfmm_virt *)(cr + 1);
+                /* (the footprint matters once V, or both A and B, have settled) */
+                if (vr->v < 0 ||
+                    (s->cost_location != 0 &&
+                     ((s->label[vr->v] & MFMM_STATE_MASK) == MFMM_ALIVE ||
+                      ((s->label[cr->a] & MFMM_STATE_MASK) == MFMM_ALIVE &&
+                       (s->label[cr->b] & MFMM_STATE_MASK) == MFMM_ALIVE)) &&
+                     !mfmm_march_virt_ok(s, m, cr, r, f)))
+                    vr = 0;
+            }
+            double t = mfmm_corner_update(cr, vr, s->T, s->label, f_a, f_b, f_t);
             if (t < s->T[c]) {
                 /* c joins the front: its own update list is read when it settles */
                 if (st == MFMM_FAR)

@@ -13,8 +13,26 @@ typedef struct mfmm_virt_step {
     double t;       /* CV crosses it at e1 + t (e2 - e1) */
 } mfmm_virt_step;
 
+/* A corner while the mesh is built (mesh.c, unfold.c), by corner id 3f+k;
+ * the march gets compact records (mfmm_corner, mfmm_virt) from these. virt:
+ * V's id >= 0 (the obtuse corner is split by the virtual edge to V), or one
+ * of the MFMM_VIRT_ codes. */
+#define MFMM_VIRT_NONE (-1)       /* not obtuse: the plain stencil */
+#define MFMM_VIRT_FAILED (-2)     /* obtuse, walk failed: plain stencil */
+#define MFMM_VIRT_DEGENERATE (-3) /* zero-area face: edge updates only */
+typedef struct mfmm_corner_full {
+    int32_t face, a, b, virt;
+    double len_a, len_b, cos_c;
+    double virt_len, virt_cos_a, virt_cos_b;
+} mfmm_corner_full;
+
 struct mfmm_mesh {
     int32_t nv, nf;
+    /* Vertices are numbered internally along a space-filling curve (order.h):
+     * every per-vertex array below, and the vertex ids in faces, are in
+     * that order; faces keep their input ids and corner order. */
+    int32_t *to_internal;      /* (nv,) internal id of each input vertex */
+    int32_t *to_external;      /* (nv,) input id of each internal vertex */
     double *xyz;               /* (nv, 3) */
     int32_t *faces;            /* (nf, 3) */
     int32_t *face_neighbor;    /* (nf, 3): face across the edge opposite corner k,
@@ -23,15 +41,20 @@ struct mfmm_mesh {
     int32_t *vertex_face_corner;
     int32_t *component;        /* (nv,) component id, -1 for unreferenced vertices */
     uint8_t *degenerate;       /* (nf,) 1 for zero-area faces */
-    mfmm_corner *corners;      /* (3 nf,) records for the march, grouped by vertex,
-                                  groups in breadth-first order (see mesh.c) */
+    mfmm_corner_full *full;    /* (3 nf,) while building only, then NULL */
+    mfmm_corner *corners;      /* (n_slots,) records for the march, grouped by vertex in
+                                  the vertex_face CSR order; an obtuse corner's
+                                  record is followed by its mfmm_virt */
+    void *corners_block;       /* the allocation corners lies in (cache-line aligned) */
+    int32_t n_slots;
+    int32_t *slot_corner;      /* (n_slots,) the corner 3f+k of each slot */
     int32_t *update_offset;    /* (nv+1,) CSR: corners to recompute when a vertex settles */
     int32_t *update_corner;    /* pairs (index into corners, its vertex C) */
     int32_t *virt_offset;      /* (3 nf + 1,) CSR by corner 3f+k into virt_steps: the
                                   strip of an obtuse corner's virtual edge */
     mfmm_virt_step *virt_steps;
-    int32_t *strip;            /* the strips' vertices for the march, by corner
-                                  record (see mfmm_march_mesh.strip) */
+    int32_t *strip;            /* virt_steps[].far, for the march (see
+                                  mfmm_march_mesh.strip) */
     mfmm_mesh_info info;
 };
 
@@ -43,12 +66,14 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
     m.update_offset = mesh->update_offset;
     m.update_corner = mesh->update_corner;
     m.corners = mesh->corners;
+    m.slot_corner = mesh->slot_corner;
+    m.strip_offset = mesh->virt_offset;
     m.strip = mesh->strip;
     return m;
 }
 
 /* Finds the virtual edge of every obtuse corner by unfolding (section 4.2);
- * fills corners[].virt, virt_len, virt_cos_a, virt_cos_b, the strips
+ * fills full[].virt, virt_len, virt_cos_a, virt_cos_b, the strips
  * (virt_offset, virt_steps) and the counts.
  * Needs faces, xyz, face_neighbor, corners' lengths and cosines, with the
  * corners still in face order (corner 3f+k), as mesh creation has them then.
@@ -61,6 +86,11 @@ mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *mesh, int32_t max_steps);
  * cost_location 1 per vertex, 2 per face. */
 void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_location,
                        double *uniform);
+
+/* The bytes a built mesh holds, array by array (issue 13.3): up to `max`
+ * entries of (name, bytes) into names/bytes; returns the number of arrays
+ * (all of them, even past max). */
+int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, int max);
 
 /* Fills err (if any) and returns status. */
 mfmm_status mfmm_fail(mfmm_error *err, mfmm_status status, int64_t index, const char *fmt, ...)

@@ -86,7 +86,7 @@ static int strip_push(strip_buf *sb, mfmm_virt_step st, vec2 p1, vec2 p2)
 static int unfold_corner(mfmm_mesh *m, int32_t corner, int32_t max_steps, strip_buf *sb)
 {
     int32_t first = sb->n;
-    mfmm_corner *cr = m->corners + corner;
+    mfmm_corner_full *cr = m->full + corner;
     /* C at the origin, A on the x axis, B above it */
     double cos_c = cr->cos_c, sin_c = sqrt((1.0 - cos_c) * (1.0 + cos_c));
     vec2 pa = {cr->len_b, 0.0}, pb = {cr->len_a * cos_c, cr->len_a * sin_c};
@@ -159,7 +159,7 @@ mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *m, int32_t max_steps)
         return MFMM_ERR_OUT_OF_MEMORY;
     for (size_t c = 0; c < nc; c++) {
         m->virt_offset[c] = sb.n;
-        if (m->corners[c].virt != MFMM_VIRT_FAILED)
+        if (m->full[c].virt != MFMM_VIRT_FAILED)
             continue;
         int r = unfold_corner(m, (int32_t)c, max_steps, &sb);
         if (r < 0) {

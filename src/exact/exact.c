@@ -78,6 +78,7 @@
 #include "exact/exact.h"
 #include "core/mesh.h"
 #include "core/check.h"
+#include "core/order.h"
 
 #define EX_PI 3.14159265358979323846264338328
 #define EX_TWO_PI 6.283185307179586476925286766559
@@ -1008,7 +1009,13 @@ mfmm_status mfmm_solve_exact(mfmm_exact_solver *solver, const mfmm_source *sourc
     mfmm_status st = ex_check_sources(solver, sources, n_sources, err);
     if (st != MFMM_OK)
         return st;
-    st = ex_run(solver, sources, n_sources, max_d, options->memory_limit);
+    /* vertex sources in the mesh's internal order (core/order.h) */
+    mfmm_mapped_args mapped = {0};
+    if (mfmm_order_map_args(solver->mesh, sources, n_sources, NULL, 0, NULL, 0, NULL, &mapped) !=
+        MFMM_OK)
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the sources");
+    st = ex_run(solver, mapped.sources, n_sources, max_d, options->memory_limit);
+    free(mapped.block);
     ex_fill_info(solver, info);
     if (st != MFMM_OK) {
         if (st == MFMM_ERR_MEMORY_LIMIT)
@@ -1021,7 +1028,7 @@ mfmm_status mfmm_solve_exact(mfmm_exact_solver *solver, const mfmm_source *sourc
     for (int32_t i = 0; i < solver->n_touched; i++) {
         int32_t v = solver->touched[i];
         double dv = solver->d[v];
-        distances[v] = dv <= max_d ? dv : INFINITY;
+        distances[mfmm_vertex_out(solver->mesh, v)] = dv <= max_d ? dv : INFINITY;
     }
     return MFMM_OK;
 }

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "rows.h"
+#include "core/order.h"
 #include "solve/seed.h"
 #include "solve/solve.h"
 
@@ -92,14 +93,15 @@ static void put_value(const mfmm_rows_job *job, void *dst, size_t j, double t)
 }
 
 /* Solves row r into dst: a dense row of job->width values of the job's
- * dtype, or (sparse) an mfmm_sparse_row whose arrays it allocates; tmp is an
- * nv float64 row for float32 full rows. The job was checked once, in
- * mfmm_distance_matrix, so rows skip mfmm_solve's checks. Full dense rows
- * march straight into the row; target columns and sparse rows read the
- * solver's own T at the touched vertices only (cost ~ the row's reach).
+ * dtype, or (sparse) an mfmm_sparse_row whose arrays it allocates. The job
+ * was checked once, in mfmm_distance_matrix, so rows skip mfmm_solve's
+ * checks. The march runs in the solver's own T; full dense rows are
+ * gathered from it into input order in the one pass that writes the row;
+ * target columns and sparse rows read it at the touched vertices only
+ * (cost ~ the row's reach).
  * Returns the vertices settled, or -1 when out of memory. */
 static int64_t solve_row(const mfmm_rows_job *job, mfmm_solver *solver,
-                         const mfmm_solve_options *so, int32_t r, void *dst, double *tmp)
+                         const mfmm_solve_options *so, int32_t r, void *dst)
 {
     mfmm_source src;
     memset(&src, 0, sizeof src);
@@ -107,23 +109,26 @@ static int64_t solve_row(const mfmm_rows_job *job, mfmm_solver *solver,
     src.face = -1;
     src.value = 0.0;
     int32_t nv = job->mesh->nv;
-    if (!job->targets && !job->sparse) {
-        if (job->elem_size == sizeof(double))
-            return mfmm_solve_checked(solver, &src, 1, so, (double *)dst);
-        int32_t settled = mfmm_solve_checked(solver, &src, 1, so, tmp);
-        if (settled < 0)
-            return -1;
-        float *f = (float *)dst;
-        for (int32_t v = 0; v < nv; v++)
-            f[v] = (float)tmp[v];
-        return settled;
-    }
     const double *T;
     const int32_t *touched;
     int32_t n_touched;
     int32_t settled = mfmm_solve_local(solver, &src, 1, so, &T, &touched, &n_touched);
     if (settled < 0)
         return -1;
+    if (!job->targets && !job->sparse) {
+        /* the row's one pass: gathered into input order (core/order.h) */
+        const int32_t *in = job->mesh->to_internal;
+        if (job->elem_size == sizeof(double)) {
+            double *d = (double *)dst;
+            for (int32_t v = 0; v < nv; v++)
+                d[v] = T[in[v]];
+        } else {
+            float *f = (float *)dst;
+            for (int32_t v = 0; v < nv; v++)
+                f[v] = (float)T[in[v]];
+        }
+        return settled;
+    }
     if (!job->sparse) {
         for (int32_t j = 0; j < job->width; j++)
             put_value(job, dst, (size_t)j, T[job->targets[j]]);
@@ -144,12 +149,13 @@ static int64_t solve_row(const mfmm_rows_job *job, mfmm_solver *solver,
     } else {
         for (int32_t i = 0; i < n_touched; i++)
             if (T[touched[i]] < INFINITY)
-                row->idx[n++] = touched[i];
+                row->idx[n++] = mfmm_vertex_out(job->mesh, touched[i]); /* input ids */
         qsort(row->idx, (size_t)n, sizeof *row->idx, cmp_i32);
     }
     for (int32_t i = 0; i < n; i++)
         put_value(job, row->val, (size_t)i,
-                  T[job->targets ? job->targets[row->idx[i]] : row->idx[i]]);
+                  T[job->targets ? job->targets[row->idx[i]]
+                                 : mfmm_vertex_in(job->mesh, row->idx[i])]);
     row->n = n;
     return settled;
 }
@@ -185,22 +191,18 @@ static mfmm_status block_failed(mfmm_status st, int32_t first, mfmm_error *err)
 
 static mfmm_status run_serial(const mfmm_rows_job *job, int32_t start, mfmm_error *err)
 {
-    int32_t nv = job->mesh->nv;
     size_t row_bytes = job->slot_bytes;
     int direct = job->opt->out != NULL && !job->sparse;
     int32_t block = cpu_block_rows(job, 1, direct ? 0 : 1);
     mfmm_solver *solver = NULL;
-    double *tmp = NULL;
     char *buf = NULL;
     mfmm_status st = mfmm_solver_create(job->mesh, &solver);
     if (st != MFMM_OK)
         return mfmm_fail(err, st, -1, "could not create a solver");
     mfmm_solver_fix_cost(solver, job->cost, job->cost_location);
-    if (job->elem_size != sizeof(double))
-        tmp = malloc((size_t)nv * sizeof *tmp);
     if (!direct)
         buf = calloc((size_t)block, row_bytes);
-    if ((job->elem_size != sizeof(double) && !tmp) || (!direct && !buf)) {
+    if (!direct && !buf) {
         st = mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for a block of %d rows",
                        (int)block);
         goto done;
@@ -212,7 +214,7 @@ static mfmm_status run_serial(const mfmm_rows_job *job, int32_t start, mfmm_erro
         int32_t n = job->n_sources - first < block ? job->n_sources - first : block;
         char *base = direct ? (char *)job->opt->out + (size_t)first * row_bytes : buf;
         for (int32_t i = 0; i < n; i++) {
-            int64_t k = solve_row(job, solver, &so, first + i, base + (size_t)i * row_bytes, tmp);
+            int64_t k = solve_row(job, solver, &so, first + i, base + (size_t)i * row_bytes);
             if (k < 0) {
                 mfmm_sparse_rows_free((mfmm_sparse_row *)(void *)base, i + 1);
                 st = block_failed(MFMM_ERR_OUT_OF_MEMORY, first + i, err);
@@ -229,7 +231,6 @@ static mfmm_status run_serial(const mfmm_rows_job *job, int32_t start, mfmm_erro
     }
 done:
     free(buf);
-    free(tmp);
     mfmm_solver_destroy(solver);
     return st;
 }
@@ -288,15 +289,9 @@ static void *pool_worker(void *arg)
     pool *p = arg;
     const mfmm_rows_job *job = p->job;
     mfmm_solver *solver = NULL;
-    double *tmp = NULL;
     mfmm_status st = mfmm_solver_create(job->mesh, &solver);
     if (st == MFMM_OK)
         mfmm_solver_fix_cost(solver, job->cost, job->cost_location);
-    if (st == MFMM_OK && job->elem_size != sizeof(double)) {
-        tmp = malloc((size_t)job->mesh->nv * sizeof *tmp);
-        if (!tmp)
-            st = MFMM_ERR_OUT_OF_MEMORY;
-    }
     mfmm_solve_options so;
     fill_solve_options(job, &so);
     pthread_mutex_lock(&p->mu);
@@ -311,7 +306,7 @@ static void *pool_worker(void *arg)
         }
         p->next_row++;
         pthread_mutex_unlock(&p->mu);
-        int64_t k = solve_row(job, solver, &so, r, row_dest(p, r), tmp);
+        int64_t k = solve_row(job, solver, &so, r, row_dest(p, r));
         pthread_mutex_lock(&p->mu);
         if (k < 0) {
             pool_failed(p, MFMM_ERR_OUT_OF_MEMORY, NULL);
@@ -322,7 +317,6 @@ static void *pool_worker(void *arg)
             pthread_cond_broadcast(&p->cv_main);
     }
     pthread_mutex_unlock(&p->mu);
-    free(tmp);
     mfmm_solver_destroy(solver);
     return NULL;
 }
@@ -535,12 +529,28 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     }
     const double *cost = own_cost ? own_cost : o->cost;
     mfmm_status cst = mfmm_check_cost(mesh, cost, o->cost_location, err);
+    /* ids and per-vertex costs in the mesh's internal order (core/order.h),
+     * after the checks (whose messages name the caller's ids) */
+    double *mapped_cost = NULL;
+    if (cst == MFMM_OK && own_cost && o->cost_location == MFMM_COST_PER_VERTEX) {
+        mapped_cost = malloc((size_t)nv * sizeof *mapped_cost);
+        if (mapped_cost)
+            mfmm_order_values_in(mesh, own_cost, mapped_cost);
+        else
+            cst = mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the cost");
+        free(own_cost);
+        own_cost = mapped_cost;
+        cost = own_cost;
+    }
     if (cst != MFMM_OK) {
         free(own_sources);
         free(own_targets);
         free(own_cost);
         return cst;
     }
+    mfmm_order_ids_in(mesh, own_sources, n_sources, own_sources);
+    if (own_targets)
+        mfmm_order_ids_in(mesh, own_targets, o->n_targets, own_targets);
     mfmm_rows_job job;
     memset(&job, 0, sizeof job);
     job.mesh = mesh;

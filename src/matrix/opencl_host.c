@@ -666,7 +666,7 @@ const char *mfmm_opencl_context_device_name(const mfmm_opencl_context *context)
 
 /* ---- rows ---- */
 
-enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_LABEL, MB_KEY, MB_VERT,
+enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_ORDER, MB_SLOTCORNER, MB_STRIPOFF, MB_LABEL, MB_KEY, MB_VERT,
        MB_POS, MB_T, MB_OUT, MB_COUNT };
 
 /* Bytes per work-item on the device (workspace and output row), and on the
@@ -674,9 +674,8 @@ enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFO
 static size_t item_bytes(const mfmm_rows_job *job, int direct)
 {
     size_t nv = (size_t)job->mesh->nv, w = (size_t)job->width;
-    size_t b = nv * (1 + 8 + 4 + 4) + w * job->elem_size;
-    if (job->elem_size != sizeof(double) || job->targets)
-        b += nv * 8; /* T apart from the output row */
+    /* label, heap key, vertex and position, T apart from the output row */
+    size_t b = nv * (1 + 8 + 4 + 4 + 8) + w * job->elem_size;
     if (!direct)
         b += 2 * w * job->elem_size;
     return b;
@@ -840,7 +839,7 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
                                         n_upd ? (void *)mesh->update_corner : (void *)&one, &e);
     if (e == CL_SUCCESS)
         mem[MB_CORNERS] = api->clCreateBuffer(cl.context, ro,
-                                         (size_t)mesh->nf * 3 * sizeof(mfmm_corner),
+                                         (size_t)mesh->n_slots * sizeof(mfmm_corner),
                                          mesh->corners, &e);
     if (e == CL_SUCCESS) {
         size_t nc = job->cost_location == 1 ? nv : job->cost_location == 2 ? (size_t)mesh->nf : 1;
@@ -850,10 +849,17 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     if (e == CL_SUCCESS)
         mem[MB_SOURCES] = api->clCreateBuffer(cl.context, ro, (size_t)job->n_sources * sizeof(int32_t),
                                          (void *)job->sources, &e);
-    if (e == CL_SUCCESS) /* virtual edges' strips (march.h) */
-        mem[MB_STRIP] = api->clCreateBuffer(cl.context, ro,
-                                       (size_t)mesh->strip[3 * (size_t)mesh->nf] * sizeof(int32_t),
-                                       mesh->strip, &e);
+    /* each slot's corner, virtual edges' strips (march.h) */
+    size_t nc = (size_t)mesh->nf * 3, n_strip = (size_t)mesh->virt_offset[nc];
+    if (e == CL_SUCCESS)
+        mem[MB_STRIP] = api->clCreateBuffer(cl.context, ro, (n_strip ? n_strip : 1) * sizeof(int32_t),
+                                            mesh->strip, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_SLOTCORNER] = api->clCreateBuffer(cl.context, ro, (size_t)mesh->n_slots * sizeof(int32_t),
+                                              mesh->slot_corner, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_STRIPOFF] = api->clCreateBuffer(cl.context, ro, (nc + 1) * sizeof(int32_t),
+                                           mesh->virt_offset, &e);
     /* with a cost: the cost around each vertex, for the virtual stencils
      * (march.h), once for the job */
     if (e == CL_SUCCESS && job->cost && (job->opt->unfolding || exact)) {
@@ -872,6 +878,9 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
                                               (job->targets ? (size_t)job->width : 1) * sizeof(int32_t),
                                               job->targets ? (void *)job->targets : (void *)&no_target,
                                               &e);
+    if (e == CL_SUCCESS) /* rows gathered into the caller's vertex order */
+        mem[MB_ORDER] = api->clCreateBuffer(cl.context, ro, nv * sizeof(int32_t),
+                                            mesh->to_internal, &e);
     if (e != CL_SUCCESS) {
         st = runtime_fail(err, "uploading the mesh", e);
         goto done;
@@ -896,7 +905,7 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
             mem[MB_VERT] = api->clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv * 4, NULL, &e);
         if (e == CL_SUCCESS)
             mem[MB_POS] = api->clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv * 4, NULL, &e);
-        if (e == CL_SUCCESS && (!f64 || job->targets))
+        if (e == CL_SUCCESS)
             mem[MB_T] = api->clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * nv * 8, NULL, &e);
         if (e == CL_SUCCESS)
             mem[MB_OUT] = api->clCreateBuffer(cl.context, CL_MEM_READ_WRITE, b * row_bytes, NULL, &e);
@@ -937,9 +946,8 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     e |= api->clSetKernelArg(cl.kernel, 12, sizeof(cl_mem), &mem[MB_KEY]);
     e |= api->clSetKernelArg(cl.kernel, 13, sizeof(cl_mem), &mem[MB_VERT]);
     e |= api->clSetKernelArg(cl.kernel, 14, sizeof(cl_mem), &mem[MB_POS]);
-    /* the float64 kernel's T workspace is used only with targets (else T is
-     * the output row): any buffer stands in for it */
-    cl_mem t_ws = mem[MB_T] ? mem[MB_T] : mem[MB_KEY];
+    /* the float32 kernel's last workspace is unused: any buffer stands in */
+    cl_mem t_ws = mem[MB_T];
     if (f64) {
         e |= api->clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_OUT]);
         e |= api->clSetKernelArg(cl.kernel, 16, sizeof(cl_mem), &mem[MB_STRIP]);
@@ -947,6 +955,9 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         e |= api->clSetKernelArg(cl.kernel, 18, sizeof(cl_mem), &mem[MB_TARGETS]);
         e |= api->clSetKernelArg(cl.kernel, 19, sizeof n_targets, &n_targets);
         e |= api->clSetKernelArg(cl.kernel, 20, sizeof(cl_mem), &t_ws);
+        e |= api->clSetKernelArg(cl.kernel, 21, sizeof(cl_mem), &mem[MB_ORDER]);
+        e |= api->clSetKernelArg(cl.kernel, 22, sizeof(cl_mem), &mem[MB_SLOTCORNER]);
+        e |= api->clSetKernelArg(cl.kernel, 23, sizeof(cl_mem), &mem[MB_STRIPOFF]);
     } else {
         e |= api->clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_T]);
         e |= api->clSetKernelArg(cl.kernel, 16, sizeof(cl_mem), &mem[MB_OUT]);
@@ -955,9 +966,12 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         e |= api->clSetKernelArg(cl.kernel, 19, sizeof(cl_mem), &mem[MB_TARGETS]);
         e |= api->clSetKernelArg(cl.kernel, 20, sizeof n_targets, &n_targets);
         e |= api->clSetKernelArg(cl.kernel, 21, sizeof(cl_mem), &t_ws);
+        e |= api->clSetKernelArg(cl.kernel, 22, sizeof(cl_mem), &mem[MB_ORDER]);
+        e |= api->clSetKernelArg(cl.kernel, 23, sizeof(cl_mem), &mem[MB_SLOTCORNER]);
+        e |= api->clSetKernelArg(cl.kernel, 24, sizeof(cl_mem), &mem[MB_STRIPOFF]);
     }
     /* the seeds (set per batch with the exact start; else unused) */
-    cl_uint seed_arg = f64 ? 21 : 22;
+    cl_uint seed_arg = f64 ? 24 : 25;
     cl_int n_seeds = exact;
     e |= api->clSetKernelArg(cl.kernel, seed_arg, sizeof n_seeds, &n_seeds);
     e |= api->clSetKernelArg(cl.kernel, seed_arg + 1, sizeof(cl_mem), &mem[MB_SOURCES]);
@@ -1136,7 +1150,8 @@ static mfmm_status self_test(ocl *cl, mfmm_error *err)
     for (int32_t s = 0; st == MFMM_OK && s < NV; s++) {
         mfmm_source src;
         memset(&src, 0, sizeof src);
-        src.vertex = sources[s] = s;
+        src.vertex = s;
+        sources[s] = mesh->to_internal[s]; /* a job's sources are internal ids */
         src.face = -1;
         st = mfmm_solve(solver, &src, 1, NULL, ref + (size_t)s * NV, err);
     }

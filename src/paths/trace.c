@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/order.h"
 #include "core/start.h"
 #include "surface.h"
 #include "straighten.h"
@@ -69,6 +70,7 @@ static int read_T(tracer *t, int32_t v, double *out)
 {
     double x = t->T[v];
     if (isnan(x)) {
+        v = mfmm_vertex_out(t->m, v); /* the caller's id */
         t->st = mfmm_fail(t->err, MFMM_ERR_BAD_ARGUMENT, v, "distances[%d] is NaN", (int)v);
         return 0;
     }
@@ -81,6 +83,8 @@ static int read_cost(tracer *t, int32_t i, double *out)
 {
     double c = t->cost[i];
     if (!(isfinite(c) && c > 0.0)) {
+        if (t->cost_loc == MFMM_COST_PER_VERTEX)
+            i = mfmm_vertex_out(t->m, i); /* the caller's id */
         t->st = mfmm_fail(t->err, MFMM_ERR_BAD_COST, i, "cost[%d] = %g is not finite and > 0",
                           (int)i, c);
         return 0;
@@ -874,13 +878,22 @@ mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
                              o->sources[i].value);
     }
 
+    /* the caller's T, target, sources and per-vertex cost in the mesh's
+     * internal vertex order (core/order.h); points hold faces only */
+    mfmm_mapped_args mapped = {0};
+    mfmm_source target_in = *target;
+    if (target_in.face == -1)
+        target_in.vertex = mfmm_vertex_in(mesh, target_in.vertex);
+    if (mfmm_order_map_args(mesh, o->sources, o->n_sources, NULL, 0, o->cost,
+                            o->cost ? (int)o->cost_location : 0, distances, &mapped) != MFMM_OK)
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "no memory for the distances");
     tracer t;
     memset(&t, 0, sizeof t);
     t.m = mesh;
-    t.T = distances;
-    t.src = o->sources;
+    t.T = mapped.values;
+    t.src = mapped.sources;
     t.n_src = o->n_sources;
-    t.cost = o->cost;
+    t.cost = mapped.cost;
     t.cost_loc = o->cost ? o->cost_location : MFMM_COST_NONE;
     t.pts = points;
     t.cap = capacity;
@@ -894,6 +907,7 @@ mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
         if (!t.vkeys || !t.fkeys) {
             free(t.vkeys);
             free(t.fkeys);
+            free(mapped.block);
             return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "no memory for %d sources",
                              (int)t.n_src);
         }
@@ -918,7 +932,7 @@ mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
         t.cap = 0;
         t.grow = 1;
     }
-    st = trace(&t, target);
+    st = trace(&t, &target_in);
     free(t.vkeys);
     free(t.fkeys);
     if (straight) {
@@ -962,6 +976,7 @@ mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
         free(raw);
         free(sp);
     }
+    free(mapped.block);
     *n_points = t.n;
     if (length)
         *length = t.len;
@@ -985,8 +1000,8 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
     if (target->face == -1) {
         int32_t v = target->vertex;
         if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1])
-            return mfmm_fail(t->err, MFMM_ERR_UNREACHED, v, "target vertex %d is in no face",
-                             (int)v);
+            return mfmm_fail(t->err, MFMM_ERR_UNREACHED, mfmm_vertex_out(m, v),
+                             "target vertex %d is in no face", (int)mfmm_vertex_out(m, v));
         if (!read_T(t, v, &T0))
             return t->st;
         set_vertex(&p, m, m->vertex_face_corner[m->vertex_face_offset[v]] / 3, v);
@@ -1005,7 +1020,8 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
                     T0 = INFINITY;
     }
     if (!(T0 < INFINITY))
-        return mfmm_fail(t->err, MFMM_ERR_UNREACHED, target->face == -1 ? target->vertex : target->face,
+        return mfmm_fail(t->err, MFMM_ERR_UNREACHED,
+                         target->face == -1 ? mfmm_vertex_out(m, target->vertex) : target->face,
                          "the target's distance is infinite (not reached)");
     if (!emit(t, p.f, p.b))
         return t->st;
@@ -1051,12 +1067,12 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
                     return t->st;
             }
             if (r == 0)
-                return mfmm_fail(t->err, MFMM_ERR_PATH_STALLED, v,
+                return mfmm_fail(t->err, MFMM_ERR_PATH_STALLED, mfmm_vertex_out(m, v),
                                  t->n_src > 0 ? "T has a local minimum %.17g at vertex %d, not at a source"
                                               : "T has a local minimum %.17g at vertex %d, not 0 "
                                                 "(pass the sources to end at a point source or "
                                                 "one with a value)",
-                                 Tcur, (int)v);
+                                 Tcur, (int)mfmm_vertex_out(m, v));
             if (p.vertex >= 0) { /* went down an edge to another vertex */
                 have_frame = 0;
                 if (t->T[p.vertex] < best) {

@@ -7,6 +7,7 @@
 
 #include "core/check.h"
 #include "core/mesh.h"
+#include "core/order.h"
 #include "core/start.h"
 #include "seed.h"
 #include "solve.h"
@@ -25,6 +26,7 @@ struct mfmm_solver {
     const double *fixed_cost;
     int fixed_location;
     mfmm_exact_ws *exact; /* the exact start's workspace, made on first use */
+    mfmm_mapped_args args; /* mfmm_solve's arguments in internal order (order.h) */
 };
 
 mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out)
@@ -71,6 +73,7 @@ void mfmm_solver_destroy(mfmm_solver *solver)
     free(solver->T);
     free(solver->touched);
     mfmm_exact_ws_destroy(solver->exact);
+    free(solver->args.block);
     free(solver);
 }
 
@@ -133,10 +136,7 @@ mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources, int32_t 
         if (st != MFMM_OK)
             return st;
     }
-    if (mfmm_solve_checked(solver, sources, n_sources, &opt, distances) < 0)
-        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1,
-                         "out of memory for the exact start's workspace");
-    return MFMM_OK;
+    return mfmm_solve_mapped(solver, sources, n_sources, &opt, distances, err);
 }
 
 /* Puts the vertices the last march touched back to Far (and the solver's
@@ -282,4 +282,27 @@ int32_t mfmm_solve_local(mfmm_solver *solver, const mfmm_source *sources, int32_
     *touched = solver->touched;
     *n_touched = solver->n_pending;
     return settled;
+}
+
+mfmm_status mfmm_solve_mapped(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
+                              const mfmm_solve_options *options, double *distances,
+                              mfmm_error *err)
+{
+    const mfmm_mesh *mesh = solver->mesh;
+    mfmm_mapped_args *a = &solver->args;
+    if (mfmm_order_map_args(mesh, sources, n_sources, options->targets, options->n_targets,
+                            options->cost, (int)options->cost_location, NULL, a) != MFMM_OK)
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the arguments");
+    mfmm_solve_options opt = *options;
+    opt.targets = a->targets;
+    opt.cost = a->cost;
+    const double *T;
+    const int32_t *touched;
+    int32_t n_touched;
+    if (mfmm_solve_local(solver, a->sources, n_sources, &opt, &T, &touched, &n_touched) < 0)
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1,
+                         "out of memory for the exact start's workspace");
+    /* the one pass over the row: gathered into input order */
+    mfmm_order_values_out(mesh, T, distances);
+    return MFMM_OK;
 }

@@ -27,4 +27,11 @@ int32_t mfmm_solve_local(mfmm_solver *solver, const mfmm_source *sources, int32_
  * per solve. NULL cost: forget it. */
 void mfmm_solver_fix_cost(mfmm_solver *solver, const double *cost, int cost_location);
 
+/* mfmm_solve after its checks: maps the sources, targets and a per-vertex
+ * cost (input vertex ids) to internal order, marches, and writes
+ * distances in input order. options must not be NULL. */
+mfmm_status mfmm_solve_mapped(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
+                              const mfmm_solve_options *options, double *distances,
+                              mfmm_error *err);
+
 #endif

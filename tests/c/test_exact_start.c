@@ -13,6 +13,7 @@
 #include <cmocka.h>
 
 #include "core/mesh.h"
+#include "core/order.h"
 #include "exact/exact.h"
 #include "testutil.h"
 
@@ -71,7 +72,11 @@ static void test_patch_is_exact(void **state)
             int32_t n = 0;
             const int32_t *pv = NULL;
             const double *pd = NULL;
-            assert_int_equal(mfmm_exact_patch(ws, &src, 1, R, 0, &n, &pv, &pd, NULL), MFMM_OK);
+            /* the patch API is internal: internal vertex ids (core/order.h) */
+            mfmm_source isrc = src;
+            if (isrc.face < 0)
+                isrc.vertex = mfmm_vertex_in(mesh, isrc.vertex);
+            assert_int_equal(mfmm_exact_patch(ws, &isrc, 1, R, 0, &n, &pv, &pd, NULL), MFMM_OK);
             assert_true(n >= 10);
             int32_t inside = 0;
             for (int32_t v = 0; v < nv; v++)
@@ -79,8 +84,9 @@ static void test_patch_is_exact(void **state)
             assert_int_equal(n, inside);
             solve_r(solver, &src, MFMM_EXACT_START_RADIUS, d);
             for (int32_t i = 0; i < n; i++) {
-                tm_assert_close(pd[i], e[pv[i]], 1e-12 * e[pv[i]] + 1e-15);
-                tm_assert_close(d[pv[i]], e[pv[i]], 1e-12 * e[pv[i]] + 1e-15);
+                int32_t v = mfmm_vertex_out(mesh, pv[i]);
+                tm_assert_close(pd[i], e[v], 1e-12 * e[v] + 1e-15);
+                tm_assert_close(d[v], e[v], 1e-12 * e[v] + 1e-15);
             }
             worst_n = n > worst_n ? n : worst_n;
             free(e);
@@ -213,11 +219,13 @@ static void test_saddle_corner_continuous(void **state)
     double *angle = calloc((size_t)nv, sizeof *angle);
     double *d0 = malloc((size_t)nv * sizeof *d0), *d1 = malloc((size_t)nv * sizeof *d1);
     assert_true(angle && d0 && d1);
+    /* geometry from the mesh's own arrays (internal vertex ids) */
+    const int32_t *IF = mesh->faces;
     for (int32_t f = 0; f < nf; f++)
         for (int k = 0; k < 3; k++) {
-            const double *a = mesh->xyz + 3 * (size_t)F[3 * f + k];
-            const double *b = mesh->xyz + 3 * (size_t)F[3 * f + (k + 1) % 3];
-            const double *c = mesh->xyz + 3 * (size_t)F[3 * f + (k + 2) % 3];
+            const double *a = mesh->xyz + 3 * (size_t)IF[3 * f + k];
+            const double *b = mesh->xyz + 3 * (size_t)IF[3 * f + (k + 1) % 3];
+            const double *c = mesh->xyz + 3 * (size_t)IF[3 * f + (k + 2) % 3];
             double u[3], w[3], uu = 0, ww = 0, uw = 0;
             for (int j = 0; j < 3; j++) {
                 u[j] = b[j] - a[j];
@@ -226,7 +234,7 @@ static void test_saddle_corner_continuous(void **state)
                 ww += w[j] * w[j];
                 uw += u[j] * w[j];
             }
-            angle[F[3 * f + k]] += acos(fmax(-1.0, fmin(1.0, uw / sqrt(uu * ww))));
+            angle[IF[3 * f + k]] += acos(fmax(-1.0, fmin(1.0, uw / sqrt(uu * ww))));
         }
     int n_saddles = 0, n_approaches = 0, n_jumps = 0;
     double worst = 0.0;
@@ -234,7 +242,7 @@ static void test_saddle_corner_continuous(void **state)
         if (!(angle[v] > 2 * TM_PI + 1e-3))
             continue;
         n_saddles++;
-        mfmm_source vs = tm_vertex_source(v);
+        mfmm_source vs = tm_vertex_source(mfmm_vertex_out(mesh, v));
         solve_r(solver, &vs, MFMM_EXACT_START_RADIUS, d0);
         double *e0 = exact_row(mesh, &vs);
         for (int32_t i = mesh->vertex_face_offset[v]; i < mesh->vertex_face_offset[v + 1]; i++) {
@@ -249,7 +257,7 @@ static void test_saddle_corner_continuous(void **state)
             for (int j = 0; j < 3; j++) {
                 double x = 0.0;
                 for (int q = 0; q < 3; q++)
-                    x += p.bary[q] * mesh->xyz[3 * (size_t)F[3 * (c / 3) + q] + j];
+                    x += p.bary[q] * mesh->xyz[3 * (size_t)IF[3 * (c / 3) + q] + j];
                 move += (x - mesh->xyz[3 * (size_t)v + j]) * (x - mesh->xyz[3 * (size_t)v + j]);
             }
             move = sqrt(move);

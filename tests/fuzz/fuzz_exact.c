@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "meshfmm.h"
+#include "core/order.h"
 #include "exact/exact.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -103,12 +104,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         const int32_t *pv = NULL;
         const double *pd = NULL;
         double R = radius * 0.5;
-        if (mfmm_exact_patch(ex, src, 1, R, 0, &n, &pv, &pd, NULL) == MFMM_OK) {
+        mfmm_source isrc = src[0]; /* the patch API takes internal ids (core/order.h) */
+        if (isrc.face < 0)
+            isrc.vertex = mfmm_vertex_in(mesh, isrc.vertex);
+        if (mfmm_exact_patch(ex, &isrc, 1, R, 0, &n, &pv, &pd, NULL) == MFMM_OK) {
             int32_t inside = 0;
             for (int32_t v = 0; v < nv; v++)
                 inside += e[v] <= R;
             for (int32_t i = 0; i < n; i++)
-                if (!(fabs(pd[i] - e[pv[i]]) <= 1e-12 * (1.0 + e[pv[i]])))
+                if (!(fabs(pd[i] - e[mfmm_vertex_out(mesh, pv[i])]) <=
+                      1e-12 * (1.0 + e[mfmm_vertex_out(mesh, pv[i])])))
                     abort();
             /* ties at the radius itself may go either way */
             if (n > inside + 1 || n + 1 < inside) {

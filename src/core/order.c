@@ -1,0 +1,194 @@
+/* Vertex renumbering along a Morton (Z-order) curve over the bounding cube,
+ * and the mapping of public arguments and results (order.h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "order.h"
+
+/* MFMM_VERTEX_ORDER: 1 Morton (default), 2 Hilbert, 0 the input order
+ * (for A/B runs) */
+#ifndef MFMM_VERTEX_ORDER
+#define MFMM_VERTEX_ORDER 1
+#endif
+
+typedef struct order_key {
+    uint64_t key;
+    int32_t id;
+} order_key;
+
+static int order_key_cmp(const void *pa, const void *pb)
+{
+    const order_key *a = pa, *b = pb;
+    if (a->key != b->key)
+        return a->key < b->key ? -1 : 1;
+    return (a->id > b->id) - (a->id < b->id);
+}
+
+/* 21 bits of x spread to every third bit */
+static uint64_t spread3(uint64_t x)
+{
+    x &= 0x1fffff;
+    x = (x | x << 32) & 0x1f00000000ffffULL;
+    x = (x | x << 16) & 0x1f0000ff0000ffULL;
+    x = (x | x << 8) & 0x100f00f00f00f00fULL;
+    x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+    x = (x | x << 2) & 0x1249249249249249ULL;
+    return x;
+}
+
+/* Hilbert key of 21-bit coordinates x[3] (J. Skilling, "Programming the
+ * Hilbert curve", AIP Conf. Proc. 707, 2004: axes to transpose, then the
+ * bits interleaved as Morton's). */
+static uint64_t hilbert3(uint32_t x[3])
+{
+    const uint32_t top = 1u << 20;
+    for (uint32_t q = top; q > 1; q >>= 1) { /* inverse undo */
+        uint32_t p = q - 1;
+        for (int i = 0; i < 3; i++) {
+            if (x[i] & q) {
+                x[0] ^= p;
+            } else {
+                uint32_t t = (x[0] ^ x[i]) & p;
+                x[0] ^= t;
+                x[i] ^= t;
+            }
+        }
+    }
+    for (int i = 1; i < 3; i++) /* Gray encode */
+        x[i] ^= x[i - 1];
+    uint32_t t = 0;
+    for (uint32_t q = top; q > 1; q >>= 1)
+        if (x[2] & q)
+            t ^= q - 1;
+    for (int i = 0; i < 3; i++)
+        x[i] ^= t;
+    return spread3(x[2]) | spread3(x[1]) << 1 | spread3(x[0]) << 2;
+}
+
+mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_internal,
+                             int32_t **to_external)
+{
+    int32_t *in = malloc((size_t)nv * sizeof *in);
+    int32_t *ex = malloc((size_t)nv * sizeof *ex);
+    order_key *keys = MFMM_VERTEX_ORDER ? malloc((size_t)nv * sizeof *keys) : NULL;
+    if (!in || !ex || (MFMM_VERTEX_ORDER && !keys)) {
+        free(in);
+        free(ex);
+        free(keys);
+        return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    if (!keys) {
+        for (int32_t v = 0; v < nv; v++)
+            ex[v] = v;
+    } else {
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, ext = 0.0;
+        for (int32_t v = 0; v < nv; v++)
+            for (int k = 0; k < 3; k++)
+                lo[k] = fmin(lo[k], xyz[3 * (size_t)v + k]);
+        for (int32_t v = 0; v < nv; v++)
+            for (int k = 0; k < 3; k++)
+                ext = fmax(ext, xyz[3 * (size_t)v + k] - lo[k]);
+        /* one cube (not a box per axis), so the curve keeps the shape's
+         * proportions; 21 bits per axis */
+        double scale = ext > 0.0 ? 2097151.0 / ext : 0.0;
+        for (int32_t v = 0; v < nv; v++) {
+            uint32_t u[3];
+            for (int k = 0; k < 3; k++) {
+                double q = (xyz[3 * (size_t)v + k] - lo[k]) * scale;
+                u[k] = q > 2097151.0 ? 2097151u : (uint32_t)q;
+            }
+            uint64_t key = MFMM_VERTEX_ORDER == 2
+                               ? hilbert3(u)
+                               : spread3(u[0]) | spread3(u[1]) << 1 | spread3(u[2]) << 2;
+            keys[v].key = key;
+            keys[v].id = v;
+        }
+        qsort(keys, (size_t)nv, sizeof *keys, order_key_cmp);
+        for (int32_t i = 0; i < nv; i++)
+            ex[i] = keys[i].id;
+        free(keys);
+    }
+    for (int32_t i = 0; i < nv; i++)
+        in[ex[i]] = i;
+    *to_internal = in;
+    *to_external = ex;
+    return MFMM_OK;
+}
+
+void mfmm_order_ids_in(const mfmm_mesh *mesh, const int32_t *ids, int32_t n, int32_t *out)
+{
+    for (int32_t i = 0; i < n; i++)
+        out[i] = mesh->to_internal[ids[i]];
+}
+
+void mfmm_order_values_in(const mfmm_mesh *mesh, const double *in, double *out)
+{
+    for (int32_t v = 0; v < mesh->nv; v++)
+        out[v] = in[mesh->to_external[v]];
+}
+
+void mfmm_order_values_out(const mfmm_mesh *mesh, const double *in, double *out)
+{
+    for (int32_t v = 0; v < mesh->nv; v++)
+        out[v] = in[mesh->to_internal[v]];
+}
+
+/* bytes rounded up to a multiple of 8 (doubles follow) */
+static size_t align8(size_t n)
+{
+    return (n + 7) & ~(size_t)7;
+}
+
+mfmm_status mfmm_order_map_args(const mfmm_mesh *mesh, const mfmm_source *sources,
+                                int32_t n_sources, const int32_t *targets, int32_t n_targets,
+                                const double *cost, int cost_location, const double *values,
+                                mfmm_mapped_args *a)
+{
+    size_t nv = (size_t)mesh->nv;
+    size_t b_src = sources ? (size_t)n_sources * sizeof(mfmm_source) : 0;
+    size_t b_tgt = targets ? align8((size_t)n_targets * sizeof(int32_t)) : 0;
+    size_t b_cost = cost && cost_location == 1 ? nv * sizeof(double) : 0;
+    size_t b_val = values ? nv * sizeof(double) : 0;
+    size_t need = b_src + b_tgt + b_cost + b_val;
+    if (need > a->capacity) {
+        void *p = malloc(need);
+        if (!p)
+            return MFMM_ERR_OUT_OF_MEMORY;
+        free(a->block);
+        a->block = p;
+        a->capacity = need;
+    }
+    char *at = a->block;
+    a->sources = NULL;
+    a->targets = NULL;
+    a->cost = cost;
+    a->values = NULL;
+    if (b_src) {
+        mfmm_source *s = (mfmm_source *)(void *)at;
+        memcpy(s, sources, b_src);
+        for (int32_t i = 0; i < n_sources; i++)
+            if (s[i].face < 0)
+                s[i].vertex = mesh->to_internal[s[i].vertex];
+        a->sources = s;
+        at += b_src;
+    }
+    if (b_tgt) {
+        int32_t *t = (int32_t *)(void *)at;
+        mfmm_order_ids_in(mesh, targets, n_targets, t);
+        a->targets = t;
+        at += b_tgt;
+    }
+    if (b_cost) {
+        double *c = (double *)(void *)at;
+        mfmm_order_values_in(mesh, cost, c);
+        a->cost = c;
+        at += b_cost;
+    }
+    if (b_val) {
+        double *t = (double *)(void *)at;
+        mfmm_order_values_in(mesh, values, t);
+        a->values = t;
+    }
+    return MFMM_OK;
+}

@@ -1,0 +1,62 @@
+/* Vertex renumbering (issue 13.1, private to the library). A mesh numbers
+ * its vertices internally along a space-filling curve, so that vertices
+ * near each other on the surface are near each other in every per-vertex
+ * array the march reads. Faces keep their ids and corner order (only the
+ * vertex ids inside them are renumbered). Everything below the public entry
+ * points works in internal ids; the entry points map vertex ids and
+ * per-vertex arrays in and out with these helpers. */
+#ifndef MFMM_ORDER_H
+#define MFMM_ORDER_H
+
+#include "mesh.h"
+
+/* The internal order of a mesh's vertices: *to_external (nv,) lists the
+ * input ids in internal order, *to_internal (nv,) is its inverse (both
+ * malloc'd). Deterministic: a function of the coordinates and the input
+ * ids only. MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
+mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_internal,
+                             int32_t **to_external);
+
+/* Internal id of input vertex v (checked to be in range). */
+static inline int32_t mfmm_vertex_in(const mfmm_mesh *mesh, int32_t v)
+{
+    return mesh->to_internal[v];
+}
+
+/* Input id of internal vertex v. */
+static inline int32_t mfmm_vertex_out(const mfmm_mesh *mesh, int32_t v)
+{
+    return mesh->to_external[v];
+}
+
+/* out[i] = internal id of ids[i], n of them; out may be ids. */
+void mfmm_order_ids_in(const mfmm_mesh *mesh, const int32_t *ids, int32_t n, int32_t *out);
+
+/* Per-vertex values (nv,) from input order to internal order (out != in). */
+void mfmm_order_values_in(const mfmm_mesh *mesh, const double *in, double *out);
+
+/* Per-vertex values (nv,) from internal order to input order (out != in). */
+void mfmm_order_values_out(const mfmm_mesh *mesh, const double *in, double *out);
+
+/* The arguments of a public call, in internal order: copies of checked
+ * sources (vertex ids mapped), targets, a per-vertex cost and a per-vertex
+ * value array (the user's T), each NULL when not given (a per-face cost is
+ * passed through: faces keep their ids). The copies live in one block,
+ * reused while large enough (a solver keeps it between solves). */
+typedef struct mfmm_mapped_args {
+    const mfmm_source *sources;
+    const int32_t *targets;
+    const double *cost;
+    const double *values;
+    void *block;
+    size_t capacity; /* bytes in block */
+} mfmm_mapped_args;
+
+/* Fills `a` (whose block/capacity it keeps or grows). cost_location 1 per
+ * vertex, 2 per face, 0 none. MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
+mfmm_status mfmm_order_map_args(const mfmm_mesh *mesh, const mfmm_source *sources,
+                                int32_t n_sources, const int32_t *targets, int32_t n_targets,
+                                const double *cost, int cost_location, const double *values,
+                                mfmm_mapped_args *a);
+
+#endif

@@ -1,0 +1,313 @@
+/* Vertex renumbering (issue 13.1): the library numbers vertices internally
+ * by position, so a mesh given with its vertices in another order is the same
+ * mesh inside. Per input vertex, every public result (distances with and
+ * without costs, matrix rows dense / float32 / targets / sparse, paths,
+ * exact distances) must then equal the unshuffled mesh's, permuted back, bit
+ * for bit; and the renumbering must not depend on anything but the input. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "testutil.h"
+#include "core/mesh.h"
+#include "io/generate.h"
+
+/* g's vertices, plus one unreferenced vertex, in a shuffled order:
+ * shuffled vertex i is original vertex perm[i]; inv the inverse. */
+typedef struct shuffled {
+    mfmm_gen_mesh orig, shuf;
+    int32_t *perm, *inv;
+} shuffled;
+
+static shuffled shuffle(mfmm_gen_mesh g, uint32_t seed)
+{
+    shuffled s;
+    int32_t nv = g.nv + 1;
+    s.orig.nv = nv;
+    s.orig.nf = g.nf;
+    s.orig.V = malloc(3 * (size_t)nv * sizeof(double));
+    s.orig.F = g.F;
+    s.shuf.nv = nv;
+    s.shuf.nf = g.nf;
+    s.shuf.V = malloc(3 * (size_t)nv * sizeof(double));
+    s.shuf.F = malloc(3 * (size_t)g.nf * sizeof(int32_t));
+    s.perm = malloc((size_t)nv * sizeof(int32_t));
+    s.inv = malloc((size_t)nv * sizeof(int32_t));
+    assert_true(s.orig.V && s.shuf.V && s.shuf.F && s.perm && s.inv);
+    memcpy(s.orig.V, g.V, 3 * (size_t)g.nv * sizeof(double));
+    s.orig.V[3 * g.nv] = 0.25, s.orig.V[3 * g.nv + 1] = 0.5, s.orig.V[3 * g.nv + 2] = 2.0;
+    free(g.V);
+    for (int32_t i = 0; i < nv; i++)
+        s.perm[i] = i;
+    for (int32_t i = nv - 1; i > 0; i--) { /* Fisher-Yates, a fixed LCG */
+        seed = seed * 1664525u + 1013904223u;
+        int32_t j = (int32_t)((seed >> 8) % (uint32_t)(i + 1));
+        int32_t t = s.perm[i];
+        s.perm[i] = s.perm[j];
+        s.perm[j] = t;
+    }
+    for (int32_t i = 0; i < nv; i++) {
+        s.inv[s.perm[i]] = i;
+        memcpy(s.shuf.V + 3 * i, s.orig.V + 3 * s.perm[i], 3 * sizeof(double));
+    }
+    for (int32_t c = 0; c < 3 * g.nf; c++)
+        s.shuf.F[c] = s.inv[s.orig.F[c]];
+    return s;
+}
+
+static void shuffled_free(shuffled *s)
+{
+    mfmm_gen_free(&s->orig);
+    mfmm_gen_free(&s->shuf);
+    free(s->perm);
+    free(s->inv);
+}
+
+/* a[perm[i]] == b[i] bit for bit, n values of `size` bytes */
+static void assert_permuted(const void *a, const void *b, const int32_t *perm, int32_t n,
+                            size_t size, const char *what)
+{
+    for (int32_t i = 0; i < n; i++)
+        if (memcmp((const char *)a + (size_t)perm[i] * size, (const char *)b + (size_t)i * size,
+                   size) != 0)
+            fail_msg("%s: shuffled vertex %d (original %d) differs", what, (int)i, (int)perm[i]);
+}
+
+static void check_mesh(mfmm_gen_mesh g, uint32_t seed)
+{
+    shuffled s = shuffle(g, seed);
+    int32_t nv = s.orig.nv, nf = s.orig.nf;
+    mfmm_mesh *ma = tm_make(&s.orig), *mb = tm_make(&s.shuf);
+    mfmm_solver *sa = NULL, *sb = NULL;
+    assert_int_equal(mfmm_solver_create(ma, &sa), MFMM_OK);
+    assert_int_equal(mfmm_solver_create(mb, &sb), MFMM_OK);
+    double *da = malloc((size_t)nv * sizeof *da), *db = malloc((size_t)nv * sizeof *db);
+    double *ca = malloc((size_t)nv * sizeof *ca), *cb = malloc((size_t)nv * sizeof *cb);
+    double *fc = malloc((size_t)nf * sizeof *fc);
+    assert_true(da && db && ca && cb && fc);
+    for (int32_t v = 0; v < nv; v++)
+        ca[v] = 1.0 + 0.5 * sin(3.0 * s.orig.V[3 * v] + 2.0 * s.orig.V[3 * v + 1]);
+    for (int32_t i = 0; i < nv; i++)
+        cb[i] = ca[s.perm[i]];
+    for (int32_t f = 0; f < nf; f++)
+        fc[f] = 1.0 + (f % 3);
+
+    /* single solves: a vertex source with targets, a face source, costs */
+    int32_t src = s.orig.F[3 * (nf / 2)], tgt[2] = {s.orig.F[0], s.orig.F[3 * nf - 1]};
+    int32_t tgt_b[2] = {s.inv[tgt[0]], s.inv[tgt[1]]};
+    mfmm_source va[2] = {tm_vertex_source(src), {0, nf / 3, {0.2, 0.3, 0.5}, 0.1}};
+    mfmm_source vb[2] = {tm_vertex_source(s.inv[src]), va[1]};
+    for (int variant = 0; variant < 5; variant++) {
+        mfmm_solve_options oa, ob;
+        mfmm_solve_options_init(&oa);
+        if (variant == 1)
+            oa.cost = ca, oa.cost_location = MFMM_COST_PER_VERTEX;
+        if (variant == 2)
+            oa.cost = fc, oa.cost_location = MFMM_COST_PER_FACE;
+        if (variant == 3)
+            oa.targets = tgt, oa.n_targets = 2, oa.unfolding = 0;
+        if (variant == 4)
+            oa.max_distance = 0.3;
+        ob = oa;
+        if (variant == 1)
+            ob.cost = cb;
+        if (variant == 3)
+            ob.targets = tgt_b;
+        assert_int_equal(mfmm_solve(sa, va, 2, &oa, da, NULL), MFMM_OK);
+        assert_int_equal(mfmm_solve(sb, vb, 2, &ob, db, NULL), MFMM_OK);
+        assert_permuted(da, db, s.perm, nv, sizeof *da, "mfmm_solve");
+        assert_true(isinf(da[nv - 1])); /* the unreferenced vertex */
+
+        /* a path to a vertex, with the sources and the cost */
+        mfmm_path_options pa, pb;
+        mfmm_path_options_init(&pa);
+        pa.sources = va, pa.n_sources = 2;
+        pa.cost = oa.cost, pa.cost_location = oa.cost_location;
+        pb = pa;
+        pb.sources = vb, pb.cost = ob.cost;
+        int32_t t = tgt[1];
+        if (!(da[t] < INFINITY))
+            t = src;
+        mfmm_source ta = tm_vertex_source(t), tb = tm_vertex_source(s.inv[t]);
+        mfmm_surface_point pts_a[4096], pts_b[4096];
+        int32_t na = 0, nb = 0;
+        double la = 0, lb = 0;
+        assert_int_equal(mfmm_trace_path(ma, da, &ta, &pa, pts_a, 4096, &na, &la, NULL), MFMM_OK);
+        assert_int_equal(mfmm_trace_path(mb, db, &tb, &pb, pts_b, 4096, &nb, &lb, NULL), MFMM_OK);
+        assert_int_equal(na, nb);
+        assert_memory_equal(pts_a, pts_b, (size_t)na * sizeof *pts_a);
+        assert_memory_equal(&la, &lb, sizeof la);
+    }
+
+    /* exact distances */
+    mfmm_exact_solver *ea = NULL, *eb = NULL;
+    assert_int_equal(mfmm_exact_solver_create(ma, &ea), MFMM_OK);
+    assert_int_equal(mfmm_exact_solver_create(mb, &eb), MFMM_OK);
+    assert_int_equal(mfmm_solve_exact(ea, va, 2, NULL, da, NULL, NULL), MFMM_OK);
+    assert_int_equal(mfmm_solve_exact(eb, vb, 2, NULL, db, NULL, NULL), MFMM_OK);
+    assert_permuted(da, db, s.perm, nv, sizeof *da, "mfmm_solve_exact");
+    mfmm_exact_solver_destroy(ea);
+    mfmm_exact_solver_destroy(eb);
+
+    /* matrix rows: float64 and float32 full rows, target columns, serial
+     * and threads (rows in the caller's order, columns permuted back) */
+    enum { NS = 7 };
+    int32_t rs_a[NS], rs_b[NS];
+    for (int i = 0; i < NS; i++) {
+        rs_a[i] = (int32_t)(((int64_t)i * 7919) % (nv - 1));
+        rs_b[i] = s.inv[rs_a[i]];
+    }
+    double *ra = malloc((size_t)NS * nv * sizeof *ra), *rb = malloc((size_t)NS * nv * sizeof *rb);
+    assert_true(ra && rb);
+    for (int kind = 0; kind < 5; kind++) {
+        mfmm_matrix_options oa, ob;
+        mfmm_matrix_options_init(&oa);
+        oa.backend = kind == 1 ? MFMM_BACKEND_THREADS : MFMM_BACKEND_SERIAL;
+        oa.n_threads = 2;
+        oa.dtype = kind == 2 ? MFMM_FLOAT32 : MFMM_FLOAT64;
+        if (kind == 3)
+            oa.targets = tgt, oa.n_targets = 2;
+        if (kind == 4)
+            oa.cost = ca, oa.cost_location = MFMM_COST_PER_VERTEX;
+        ob = oa;
+        if (kind == 3)
+            ob.targets = tgt_b;
+        if (kind == 4)
+            ob.cost = cb;
+        oa.out = ra;
+        ob.out = rb;
+        assert_int_equal(mfmm_distance_matrix(ma, rs_a, NS, &oa, NULL), MFMM_OK);
+        assert_int_equal(mfmm_distance_matrix(mb, rs_b, NS, &ob, NULL), MFMM_OK);
+        size_t esz = kind == 2 ? sizeof(float) : sizeof(double);
+        for (int i = 0; i < NS; i++) {
+            if (kind == 3) {
+                assert_memory_equal((char *)ra + (size_t)i * 2 * esz,
+                                    (char *)rb + (size_t)i * 2 * esz, 2 * esz);
+                continue;
+            }
+            assert_permuted((char *)ra + (size_t)i * nv * esz, (char *)rb + (size_t)i * nv * esz,
+                            s.perm, nv, esz, "matrix row");
+        }
+    }
+    free(ra);
+    free(rb);
+
+    mfmm_solver_destroy(sa);
+    mfmm_solver_destroy(sb);
+    mfmm_mesh_destroy(ma);
+    mfmm_mesh_destroy(mb);
+    free(da);
+    free(db);
+    free(ca);
+    free(cb);
+    free(fc);
+    shuffled_free(&s);
+}
+
+static void test_shuffled_lattice(void **state)
+{
+    (void)state;
+    check_mesh(mfmm_gen_lattice(12, 3.0), 12345u); /* obtuse corners: virtual edges */
+}
+
+static void test_shuffled_sine(void **state)
+{
+    (void)state;
+    check_mesh(mfmm_gen_sine(16), 777u);
+}
+
+/* Sparse rows: column ids are the caller's, ascending, values permuted back. */
+typedef struct sparse_rows {
+    int32_t n[8];
+    int32_t idx[8][400];
+    double val[8][400];
+} sparse_rows;
+
+static int collect_sparse(void *user, int32_t first, int32_t n, const int64_t *indptr,
+                          const int32_t *indices, const void *values)
+{
+    sparse_rows *r = user;
+    for (int32_t i = 0; i < n; i++) {
+        int32_t k = (int32_t)(indptr[i + 1] - indptr[i]);
+        assert_true(first + i < 8 && k <= 400);
+        r->n[first + i] = k;
+        memcpy(r->idx[first + i], indices + indptr[i], (size_t)k * sizeof(int32_t));
+        memcpy(r->val[first + i], (const double *)values + indptr[i], (size_t)k * sizeof(double));
+        for (int32_t j = 1; j < k; j++)
+            assert_true(r->idx[first + i][j - 1] < r->idx[first + i][j]);
+    }
+    return 0;
+}
+
+static void test_shuffled_sparse(void **state)
+{
+    (void)state;
+    shuffled s = shuffle(mfmm_gen_sine(16), 99u);
+    mfmm_mesh *ma = tm_make(&s.orig), *mb = tm_make(&s.shuf);
+    int32_t src_a[8], src_b[8];
+    for (int i = 0; i < 8; i++) {
+        src_a[i] = (int32_t)((i * 37) % (s.orig.nv - 1));
+        src_b[i] = s.inv[src_a[i]];
+    }
+    static sparse_rows ra, rb;
+    mfmm_matrix_options oa, ob;
+    mfmm_matrix_options_init(&oa);
+    oa.dtype = MFMM_FLOAT64;
+    oa.backend = MFMM_BACKEND_THREADS;
+    oa.max_distance = 0.3;
+    oa.on_sparse = collect_sparse;
+    ob = oa;
+    oa.user = &ra;
+    ob.user = &rb;
+    assert_int_equal(mfmm_distance_matrix(ma, src_a, 8, &oa, NULL), MFMM_OK);
+    assert_int_equal(mfmm_distance_matrix(mb, src_b, 8, &ob, NULL), MFMM_OK);
+    for (int i = 0; i < 8; i++) {
+        assert_int_equal(ra.n[i], rb.n[i]);
+        assert_true(ra.n[i] > 5);
+        for (int32_t j = 0; j < rb.n[i]; j++) { /* find b's column in a's row */
+            int32_t col = s.perm[rb.idx[i][j]], k = 0;
+            while (k < ra.n[i] && ra.idx[i][k] != col)
+                k++;
+            assert_true(k < ra.n[i]);
+            assert_memory_equal(&ra.val[i][k], &rb.val[i][j], sizeof(double));
+        }
+    }
+    mfmm_mesh_destroy(ma);
+    mfmm_mesh_destroy(mb);
+    shuffled_free(&s);
+}
+
+/* The same input gives the same internal order and arrays, every time. */
+static void test_deterministic(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh g = mfmm_gen_lattice(10, 3.0);
+    mfmm_mesh *a = tm_make(&g), *b = tm_make(&g);
+    assert_memory_equal(a->to_internal, b->to_internal, (size_t)g.nv * sizeof(int32_t));
+    assert_memory_equal(a->faces, b->faces, 3 * (size_t)g.nf * sizeof(int32_t));
+    assert_memory_equal(a->xyz, b->xyz, 3 * (size_t)g.nv * sizeof(double));
+    for (int32_t v = 0; v < g.nv; v++) {
+        assert_int_equal(a->to_external[a->to_internal[v]], v);
+        assert_memory_equal(a->xyz + 3 * a->to_internal[v], g.V + 3 * v, 3 * sizeof(double));
+    }
+    mfmm_mesh_destroy(a);
+    mfmm_mesh_destroy(b);
+    mfmm_gen_free(&g);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_shuffled_lattice),
+        cmocka_unit_test(test_shuffled_sine),
+        cmocka_unit_test(test_shuffled_sparse),
+        cmocka_unit_test(test_deterministic),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
