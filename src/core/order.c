@@ -9,11 +9,12 @@
 
 /* MFMM_VERTEX_ORDER, for A/B runs: 1 Morton cells, rows inside (default),
  * 4 Morton at full resolution, 2 Hilbert, 3 breadth-first from the Morton
- * order, 0 the input order. Measured (bench_solve, solve ms, input / 4 / 3
- * / 1): 1M sine 254-273 / 208-216 / 250 / 204-207; 125k sine 19.2 /
- * 23.6-24.1 / 21.9 / 21.8-22.6 (cells with input order inside; row-major
- * generated grids are already a good order); igea 26.7-27.9 / 26.7-27.2 /
- * 27.2-28.8 / 26.3-26.6; camelhead, nefertiti: equal. */
+ * order, 0 the input order. Measured (bench_solve, solve ms, one run each,
+ * shared machine; input / 4 / 3 / 1): 1M sine 250-279 / 208-222 / 250 /
+ * 195-196; 125k sine 19.2-21.5 / 23.6-25.6 / 21.8-22.0 / 22.7-22.8 (a
+ * generated grid's row-major order is already good at that size); igea
+ * 27.5-29.3 / 26.7-29.1 / 27.2-28.8 / 27.6-28.5; camelhead, nefertiti:
+ * equal within noise. */
 #ifndef MFMM_VERTEX_ORDER
 #define MFMM_VERTEX_ORDER 1
 #endif
@@ -155,10 +156,9 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, const int32_t *faces
          * proportions; 21 bits per axis */
         double scale = ext > 0.0 ? 2097151.0 / ext : 0.0;
         /* cells of ~64 vertices (a surface has about nv / 4^L cells at
-         * level L) along the curve; inside a cell, rows (measured: rows
-         * beat the curve's own order at that scale, 125k sine 21.8 vs 23.8
-         * ms, and cells beat the curve at full resolution on 1M, 205 vs
-         * 212 ms) */
+         * level L) along the curve; inside a cell, rows by position (rows
+         * beat the curve's own order at that scale: 125k sine 22.8 vs 23.8
+         * ms; 1M 196 vs 212 ms) */
         int shift = 0;
         if (MFMM_VERTEX_ORDER == 1) {
             int L = 0;
