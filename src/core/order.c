@@ -1,19 +1,27 @@
-/* Vertex renumbering along a Morton (Z-order) curve over the bounding cube,
- * and the mapping of public arguments and results (order.h). */
+/* Vertex renumbering along a space-filling curve over the bounding cube
+ * (cells of about 64 vertices in Morton order, rows inside a cell), and the
+ * mapping of public arguments and results (order.h). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "order.h"
 
-/* MFMM_VERTEX_ORDER: 1 Morton (default), 2 Hilbert, 0 the input order
- * (for A/B runs) */
+/* MFMM_VERTEX_ORDER, for A/B runs: 1 Morton cells, rows inside (default),
+ * 4 Morton at full resolution, 2 Hilbert, 3 breadth-first from the Morton
+ * order, 0 the input order. Measured (bench_solve, solve ms, one run each,
+ * shared machine; input / 4 / 3 / 1): 1M sine 250-279 / 208-222 / 250 /
+ * 195-196; 125k sine 19.2-21.5 / 23.6-25.6 / 21.8-22.0 / 22.7-22.8 (a
+ * generated grid's row-major order is already good at that size); igea
+ * 27.5-29.3 / 26.7-29.1 / 27.2-28.8 / 27.6-28.5; camelhead, nefertiti:
+ * equal within noise. */
 #ifndef MFMM_VERTEX_ORDER
 #define MFMM_VERTEX_ORDER 1
 #endif
 
 typedef struct order_key {
-    uint64_t key;
+    uint64_t key;  /* the cell's curve key */
+    uint64_t fine; /* inside the cell: y, then x, then z (rows) */
     int32_t id;
 } order_key;
 
@@ -22,6 +30,8 @@ static int order_key_cmp(const void *pa, const void *pb)
     const order_key *a = pa, *b = pb;
     if (a->key != b->key)
         return a->key < b->key ? -1 : 1;
+    if (a->fine != b->fine)
+        return a->fine < b->fine ? -1 : 1;
     return (a->id > b->id) - (a->id < b->id);
 }
 
@@ -66,8 +76,61 @@ static uint64_t hilbert3(uint32_t x[3])
     return spread3(x[2]) | spread3(x[1]) << 1 | spread3(x[0]) << 2;
 }
 
-mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_internal,
-                             int32_t **to_external)
+/* Breadth-first over the faces' edges from the curve order's vertices in
+ * turn (ex: the curve order, replaced by the BFS order). */
+static mfmm_status bfs_reorder(int32_t nv, const int32_t *faces, int32_t nf, int32_t *ex)
+{
+    size_t nc = 3 * (size_t)nf;
+    int32_t *off = calloc((size_t)nv + 1, sizeof *off);
+    int32_t *vf = malloc((nc ? nc : 1) * sizeof *vf);
+    int32_t *out = malloc((size_t)nv * sizeof *out);
+    unsigned char *seen = calloc((size_t)nv, 1);
+    if (!off || !vf || !out || !seen) {
+        free(off);
+        free(vf);
+        free(out);
+        free(seen);
+        return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    for (size_t c = 0; c < nc; c++)
+        off[faces[c] + 1]++;
+    for (int32_t v = 0; v < nv; v++)
+        off[v + 1] += off[v];
+    for (size_t c = 0; c < nc; c++)
+        vf[off[faces[c]]++] = (int32_t)c;
+    for (int32_t v = nv; v > 0; v--)
+        off[v] = off[v - 1];
+    off[0] = 0;
+    int32_t head = 0, tail = 0;
+    for (int32_t i = 0; i < nv; i++) {
+        if (seen[ex[i]])
+            continue;
+        seen[ex[i]] = 1;
+        out[tail++] = ex[i];
+        while (head < tail) {
+            int32_t v = out[head++];
+            for (int32_t j = off[v]; j < off[v + 1]; j++) {
+                int32_t f = vf[j] / 3, k = vf[j] % 3;
+                for (int t = 1; t < 3; t++) {
+                    int32_t w = faces[3 * f + (k + t) % 3];
+                    if (!seen[w]) {
+                        seen[w] = 1;
+                        out[tail++] = w;
+                    }
+                }
+            }
+        }
+    }
+    memcpy(ex, out, (size_t)nv * sizeof *ex);
+    free(off);
+    free(vf);
+    free(out);
+    free(seen);
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_order_build(const double *xyz, int32_t nv, const int32_t *faces, int32_t nf,
+                             int32_t **to_internal, int32_t **to_external)
 {
     int32_t *in = malloc((size_t)nv * sizeof *in);
     int32_t *ex = malloc((size_t)nv * sizeof *ex);
@@ -92,12 +155,26 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_interna
         /* one cube (not a box per axis), so the curve keeps the shape's
          * proportions; 21 bits per axis */
         double scale = ext > 0.0 ? 2097151.0 / ext : 0.0;
+        /* cells of ~64 vertices (a surface has about nv / 4^L cells at
+         * level L) along the curve; inside a cell, rows by position (rows
+         * beat the curve's own order at that scale: 125k sine 22.8 vs 23.8
+         * ms; 1M 196 vs 212 ms) */
+        int shift = 0;
+        if (MFMM_VERTEX_ORDER == 1) {
+            int L = 0;
+            while (L < 21 && ((double)nv / 64.0) > (double)(1u << L) * (double)(1u << L))
+                L++;
+            shift = 21 - L;
+        }
         for (int32_t v = 0; v < nv; v++) {
             uint32_t u[3];
             for (int k = 0; k < 3; k++) {
                 double q = (xyz[3 * (size_t)v + k] - lo[k]) * scale;
                 u[k] = q > 2097151.0 ? 2097151u : (uint32_t)q;
             }
+            keys[v].fine = (uint64_t)u[1] << 42 | (uint64_t)u[0] << 21 | u[2];
+            for (int k = 0; k < 3; k++)
+                u[k] >>= shift;
             uint64_t key = MFMM_VERTEX_ORDER == 2
                                ? hilbert3(u)
                                : spread3(u[0]) | spread3(u[1]) << 1 | spread3(u[2]) << 2;
@@ -108,6 +185,11 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_interna
         for (int32_t i = 0; i < nv; i++)
             ex[i] = keys[i].id;
         free(keys);
+        if (MFMM_VERTEX_ORDER == 3 && bfs_reorder(nv, faces, nf, ex) != MFMM_OK) {
+            free(in);
+            free(ex);
+            return MFMM_ERR_OUT_OF_MEMORY;
+        }
     }
     for (int32_t i = 0; i < nv; i++)
         in[ex[i]] = i;
