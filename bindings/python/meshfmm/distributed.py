@@ -39,6 +39,21 @@ RUN_ATTR = "meshfmm_last_run"
 # Bytes of one block: large enough that scheduling is noise, small enough
 # that a 2-worker cluster gets many tasks and a lost worker loses little.
 _BLOCK_BYTES = 8 << 20
+# Blosc (cname, clevel) per `compression`, always with bit shuffle: on real
+# meshes' rows (bench/bench_compression.py) lz4 + bit shuffle stores within
+# 0.5 % of zstd 3 + byte shuffle and encodes ~3x faster (the encoding is on
+# each task's critical path); zstd 3 + bit shuffle is ~2 % smaller again.
+_CODECS: Dict[str, Optional[Tuple[str, int]]] = {"lz4": ("lz4", 5), "zstd": ("zstd", 3),
+                                                 "none": None}
+
+
+def _default_block_rows(n_rows: int, row_bytes: int, dask_threads: int) -> int:
+    """Rows per block: at most ~_BLOCK_BYTES a chunk, at least 4 blocks per
+    Dask thread, and a multiple of the threads in blocks of equal rows, so
+    that no thread idles at the end while another runs a last block alone."""
+    max_rows = max(1, _BLOCK_BYTES // row_bytes)
+    per_thread = max(4, math.ceil(n_rows / (dask_threads * max_rows)))
+    return max(1, math.ceil(n_rows / (per_thread * dask_threads)))
 
 
 def _sha256(*arrays: Optional[np.ndarray]) -> Optional[str]:
@@ -115,12 +130,39 @@ def _worker_cache() -> Dict[str, Mesh]:
     return cache
 
 
+def _cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
+def _task_threads(n_threads: int, host_threads: Dict[str, int]) -> int:
+    """Library threads for one task. 0: this worker's share of its machine's
+    cores, cores / (Dask threads of all workers on this host), so that a
+    LocalCluster of one process per core runs one library thread per task
+    (Dask's own rule: its nannies set OMP_NUM_THREADS=1) while a single
+    one-thread worker on a 16-core node still uses all 16 cores."""
+    if n_threads > 0:
+        return n_threads
+    try:
+        from distributed import get_worker
+        from distributed.comm import get_address_host
+
+        w = get_worker()
+    except (ImportError, ValueError):  # run in the client process
+        return 0
+    total = host_threads.get(get_address_host(w.address)) or w.state.nthreads
+    return max(1, _cores() // max(1, total))
+
+
 def _compute_block(key: str, V: np.ndarray, F: np.ndarray, url: str,
                    storage_options: Optional[dict], r0: int, r1: int,
                    src: Optional[np.ndarray], targets: Optional[np.ndarray],
-                   opts: Dict[str, Any]) -> Tuple[int, int, float]:
+                   opts: Dict[str, Any]) -> Tuple[int, int, float, float]:
     """One task: rows [r0, r1) into their own chunk. Idempotent: a retry
-    writes the same bytes."""
+    writes the same bytes. Returns r0, r1 and the seconds spent computing
+    and writing (encoding included)."""
     import zarr
 
     cache = _worker_cache()
@@ -129,15 +171,17 @@ def _compute_block(key: str, V: np.ndarray, F: np.ndarray, url: str,
         mesh = cache[key] = Mesh(V, F)
     t0 = time.perf_counter()
     rows_src = np.arange(r0, r1, dtype=np.int32) if src is None else src[r0:r1]
-    kw = dict(backend=opts["backend"], dtype=opts["dtype"], n_threads=opts["n_threads"],
+    kw = dict(backend=opts["backend"], dtype=opts["dtype"],
+              n_threads=_task_threads(opts["n_threads"], opts.get("host_threads") or {}),
               max_distance=opts["max_distance"], unfolding=opts["unfolding"])
     if opts["cost"] is not None:
         kw.update(cost=opts["cost"], cost_location=opts["cost_location"])
     # the library's target columns: each row stops once its targets settle
     rows = mesh.distance_matrix(rows_src, targets=targets, **kw)
+    t1 = time.perf_counter()
     arr = zarr.open_array(url, mode="r+", storage_options=storage_options)
     arr[r0:r1, :] = rows
-    return r0, r1, time.perf_counter() - t0
+    return r0, r1, t1 - t0, time.perf_counter() - t1
 
 
 # ------------------------------------------------------------- client side
@@ -205,7 +249,7 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                     n_threads: int = 0, max_distance: Optional[float] = None,
                     cost: Any = None, cost_location: Optional[str] = None,
                     unfolding: bool = True, n_workers: Optional[int] = None,
-                    storage_options: Optional[dict] = None, compression: str = "zstd",
+                    storage_options: Optional[dict] = None, compression: str = "lz4",
                     progress: Any = True, retries: int = 3) -> Any:
     """Computes a dense S x N (or S x T) distance matrix as Dask tasks writing
     a Zarr v3 array at `store`, and returns the ``zarr.Array``.
@@ -223,13 +267,16 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         holds the same job, and refuses a store holding another job; False
         starts over, overwriting the store.
     block_rows: rows per task and chunk (default: about 8 MiB a chunk, at
-        least 4 tasks a worker).
+        least 4 tasks per Dask thread of the cluster).
     backend, n_threads: the in-process backend each task runs ("threads",
-        "serial", "opencl", "auto") and its threads (0: all cores of the
-        worker; a LocalCluster's workers get 1).
+        "serial", "opencl", "auto") and its threads (0: the worker's share of
+        its machine, cores / Dask threads on that host, so a LocalCluster of
+        one 1-thread process per core runs 1 library thread per task).
     max_distance, cost, cost_location, unfolding: as in ``Mesh.distance``.
-    compression: "zstd" (Blosc zstd with byte shuffle, the default) or
-        "none"; chunks always carry a CRC-32C.
+    compression: "lz4" (Blosc lz4 with bit shuffle, the default), "zstd"
+        (Blosc zstd level 3 with bit shuffle: ~2 % smaller, ~3x slower to
+        encode) or "none"; chunks always carry a CRC-32C. Measured on real
+        meshes' rows by bench/bench_compression.py (bench/RESULTS.md).
     progress: True for a progress bar on a terminal (plain lines when piped),
         False for none, or a callable ``progress(rows_done, n_rows)``; an
         exception it raises stops the job (blocks in flight still finish).
@@ -237,7 +284,8 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         rescheduled by Dask regardless).
 
     The attribute ``meshfmm_last_run`` of the returned array records how many
-    blocks this call computed and skipped.
+    blocks this call computed and skipped, and the task seconds spent
+    computing and writing (encoding included), summed over the tasks.
     """
     import zarr
     from zarr.codecs import BloscCodec, BloscShuffle, Crc32cCodec
@@ -256,8 +304,9 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         if not (float(max_distance) >= 0.0):
             raise ValueError(f"max_distance must be >= 0, not {max_distance}")
     cost_arr = None if cost is None else np.ascontiguousarray(cost, dtype=np.float64)
-    if compression not in ("zstd", "none"):
-        raise ValueError(f"compression must be 'zstd' or 'none', not {compression!r}")
+    if compression not in _CODECS:
+        raise ValueError(f"compression must be one of {', '.join(map(repr, _CODECS))}, "
+                         f"not {compression!r}")
     if backend not in ("auto", "threads", "serial", "opencl"):
         raise ValueError(f"backend must be auto, threads, serial or opencl, not {backend!r}")
     url, storage_options = _open_store(store, storage_options)
@@ -278,7 +327,11 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         if progress and link:
             print(f"meshfmm: Dask dashboard at {link}", file=sys.stderr)
     try:
-        n_workers_now = max(1, len(client.scheduler_info().get("workers", {})))
+        host_threads: Dict[str, int] = {}
+        for w in client.scheduler_info().get("workers", {}).values():
+            host = w.get("host", "")
+            host_threads[host] = host_threads.get(host, 0) + int(w.get("nthreads", 1))
+        dask_threads = max(1, sum(host_threads.values()))
         arr = None
         if resume:
             try:
@@ -295,15 +348,14 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                         "to overwrite it")
         if arr is None:
             if block_rows is None:
-                per_row = n_cols * dt.itemsize
-                block_rows = max(1, min(_BLOCK_BYTES // per_row,
-                                        math.ceil(n_rows / (4 * n_workers_now))))
+                block_rows = _default_block_rows(n_rows, n_cols * dt.itemsize, dask_threads)
             if int(block_rows) < 1:
                 raise ValueError(f"block_rows must be >= 1, not {block_rows}")
             compressors = [Crc32cCodec()]
-            if compression == "zstd":
-                compressors.insert(0, BloscCodec(cname="zstd", clevel=3,
-                                                 shuffle=BloscShuffle.shuffle,
+            if _CODECS[compression] is not None:
+                cname, clevel = _CODECS[compression]
+                compressors.insert(0, BloscCodec(cname=cname, clevel=clevel,
+                                                 shuffle=BloscShuffle.bitshuffle,
                                                  typesize=dt.itemsize))
             arr = zarr.create_array(url, shape=(n_rows, n_cols), chunks=(int(block_rows), n_cols),
                                     dtype=dt, fill_value=np.nan, compressors=compressors,
@@ -328,10 +380,10 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
 
         opts = {"backend": backend, "dtype": dt.name, "max_distance": max_distance,
                 "unfolding": unfolding, "cost": cost_arr, "cost_location": cost_location,
-                "n_threads": n_threads}
+                "n_threads": n_threads, "host_threads": host_threads}
         V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
         F = np.ascontiguousarray(mesh.faces, dtype=np.int32)
-        computed = 0
+        computed, t_compute, t_write = 0, 0.0, 0.0
         if todo:
             from distributed import as_completed
 
@@ -345,15 +397,19 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                        for b in todo]
             try:
                 for fut in as_completed(futures):
-                    r0, r1, _ = fut.result()
+                    r0, r1, tc, tw = fut.result()
                     computed += 1
+                    t_compute += tc
+                    t_write += tw
                     if report:
                         report(r1 - r0)
             except BaseException:
                 client.cancel(futures)
                 raise
         arr.attrs[RUN_ATTR] = {"blocks": n_blocks, "blocks_computed": computed,
-                               "blocks_skipped": len(done), "block_rows": block_rows}
+                               "blocks_skipped": len(done), "block_rows": block_rows,
+                               "task_compute_seconds": t_compute,
+                               "task_write_seconds": t_write}
         return arr
     finally:
         if own_cluster is not None:
@@ -411,6 +467,8 @@ def cli_allpairs_zarr(argv: Sequence[str]) -> int:
     ap.add_argument("--cost", help="per-vertex or per-face cost (.npy or .txt)")
     ap.add_argument("--backend", choices=["threads", "serial", "opencl", "auto"], default="threads")
     ap.add_argument("--block-rows", type=int)
+    ap.add_argument("--compression", choices=list(_CODECS), default="lz4",
+                    help="Blosc lz4 or zstd (bit shuffle), or none (default: lz4)")
     ap.add_argument("--no-progress", action="store_true")
     a = ap.parse_args(list(argv))
     try:
@@ -430,7 +488,8 @@ def cli_allpairs_zarr(argv: Sequence[str]) -> int:
         Z = distance_matrix(mesh, a.output, sources=src, targets=tgt, client=client,
                             dtype=a.dtype, resume=a.resume, block_rows=a.block_rows,
                             backend=a.backend, max_distance=a.max_distance, cost=cost,
-                            n_workers=a.workers, progress=not a.no_progress)
+                            n_workers=a.workers, progress=not a.no_progress,
+                            compression=a.compression)
         run = Z.attrs.get(RUN_ATTR, {})
         print(f"meshfmm: wrote {Z.shape[0]} x {Z.shape[1]} {Z.dtype} to {a.output} "
               f"({run.get('blocks_computed')} blocks computed, {run.get('blocks_skipped')} "
