@@ -211,25 +211,39 @@ def complete_blocks(arr: Any, block_rows: int) -> List[int]:
     return done
 
 
+def _fmt_seconds(s: float) -> str:
+    if not math.isfinite(s):
+        return "?"
+    s = int(round(s))
+    if s < 60:
+        return f"{s} s"
+    if s < 3600:
+        return f"{s // 60} min {s % 60:02d} s"
+    return f"{s // 3600} h {s % 3600 // 60:02d} min"
+
+
 class _Progress:
     """A progress bar on a terminal (rows done, rows/s, time left), plain lines
-    every ~10 % or 30 s when piped."""
+    every ~10 % or 30 s when piped. `done`: rows already complete (a resumed
+    job); they count in rows done, not in the rate."""
 
-    def __init__(self, total: int, stream=None) -> None:
-        self.total, self.done = total, 0
+    def __init__(self, total: int, stream=None, done: int = 0) -> None:
+        self.total, self.done, self.done0 = total, done, done
         self.stream = stream or sys.stderr
         self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
         self.t0 = self.last = time.monotonic()
-        self.last_frac = 0.0
+        self.last_frac = -1.0
 
     def __call__(self, rows: int) -> None:
         self.done += rows
         now = time.monotonic()
-        rate = self.done / max(now - self.t0, 1e-9)
-        left = (self.total - self.done) / rate if rate > 0 else float("inf")
-        frac = self.done / self.total
-        msg = (f"{self.done}/{self.total} rows ({100 * frac:.1f} %), {rate:.1f} rows/s, "
-               f"{left:.0f} s left")
+        new = self.done - self.done0
+        rate = new / (now - self.t0) if new > 0 and now > self.t0 else float("nan")
+        left = (self.total - self.done) / rate if rate > 0 else float("nan")
+        frac = self.done / self.total if self.total else 1.0
+        rate_s = "?" if not math.isfinite(rate) else f"{rate:.1f}"
+        msg = (f"{self.done}/{self.total} rows ({100 * frac:.1f} %), {rate_s} rows/s, "
+               f"{_fmt_seconds(left)} left")
         if self.tty:
             w = 30
             bar = "#" * int(w * frac) + "-" * (w - int(w * frac))
@@ -368,8 +382,9 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
 
         report: Optional[Callable[[int], None]] = None
         if progress is True:
-            bar = _Progress(n_rows)
-            bar(sum(min(n_rows, (b + 1) * block_rows) - b * block_rows for b in done))
+            bar = _Progress(n_rows, done=sum(min(n_rows, (b + 1) * block_rows) - b * block_rows
+                                             for b in done))
+            bar(0)
             report = bar
         elif callable(progress):
             rows_done = [sum(min(n_rows, (b + 1) * block_rows) - b * block_rows for b in done)]
@@ -485,6 +500,9 @@ def cli_allpairs_zarr(argv: Sequence[str]) -> int:
             from distributed import Client
 
             client = Client(a.scheduler)
+            link = getattr(client, "dashboard_link", None)
+            if link and not a.no_progress:
+                print(f"meshfmm: Dask dashboard at {link}", file=sys.stderr)
         Z = distance_matrix(mesh, a.output, sources=src, targets=tgt, client=client,
                             dtype=a.dtype, resume=a.resume, block_rows=a.block_rows,
                             backend=a.backend, max_distance=a.max_distance, cost=cost,
