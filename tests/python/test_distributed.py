@@ -302,3 +302,17 @@ def test_compression_choices(hand, serial64, client, tmp_path):
     assert sizes["zstd"] < sizes["none"] and sizes["lz4"] < sizes["none"]
     with pytest.raises(ValueError, match="compression"):
         md.distance_matrix(hand, str(tmp_path / "x.zarr"), client=client, compression="gzip")
+
+
+def test_resume_check_on_the_cluster_equals_the_local_check(hand, client, tmp_path):
+    store = str(tmp_path / "v.zarr")
+    Z = md.distance_matrix(hand, store, sources=SOURCES, client=client, block_rows=8,
+                           progress=False)
+    os.remove(os.path.join(store, "c", "3", "0"))  # never written
+    chunk = os.path.join(store, "c", "11", "0")  # torn
+    data = open(chunk, "rb").read()
+    open(chunk, "wb").write(data[:-3])
+    local = md.complete_blocks(Z, 8)
+    assert local == [b for b in range(15) if b not in (3, 11)]
+    assert md._complete_blocks_on(client, store, None, 116, 8, 2) == local
+    assert md._complete_blocks_on(client, store, None, 116, 8, 64) == local  # a task per block

@@ -194,13 +194,12 @@ def _open_store(store: Any, storage_options: Optional[dict]) -> Tuple[str, Optio
     return url, storage_options
 
 
-def complete_blocks(arr: Any, block_rows: int) -> List[int]:
-    """Indices of the row blocks of `arr` that are complete and verified: the
-    chunk decodes (its CRC-32C matches) and holds no NaN (the fill value of a
-    chunk never written)."""
+def _verified(arr: Any, blocks: Sequence[int], block_rows: int) -> List[int]:
+    """Those of `blocks` whose chunk decodes (its CRC-32C matches) and holds no
+    NaN (a chunk never written reads as the NaN fill value)."""
     n_rows = arr.shape[0]
     done = []
-    for b in range(math.ceil(n_rows / block_rows)):
+    for b in blocks:
         r0, r1 = b * block_rows, min(n_rows, (b + 1) * block_rows)
         try:
             block = arr[r0:r1, :]
@@ -209,6 +208,36 @@ def complete_blocks(arr: Any, block_rows: int) -> List[int]:
         if not np.isnan(block).any():
             done.append(b)
     return done
+
+
+def _verify_task(url: str, storage_options: Optional[dict], blocks: List[int],
+                 block_rows: int) -> List[int]:
+    import zarr
+
+    arr = zarr.open_array(url, mode="r", storage_options=storage_options)
+    return _verified(arr, blocks, block_rows)
+
+
+def complete_blocks(arr: Any, block_rows: int) -> List[int]:
+    """Indices of the row blocks of `arr` that are complete and verified: the
+    chunk decodes (its CRC-32C matches) and holds no NaN (the fill value of a
+    chunk never written). Reads the whole array in this process; a resumed
+    ``distance_matrix`` does the same check as tasks on its cluster."""
+    return _verified(arr, range(math.ceil(arr.shape[0] / block_rows)), block_rows)
+
+
+def _complete_blocks_on(client: Any, url: str, storage_options: Optional[dict], n_rows: int,
+                        block_rows: int, dask_threads: int) -> List[int]:
+    """complete_blocks as tasks on the cluster (each reads and checks a share
+    of the chunks), so resuming a big store does not read it all through the
+    client."""
+    n_blocks = math.ceil(n_rows / block_rows)
+    n_tasks = max(1, min(n_blocks, 4 * dask_threads))
+    batches = [list(range(i, n_blocks, n_tasks)) for i in range(n_tasks)]
+    futures = client.map(_verify_task, [url] * n_tasks, [storage_options] * n_tasks, batches,
+                         [block_rows] * n_tasks, pure=False,
+                         key=[f"meshfmm-verify-{i}-{time.time_ns()}" for i in range(n_tasks)])
+    return sorted(b for done in client.gather(futures) for b in done)
 
 
 def _fmt_seconds(s: float) -> str:
@@ -377,7 +406,8 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                                     storage_options=storage_options)
         block_rows = int(arr.chunks[0])
         n_blocks = math.ceil(n_rows / block_rows)
-        done = set(complete_blocks(arr, block_rows)) if resume else set()
+        done = (set(_complete_blocks_on(client, url, storage_options, n_rows, block_rows,
+                                        dask_threads)) if resume else set())
         todo = [b for b in range(n_blocks) if b not in done]
 
         report: Optional[Callable[[int], None]] = None
