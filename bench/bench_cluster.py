@@ -42,6 +42,7 @@ def main() -> None:
     ap.add_argument("--rows", type=int, default=0, help="first N rows only (0: all)")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--threads-per-worker", type=int, default=1)
     ap.add_argument("--dtype", default="float32")
     ap.add_argument("--block-rows", type=int, default=None)
     ap.add_argument("--compression", default="lz4", choices=["lz4", "zstd", "none"])
@@ -60,17 +61,19 @@ def main() -> None:
     src = None if n_rows == nv else np.arange(n_rows, dtype=np.int32)
     entries = n_rows * nv
     work = Path(tempfile.mkdtemp(prefix="mfmm_cluster_"))
-    threads = a.workers  # the in-process run uses as many threads as the cluster has workers
+    threads = a.workers * a.threads_per_worker  # in-process: as many threads as the cluster
 
     t0 = time.perf_counter()
-    cluster = LocalCluster(n_workers=a.workers, threads_per_worker=1, processes=True,
+    cluster = LocalCluster(n_workers=a.workers, threads_per_worker=a.threads_per_worker,
+                           processes=True,
                            dashboard_address=":0")
     client = Client(cluster)
     # workers import the library and zarr once (as they would for a job's first task)
     client.run(lambda: [__import__(m) for m in ("meshfmm", "zarr", "zarr.codecs")])
     t_start = time.perf_counter() - t0
     print(f"{a.mesh}: {n_rows} x {nv} {a.dtype} ({entries / 1e6:.1f} M entries); "
-          f"cluster of {a.workers} started in {t_start:.2f} s", flush=True)
+          f"cluster of {a.workers} x {a.threads_per_worker} started in {t_start:.2f} s",
+          flush=True)
 
     # warm-up (page faults, first calls), not timed
     mesh.distance_matrix(np.arange(8, dtype=np.int32), backend="threads", n_threads=threads,
@@ -100,7 +103,7 @@ def main() -> None:
         runs["cluster"].append(dt)
         info = dict(Z.attrs.get(mdist.RUN_ATTR, {}))
         task_s.append((info.get("task_compute_seconds"), info.get("task_write_seconds")))
-        print(f"  cluster {a.workers}x1:        {dt:7.2f} s  {entries / dt / 1e6:6.2f} M/s  "
+        print(f"  cluster {a.workers}x{a.threads_per_worker}:        {dt:7.2f} s  {entries / dt / 1e6:6.2f} M/s  "
               f"({info.get('blocks')} blocks of {info.get('block_rows')} rows; task seconds: "
               f"compute {task_s[-1][0]:.2f}, write {task_s[-1][1]:.2f})", flush=True)
         if rep == 0:
@@ -113,7 +116,7 @@ def main() -> None:
         shutil.rmtree(store)
 
     cold = None
-    if a.cold:
+    if a.cold and a.threads_per_worker == 1:  # client=None starts 1-thread workers
         client.close()
         cluster.close()
         client = cluster = None
@@ -140,7 +143,7 @@ def main() -> None:
     raw = entries * np.dtype(a.dtype).itemsize
     res = {"machine": benchlib.machine_info(), "versions": benchlib.versions(),
            "mesh": a.mesh, "n_vertices": nv, "rows": n_rows, "entries": entries,
-           "dtype": a.dtype, "workers": a.workers, "threads_per_worker": 1,
+           "dtype": a.dtype, "workers": a.workers, "threads_per_worker": a.threads_per_worker,
            "in_process_threads": threads, "compression": a.compression,
            "task_threads": a.task_threads,
            "task_compute_write_seconds": task_s, "cluster_start_seconds": t_start,
