@@ -9,9 +9,16 @@ Default: camelhead (tests/data/meshes, 11,381 vertices), every row (130 M
 entries), float32, 2 worker processes of 1 thread against 2 library threads.
 Runs alternate (in-process, cluster, in-process, cluster, ...) so load from
 other processes hits both; the ratio is taken between the best run of each
-(the least disturbed), with every adjacent pair's ratio recorded too; the cluster is started once before the timed runs
+(the least disturbed), with every adjacent pair's ratio recorded too; the
+cluster is started once before the timed runs
 (its start is timed separately, and once more in a cold run with client=None
 when --cold is given). Each cluster run starts a fresh store (resume=False).
+Also records CPU seconds (user + system) of each run: the in-process run's
+own, and the cluster run's over this process (client and scheduler) and every
+nanny and worker; their ratio is the throughput ratio on dedicated cores
+that both keep busy, and it does not move with other processes' load.
+The cluster runs with meshfmm.distributed.DASK_CONFIG (what distance_matrix's
+own LocalCluster uses; --dask-defaults for Dask's defaults).
 Writes bench/results/cluster.json (--rows < all: cluster_quick.json)."""
 
 from __future__ import annotations
@@ -30,6 +37,24 @@ import numpy as np
 import benchlib
 import meshfmm
 import meshfmm.distributed as mdist
+
+
+def cpu_seconds(tree: bool) -> float:
+    """User + system CPU seconds of this process (all its threads) and, with
+    `tree`, of its live descendants (a LocalCluster's nannies and workers; its
+    scheduler runs in this process)."""
+    import psutil
+
+    me = psutil.Process()
+    procs = [me] + (me.children(recursive=True) if tree else [])
+    total = 0.0
+    for p in procs:
+        try:
+            t = p.cpu_times()
+        except psutil.Error:
+            continue
+        total += t.user + t.system
+    return total
 
 
 def du(path: Path) -> int:
@@ -51,9 +76,16 @@ def main() -> None:
     ap.add_argument("--cold", action="store_true",
                     help="also one run with client=None (cluster start included)")
     ap.add_argument("--out", default=None, help="result file name in bench/results")
+    ap.add_argument("--dask-defaults", action="store_true",
+                    help="Dask's default settings, not meshfmm.distributed.DASK_CONFIG")
     a = ap.parse_args()
 
+    import dask
     from distributed import Client, LocalCluster
+
+    # the settings distance_matrix's own LocalCluster uses (cold run too)
+    dask_config = {} if a.dask_defaults else dict(mdist.DASK_CONFIG)
+    dask.config.set(dask_config)
 
     mesh = meshfmm.Mesh(*meshfmm.load_mesh(str(benchlib.DATA / "meshes" / a.mesh)))
     nv = mesh.n_vertices
@@ -79,33 +111,40 @@ def main() -> None:
     mesh.distance_matrix(np.arange(8, dtype=np.int32), backend="threads", n_threads=threads,
                          dtype=a.dtype)
     runs = {"in_process": [], "cluster": []}
+    cpu = {"in_process": [], "cluster": []}
     ref = None
     store_bytes = None
     info = None
     task_s = []
     for rep in range(a.repeats):
-        t0 = time.perf_counter()
+        c0, t0 = cpu_seconds(False), time.perf_counter()
         D = mesh.distance_matrix(src, backend="threads", n_threads=threads, dtype=a.dtype)
         dt = time.perf_counter() - t0
         runs["in_process"].append(dt)
-        print(f"  in-process threads={threads}: {dt:7.2f} s  {entries / dt / 1e6:6.2f} M/s",
-              flush=True)
+        cpu["in_process"].append(cpu_seconds(False) - c0)
+        print(f"  in-process threads={threads}: {dt:7.2f} s  {entries / dt / 1e6:6.2f} M/s  "
+              f"(CPU {cpu['in_process'][-1]:.2f} s)", flush=True)
         if ref is None:
             ref = D
         del D
 
         store = work / f"rep{rep}.zarr"
-        t0 = time.perf_counter()
+        c0, t0 = cpu_seconds(True), time.perf_counter()
         Z = mdist.distance_matrix(mesh, str(store), sources=src, client=client, dtype=a.dtype,
                                   resume=False, block_rows=a.block_rows, progress=False,
                                   compression=a.compression, n_threads=a.task_threads)
         dt = time.perf_counter() - t0
         runs["cluster"].append(dt)
+        cpu["cluster"].append(cpu_seconds(True) - c0)
         info = dict(Z.attrs.get(mdist.RUN_ATTR, {}))
-        task_s.append((info.get("task_compute_seconds"), info.get("task_write_seconds")))
-        print(f"  cluster {a.workers}x{a.threads_per_worker}:        {dt:7.2f} s  {entries / dt / 1e6:6.2f} M/s  "
+        task_s.append((info.get("task_compute_seconds"), info.get("task_write_seconds"),
+                       info.get("task_thread_cpu_seconds")))
+        print(f"  cluster {a.workers}x{a.threads_per_worker}:        {dt:7.2f} s  "
+              f"{entries / dt / 1e6:6.2f} M/s  "
               f"({info.get('blocks')} blocks of {info.get('block_rows')} rows; task seconds: "
-              f"compute {task_s[-1][0]:.2f}, write {task_s[-1][1]:.2f})", flush=True)
+              f"compute {task_s[-1][0]:.2f}, write {task_s[-1][1]:.2f}, task threads' CPU "
+              f"{task_s[-1][2]:.2f}; CPU, all processes "
+              f"{cpu['cluster'][-1]:.2f} s)", flush=True)
         if rep == 0:
             store_bytes = du(store)
             # the store holds exactly the in-process rows
@@ -140,23 +179,30 @@ def main() -> None:
     # ratio of each adjacent pair is reported too
     ratio = best["in_process"] / best["cluster"]
     pair_ratios = [i / c for i, c in zip(runs["in_process"], runs["cluster"])]
+    # CPU seconds per entry: what a run costs whatever else the box runs (a
+    # dedicated box with every core busy gets entries/s = cores / that)
+    cpu_ratio = statistics.median(cpu["in_process"]) / statistics.median(cpu["cluster"])
     raw = entries * np.dtype(a.dtype).itemsize
     res = {"machine": benchlib.machine_info(), "versions": benchlib.versions(),
            "mesh": a.mesh, "n_vertices": nv, "rows": n_rows, "entries": entries,
            "dtype": a.dtype, "workers": a.workers, "threads_per_worker": a.threads_per_worker,
            "in_process_threads": threads, "compression": a.compression,
+           "dask_config": dask_config,
            "task_threads": a.task_threads,
-           "task_compute_write_seconds": task_s, "cluster_start_seconds": t_start,
+           "task_compute_write_cpu_seconds": task_s, "cluster_start_seconds": t_start,
            "seconds": runs, "median_seconds": med, "best_seconds": best,
            "entries_per_s": {k: entries / v for k, v in best.items()},
            "cluster_over_in_process": ratio, "pair_ratios": pair_ratios,
            "median_pair_ratio": statistics.median(pair_ratios), "target": 0.9,
+           "cpu_seconds": cpu, "cpu_ratio": cpu_ratio,
            "blocks": info.get("blocks"), "block_rows": info.get("block_rows"),
            "store_bytes": store_bytes, "raw_bytes": raw,
            "store_ratio": raw / store_bytes if store_bytes else None,
            "cold_seconds": cold,
            "cold_over_in_process": best["in_process"] / cold if cold else None,
            "load_average": os.getloadavg()}
+    print(f"CPU seconds, in-process / cluster (all its processes): {cpu_ratio * 100:.1f} %",
+          flush=True)
     print(f"cluster / in-process throughput: {ratio * 100:.1f} % best runs, "
           f"{statistics.median(pair_ratios) * 100:.1f} % median of pairs (target 90 %); store "
           f"{store_bytes / 2**20:.0f} MiB for {raw / 2**20:.0f} MiB raw", flush=True)

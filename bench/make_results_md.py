@@ -311,7 +311,8 @@ def scale_section(sc):
          f"`bench/bench_scale.py` → bench/results/scale.json.", "",
          "Sparse local rows (`max_distance=r`, CSR) on sine surfaces; a row costs what it reaches "
          "(touched-list reset):", "",
-         "| mesh | vertices | r (mean edges) | rows/s | entries per row | vertices settled per row |",
+         "| mesh | vertices | r (mean edges) | rows/s | entries per row "
+         "| vertices settled per row |",
          "|---|---:|---:|---:|---:|---:|"]
     for m in sc["sparse_vs_n"]:
         for r in m["radii"]:
@@ -339,51 +340,73 @@ def scale_section(sc):
               f"gdist {g['gdist_seconds']:.3g} s ({g['speedup']:.1f}x); "
               f"{g['meshfmm_entries_per_s'] / 1e6:.3g} vs {g['gdist_entries_per_s'] / 1e6:.3g} "
               f"M entries/s; sparsity patterns' Jaccard index {g['pattern_jaccard']:.3f}; mean "
-              f"relative difference on the pairs both hold {g['mean_rel_diff_common'] * 100:.2f} %."]
+              "relative difference on the pairs both hold "
+              f"{g['mean_rel_diff_common'] * 100:.2f} %."]
     elif g:
         L += ["", f"gdist: {g['skipped']}"]
     return L + [""]
 
 
-def cluster_section(cl, cl12=None):
+def cluster_section(cl, cl12=None, cldef=None):
     ent = cl["entries"]
     L = ["## Dask cluster against in-process (issue 11)", "",
          f"**Machine:** {machine_line(cl)}; load average at the end "
          f"{', '.join(f'{x:.1f}' for x in cl['load_average'])}. "
          f"`bench/bench_cluster.py` → bench/results/cluster.json.", "",
          f"{cl['mesh']}, {cl['rows']:,} x {cl['n_vertices']:,} {cl['dtype']} "
-         f"({ent / 1e6:.1f} M entries): the threads backend with {cl['in_process_threads']} threads "
+         f"({ent / 1e6:.1f} M entries): the threads backend with "
+         f"{cl['in_process_threads']} threads "
          f"in one process (the matrix in memory) against `meshfmm.distributed.distance_matrix` on "
          f"a LocalCluster of {cl['workers']} processes x {cl['threads_per_worker']} thread writing "
          f"a Zarr store on local disk ({cl['compression']}, {cl['blocks']} tasks of "
          f"{cl['block_rows']} rows). Runs alternate; the ratio compares the best run of each "
          "(the box is shared).", "",
-         "| run | seconds (each run) | best: M entries/s |", "|---|---|---:|"]
+         "| run | seconds (each run) | best: M entries/s | CPU seconds (each run) |",
+         "|---|---|---:|---|"]
     for k, name in (("in_process", f"in-process, {cl['in_process_threads']} threads"),
-                    ("cluster", f"cluster, {cl['workers']} x {cl['threads_per_worker']}")):
+                    ("cluster", f"cluster, {cl['workers']} x {cl['threads_per_worker']} "
+                                "(client, scheduler, nannies, workers)")):
         L.append(f"| {name} | {', '.join(f'{s:.2f}' for s in cl['seconds'][k])} | "
-                 f"{cl['entries_per_s'][k] / 1e6:.2f} |")
+                 f"{cl['entries_per_s'][k] / 1e6:.2f} | "
+                 f"{', '.join(f'{s:.2f}' for s in cl.get('cpu_seconds', {}).get(k, []))} |")
     verdict = "meets" if cl["cluster_over_in_process"] >= cl["target"] else "misses"
-    tw = cl.get("task_compute_write_seconds") or []
+    tw = [x[:2] for x in cl.get("task_compute_write_cpu_seconds")
+          or cl.get("task_compute_write_seconds") or []]
     wr = (f" Inside the tasks, writing (encode, CRC-32C, file) took "
           f"{100 * min(w / c for c, w in tw):.1f}-{100 * max(w / c for c, w in tw):.1f} % of the "
           "computing time." if tw else "")
     L += ["", f"Cluster / in-process throughput: **{cl['cluster_over_in_process'] * 100:.1f} %** "
-          f"(best runs; median of adjacent pairs {cl['median_pair_ratio'] * 100:.1f} %): "
-          f"{verdict} the {cl['target'] * 100:.0f} % target.{wr} Cluster start "
+          f"(best runs; median of adjacent pairs {cl['median_pair_ratio'] * 100:.1f} %; "
+          + (f"CPU seconds in-process / cluster {cl['cpu_ratio'] * 100:.1f} %, which other "
+             "processes' load does not move" if cl.get("cpu_ratio") else "")
+          + f"): {verdict} the {cl['target'] * 100:.0f} % target.{wr} Cluster start "
           f"{cl['cluster_start_seconds']:.2f} s"
           + (f"; a cold run (client=None: cluster started inside) "
              f"{cl['cold_seconds']:.2f} s, {cl['cold_over_in_process'] * 100:.1f} % of the best "
              "in-process run" if cl.get("cold_seconds") else "")
           + f". Store {fbytes(cl['store_bytes'])} for {fbytes(cl['raw_bytes'])} raw "
           f"(ratio {cl['store_ratio']:.3f}); the rows equal the in-process rows bit for bit.", ""]
+    if cl.get("dask_config"):
+        L += ["The cluster runs with `meshfmm.distributed.DASK_CONFIG` (event-loop tick 1 s, "
+              "memory monitor 1 s, system monitor 2 s, no GIL monitor, no statistical profiler; "
+              "what `distance_matrix` gives the LocalCluster it starts): Dask's defaults poll "
+              "every 10-500 ms in the scheduler, each nanny and each worker, which cost an idle "
+              "2-process LocalCluster ~9 % of a core and busy tasks 5-9 % of their CPU here, "
+              "against ~2 % with these settings."
+              + (f" Same job with Dask's defaults: best runs "
+                 f"{cldef['cluster_over_in_process'] * 100:.1f} %, median of pairs "
+                 f"{cldef['median_pair_ratio'] * 100:.1f} %, CPU seconds "
+                 f"{cldef['cpu_ratio'] * 100:.1f} % (bench/results/cluster_dask_defaults.json)."
+                 if cldef else ""), ""]
     if cl12:
         L += [f"One worker process of {cl12['threads_per_worker']} threads instead (`dask worker "
               f"--nworkers 1 --nthreads {cl12['threads_per_worker']}`; one mesh per process), same "
               f"job: in-process {', '.join(f'{s:.2f}' for s in cl12['seconds']['in_process'])} s, "
               f"cluster {', '.join(f'{s:.2f}' for s in cl12['seconds']['cluster'])} s: "
               f"**{cl12['cluster_over_in_process'] * 100:.1f} %** (best runs; median of pairs "
-              f"{cl12['median_pair_ratio'] * 100:.1f} %).", ""]
+              f"{cl12['median_pair_ratio'] * 100:.1f} %"
+              + (f"; CPU seconds {cl12['cpu_ratio'] * 100:.1f} %" if cl12.get("cpu_ratio") else "")
+              + ").", ""]
     return L
 
 
@@ -456,11 +479,13 @@ def plan_section(pl, cl, co):
          "`bench/bench_compression.py`; refresh with `python bench/plan_1m.py && python "
          "bench/make_results_md.py --no-readme` (the vertex renumbering of issue 13 changes the "
          "per-row time, and the ratio of real meshes).", "",
-         "**Measured** (m) on this machine; **extrapolated** (x) from them by the formula given.", "",
+         "**Measured** (m) on this machine; **extrapolated** (x) from them by the formula "
+         "given.", "",
          "| quantity | value | m/x | how |", "|---|---|---|---|",
          f"| mesh | {pl['mesh']}: {n:,} vertices, {pl['n_faces']:,} faces | m | `meshfmm generate "
          "sine 1000` |",
-         f"| time per row, 1 thread, float32 | {t * 1e3:.0f} ms ({n / t / 1e6:.2f} M entries/s) | m "
+         f"| time per row, 1 thread, float32 | {t * 1e3:.0f} ms "
+         f"({n / t / 1e6:.2f} M entries/s) | m "
          f"| best of {pl.get('repeats', 2)} blocks of {pl['rows_timed']} contiguous rows |",
          f"| mesh build on a worker | {pl['mesh_build_seconds']:.1f} s, {mesh_mib:.0f} MiB | m | "
          "`Mesh(V, F)`, resident memory before/after |",
@@ -494,9 +519,11 @@ def plan_section(pl, cl, co):
           f"({fmt_time(sched)} of scheduler time over the job) | x | {cores} / task time; "
           "tasks x cost per task |",
           f"| compute | {core_h:,.0f} core-hours | x | N x time per row |",
-          f"| on 16-core nodes | **{node_h:.1f} node-hours** (e.g. {math.ceil(node_h / 2)} nodes "
-          f"for ~2 h, {math.ceil(node_h / 8)} for ~8 h) | x | core-hours / {cores} / "
-          f"{eff_used * 100:.0f} % efficiency |",
+          f"| on {cores}-core nodes | **{node_h:.1f} node-hours**: "
+          + ", ".join(f"{k} node{'s' * (k > 1)} {fmt_time(node_h / k * 3600)}"
+                      for k in (1, 4, 16))
+          + f" | x | core-hours / {cores} / {eff_used * 100:.0f} % efficiency (measured on 2 "
+          "cores; assumed to hold per node) |",
           f"| memory, 16 processes x 1 thread per node | {per_proc / 1024:.2f} GiB per worker, "
           f"{cores * per_proc / 1024:.1f} GiB per node | x | idle worker + V, F + mesh + 3 chunks |",
           f"| memory, 1 process x 16 threads per node | {per_node_threads / 1024:.1f} GiB per node "
@@ -505,6 +532,11 @@ def plan_section(pl, cl, co):
           "row x 4 B / ratio |",
           "", "Steps:", "",
           "```sh",
+          "export DASK_DISTRIBUTED__ADMIN__TICK__INTERVAL=1s \\",
+          "       DASK_DISTRIBUTED__ADMIN__SYSTEM_MONITOR__INTERVAL=2s \\",
+          "       DASK_DISTRIBUTED__ADMIN__SYSTEM_MONITOR__GIL__ENABLED=False \\",
+          "       DASK_DISTRIBUTED__WORKER__MEMORY__MONITOR_INTERVAL=1s \\",
+          "       DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False  # meshfmm.distributed.DASK_CONFIG",
           "dask scheduler                                         # head node",
           "dask worker tcp://HEAD:8786 --nworkers 1 --nthreads 16  # each 16-core node",
           f"meshfmm allpairs scan.ply -o s3://bucket/D.zarr --scheduler tcp://HEAD:8786 "
@@ -515,7 +547,9 @@ def plan_section(pl, cl, co):
           "One worker process of 16 threads per node holds one mesh (tasks run the C code without "
           "the GIL, each with one library thread: meshfmm gives a task cores / Dask threads on its "
           "host); 16 one-thread processes hold 16. Writing needs the bandwidth above times the "
-          "nodes from the object store or file system. Resuming reads every stored chunk once, "
+          "nodes from the object store or file system. The sine surface's grid order "
+          "compresses better than real meshes' vertex orders, hence the range of store sizes. "
+          "Resuming reads every stored chunk once, "
           "spread over the cluster's tasks (the verification is a CRC over the whole chunk), so "
           "a resume of an almost complete job costs about one read of the store. float64 doubles "
           "the store and the chunk memory, not the compute.", ""]
@@ -585,7 +619,8 @@ def main():
     if sc:
         D += scale_section(sc)
     if cl:
-        D += cluster_section(cl, load_json("cluster_1x2.json"))
+        D += cluster_section(cl, load_json("cluster_1x2.json"),
+                             load_json("cluster_dask_defaults.json"))
     if co:
         D += compression_section(co)
     if pl:

@@ -112,12 +112,13 @@ def main() -> None:
     res = {"machine": benchlib.machine_info(), "versions": benchlib.versions(),
            "mesh": f"sine {a.n}", "n_vertices": nv, "n_faces": mesh.n_faces,
            "mesh_build_seconds": t_build, "rows_timed": a.rows, "first_row": r0,
-           "seconds_per_row_1_thread": per_row, "rss_mib": {"after_import": rss0, "with_v_f": rss_vf,
+           "seconds_per_row_1_thread": per_row,
+           "rss_mib": {"after_import": rss0, "with_v_f": rss_vf,
                                                             "after_mesh": rss_mesh,
                                                             "after_block": rss_block},
            "v_f_bytes": vf_bytes, "dask_worker_idle_rss_mib": worker_rss,
            "dask_seconds_per_noop_task": per_task,
-           "block_rows": a.rows, "codecs": codecs, "node_cores": a.node_cores,
+           "repeats": a.repeats, "block_rows": a.rows, "codecs": codecs, "node_cores": a.node_cores,
            "cluster_efficiency_measured": eff, "load_average": os.getloadavg()}
     out = benchlib.RESULTS / "plan_1m.json"
     out.write_text(json.dumps(res, indent=1) + "\n")

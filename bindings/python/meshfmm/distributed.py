@@ -19,6 +19,7 @@ Needs ``dask[distributed]`` and ``zarr>=3``.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import math
@@ -32,7 +33,7 @@ import numpy as np
 from . import __version__
 from ._mesh import Mesh
 
-__all__ = ["distance_matrix", "job_description", "complete_blocks", "symmetrize"]
+__all__ = ["distance_matrix", "job_description", "complete_blocks", "symmetrize", "DASK_CONFIG"]
 
 JOB_ATTR = "meshfmm_job"
 RUN_ATTR = "meshfmm_last_run"
@@ -45,6 +46,23 @@ _BLOCK_BYTES = 8 << 20
 # each task's critical path); zstd 3 + bit shuffle is ~2 % smaller again.
 _CODECS: Dict[str, Optional[Tuple[str, int]]] = {"lz4": ("lz4", 5), "zstd": ("zstd", 3),
                                                  "none": None}
+
+
+# Dask settings for long compute-bound tasks. Dask's defaults poll every
+# 10-500 ms (event-loop tick, memory and system monitors, GIL monitor,
+# statistical profiler) in the scheduler, every nanny and every worker: on a
+# 2-core LocalCluster that cost 5-9 % of the tasks' CPU, these ~2 %
+# (bench/bench_cluster.py). distance_matrix's own LocalCluster runs with them;
+# for a cluster of your own, start it inside dask.config.set(DASK_CONFIG), or
+# give `dask scheduler` / `dask worker` the same as DASK_* variables
+# (DASK_DISTRIBUTED__ADMIN__TICK__INTERVAL=1s, ...).
+DASK_CONFIG: Dict[str, Any] = {
+    "distributed.admin.tick.interval": "1s",
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.admin.system-monitor.gil.enabled": False,
+    "distributed.worker.memory.monitor-interval": "1s",
+    "distributed.worker.profile.enabled": False,
+}
 
 
 def _default_block_rows(n_rows: int, row_bytes: int, dask_threads: int) -> int:
@@ -159,17 +177,18 @@ def _task_threads(n_threads: int, host_threads: Dict[str, int]) -> int:
 def _compute_block(key: str, V: np.ndarray, F: np.ndarray, url: str,
                    storage_options: Optional[dict], r0: int, r1: int,
                    src: Optional[np.ndarray], targets: Optional[np.ndarray],
-                   opts: Dict[str, Any]) -> Tuple[int, int, float, float]:
+                   opts: Dict[str, Any]) -> Tuple[int, int, float, float, float]:
     """One task: rows [r0, r1) into their own chunk. Idempotent: a retry
-    writes the same bytes. Returns r0, r1 and the seconds spent computing
-    and writing (encoding included)."""
+    writes the same bytes. Returns r0, r1, the seconds spent computing and
+    writing (encoding included), and the CPU seconds of the task's thread
+    (library threads started beyond it not counted)."""
     import zarr
 
     cache = _worker_cache()
     mesh = cache.get(key)
     if mesh is None:
         mesh = cache[key] = Mesh(V, F)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.thread_time()
     rows_src = np.arange(r0, r1, dtype=np.int32) if src is None else src[r0:r1]
     kw = dict(backend=opts["backend"], dtype=opts["dtype"],
               n_threads=_task_threads(opts["n_threads"], opts.get("host_threads") or {}),
@@ -181,7 +200,7 @@ def _compute_block(key: str, V: np.ndarray, F: np.ndarray, url: str,
     t1 = time.perf_counter()
     arr = zarr.open_array(url, mode="r+", storage_options=storage_options)
     arr[r0:r1, :] = rows
-    return r0, r1, t1 - t0, time.perf_counter() - t1
+    return r0, r1, t1 - t0, time.perf_counter() - t1, time.thread_time() - c0
 
 
 # ------------------------------------------------------------- client side
@@ -303,7 +322,8 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         (T,) for the columns, in the given order; None for every vertex.
     client: a ``distributed.Client``; None starts a ``LocalCluster`` of
         `n_workers` processes (default: the machine's cores) with one thread
-        each, and prints its dashboard address.
+        each and the settings of ``DASK_CONFIG``, and prints its dashboard
+        address.
     dtype: "float32" or "float64"; the values equal ``mesh.distance`` per row
         (float64 bit for bit, float32 the same rounding).
     resume: True skips blocks already complete and verified when the store
@@ -359,10 +379,13 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                           unfolding)
 
     own_cluster = None
+    quiet = contextlib.ExitStack()
     if client is None:
+        import dask
         from distributed import Client, LocalCluster
 
         workers = n_workers or os.cpu_count() or 1
+        quiet.enter_context(dask.config.set(DASK_CONFIG))
         own_cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                    dashboard_address=":0")
         client = Client(own_cluster)
@@ -428,7 +451,7 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                 "n_threads": n_threads, "host_threads": host_threads}
         V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
         F = np.ascontiguousarray(mesh.faces, dtype=np.int32)
-        computed, t_compute, t_write = 0, 0.0, 0.0
+        computed, t_compute, t_write, t_cpu = 0, 0.0, 0.0, 0.0
         if todo:
             from distributed import as_completed
 
@@ -442,10 +465,11 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                        for b in todo]
             try:
                 for fut in as_completed(futures):
-                    r0, r1, tc, tw = fut.result()
+                    r0, r1, tc, tw, tcpu = fut.result()
                     computed += 1
                     t_compute += tc
                     t_write += tw
+                    t_cpu += tcpu
                     if report:
                         report(r1 - r0)
             except BaseException:
@@ -454,12 +478,14 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         arr.attrs[RUN_ATTR] = {"blocks": n_blocks, "blocks_computed": computed,
                                "blocks_skipped": len(done), "block_rows": block_rows,
                                "task_compute_seconds": t_compute,
-                               "task_write_seconds": t_write}
+                               "task_write_seconds": t_write,
+                               "task_thread_cpu_seconds": t_cpu}
         return arr
     finally:
         if own_cluster is not None:
             client.close()
             own_cluster.close()
+        quiet.close()
 
 
 def symmetrize(store: Any, out: Any, storage_options: Optional[dict] = None) -> Any:
