@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Writes bench/RESULTS.md from bench/results/{peers,allpairs_peers,figures}.json
+"""Writes bench/RESULTS.md from bench/results/{peers,allpairs_peers,figures,scale,
+cluster,compression,plan_1m}.json
 and copies its summary into README.md between the markers
 <!-- bench:begin --> and <!-- bench:end -->. Neither is edited by hand: rerun
 `bash bench/run_all.sh` (or this script on existing JSON).
@@ -291,6 +292,270 @@ def allpairs_table(ap, meshes=None, compact=False):
     return "\n".join(L)
 
 
+# ---------------------------------------------------------------- scale (issue 11)
+def load_json(name):
+    p = bl.RESULTS / name
+    return json.loads(p.read_text()) if p.is_file() else None
+
+
+def fbytes(b):
+    for unit, k in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if b >= k:
+            return f"{b / k:.3g} {unit}"
+    return f"{b:.0f} B"
+
+
+def scale_section(sc):
+    L = ["## Sparse local matrices and landmarks (issue 11)", "",
+         f"**Machine:** {machine_line(sc)}; {sc['threads']} thread(s); "
+         f"`bench/bench_scale.py` → bench/results/scale.json.", "",
+         "Sparse local rows (`max_distance=r`, CSR) on sine surfaces; a row costs what it reaches "
+         "(touched-list reset):", "",
+         "| mesh | vertices | r (mean edges) | rows/s | entries per row "
+         "| vertices settled per row |",
+         "|---|---:|---:|---:|---:|---:|"]
+    for m in sc["sparse_vs_n"]:
+        for r in m["radii"]:
+            L.append(f"| {m['mesh']} | {m['n_vertices']:,} | {r['r_edges']} | "
+                     f"{r['rows_per_s']:,.0f} | {r['nnz_per_row']:.0f} | "
+                     f"{r['vertices_settled_per_row']:.0f} |")
+    lm = sc.get("landmarks")
+    if lm:
+        L += ["", f"Landmarks on {lm['mesh']} ({lm['n_vertices']:,} vertices), "
+              f"{lm['landmarks']} x {lm['landmarks']} (targets = the landmarks; each row stops "
+              "once its targets are settled):", "",
+              "| landmarks | ms per row | vs full rows | vertices settled per row |",
+              "|---|---:|---:|---:|",
+              f"| full rows (reference) | {lm['full_seconds_per_row'] * 1e3:.3g} | 1 | "
+              f"{lm['settled_per_row_full']:,.0f} |",
+              f"| spread at random | {lm['landmark_seconds_per_row'] * 1e3:.3g} | "
+              f"{lm['speedup_per_row']:.2f}x | {lm['settled_per_row_landmarks']:,.0f} |",
+              f"| clustered (the {lm['landmarks']} nearest to one point) | "
+              f"{lm['clustered_seconds_per_row'] * 1e3:.3g} | "
+              f"{lm['clustered_speedup_per_row']:.1f}x | {lm['settled_per_row_clustered']:,.0f} |"]
+    g = sc.get("gdist")
+    if g and "skipped" not in g:
+        L += ["", f"Against `gdist.local_gdist_matrix` on {g['mesh']} ({g['n_vertices']:,} "
+              f"vertices), r = {g['r_edges']} mean edges: meshfmm {g['meshfmm_seconds']:.3g} s, "
+              f"gdist {g['gdist_seconds']:.3g} s ({g['speedup']:.1f}x); "
+              f"{g['meshfmm_entries_per_s'] / 1e6:.3g} vs {g['gdist_entries_per_s'] / 1e6:.3g} "
+              f"M entries/s; sparsity patterns' Jaccard index {g['pattern_jaccard']:.3f}; mean "
+              "relative difference on the pairs both hold "
+              f"{g['mean_rel_diff_common'] * 100:.2f} %."]
+    elif g:
+        L += ["", f"gdist: {g['skipped']}"]
+    return L + [""]
+
+
+def cluster_section(cl, cl12=None, cldef=None):
+    ent = cl["entries"]
+    L = ["## Dask cluster against in-process (issue 11)", "",
+         f"**Machine:** {machine_line(cl)}; load average at the end "
+         f"{', '.join(f'{x:.1f}' for x in cl['load_average'])}. "
+         f"`bench/bench_cluster.py` → bench/results/cluster.json.", "",
+         f"{cl['mesh']}, {cl['rows']:,} x {cl['n_vertices']:,} {cl['dtype']} "
+         f"({ent / 1e6:.1f} M entries): the threads backend with "
+         f"{cl['in_process_threads']} threads "
+         f"in one process (the matrix in memory) against `meshfmm.distributed.distance_matrix` on "
+         f"a LocalCluster of {cl['workers']} processes x {cl['threads_per_worker']} thread writing "
+         f"a Zarr store on local disk ({cl['compression']}, {cl['blocks']} tasks of "
+         f"{cl['block_rows']} rows). Runs alternate; the ratio compares the best run of each "
+         "(the box is shared).", "",
+         "| run | seconds (each run) | best: M entries/s | CPU seconds (each run) |",
+         "|---|---|---:|---|"]
+    for k, name in (("in_process", f"in-process, {cl['in_process_threads']} threads"),
+                    ("cluster", f"cluster, {cl['workers']} x {cl['threads_per_worker']} "
+                                "(client, scheduler, nannies, workers)")):
+        L.append(f"| {name} | {', '.join(f'{s:.2f}' for s in cl['seconds'][k])} | "
+                 f"{cl['entries_per_s'][k] / 1e6:.2f} | "
+                 f"{', '.join(f'{s:.2f}' for s in cl.get('cpu_seconds', {}).get(k, []))} |")
+    verdict = "meets" if cl["cluster_over_in_process"] >= cl["target"] else "misses"
+    tw = [x[:2] for x in cl.get("task_compute_write_cpu_seconds")
+          or cl.get("task_compute_write_seconds") or []]
+    wr = (f" Inside the tasks, writing (encode, CRC-32C, file) took "
+          f"{100 * min(w / c for c, w in tw):.1f}-{100 * max(w / c for c, w in tw):.1f} % of the "
+          "computing time." if tw else "")
+    L += ["", f"Cluster / in-process throughput: **{cl['cluster_over_in_process'] * 100:.1f} %** "
+          f"(best runs; median of adjacent pairs {cl['median_pair_ratio'] * 100:.1f} %; "
+          + (f"CPU seconds in-process / cluster {cl['cpu_ratio'] * 100:.1f} %, which other "
+             "processes' load does not move" if cl.get("cpu_ratio") else "")
+          + f"): {verdict} the {cl['target'] * 100:.0f} % target.{wr} Cluster start "
+          f"{cl['cluster_start_seconds']:.2f} s"
+          + (f"; a cold run (client=None: cluster started inside) "
+             f"{cl['cold_seconds']:.2f} s, {cl['cold_over_in_process'] * 100:.1f} % of the best "
+             "in-process run" if cl.get("cold_seconds") else "")
+          + f". Store {fbytes(cl['store_bytes'])} for {fbytes(cl['raw_bytes'])} raw "
+          f"(ratio {cl['store_ratio']:.3f}); the rows equal the in-process rows bit for bit.", ""]
+    if cl.get("dask_config"):
+        L += ["The cluster runs with `meshfmm.distributed.DASK_CONFIG` (event-loop tick 1 s, "
+              "memory monitor 1 s, system monitor 2 s, no GIL monitor, no statistical profiler; "
+              "what `distance_matrix` gives the LocalCluster it starts): Dask's defaults poll "
+              "every 10-500 ms in the scheduler, each nanny and each worker, which cost an idle "
+              "2-process LocalCluster ~9 % of a core and busy tasks 5-9 % of their CPU here, "
+              "against ~2 % with these settings."
+              + (f" Same job with Dask's defaults: best runs "
+                 f"{cldef['cluster_over_in_process'] * 100:.1f} %, median of pairs "
+                 f"{cldef['median_pair_ratio'] * 100:.1f} %, CPU seconds "
+                 f"{cldef['cpu_ratio'] * 100:.1f} % (bench/results/cluster_dask_defaults.json)."
+                 if cldef else ""), ""]
+    if cl12:
+        L += [f"One worker process of {cl12['threads_per_worker']} threads instead (`dask worker "
+              f"--nworkers 1 --nthreads {cl12['threads_per_worker']}`; one mesh per process), same "
+              f"job: in-process {', '.join(f'{s:.2f}' for s in cl12['seconds']['in_process'])} s, "
+              f"cluster {', '.join(f'{s:.2f}' for s in cl12['seconds']['cluster'])} s: "
+              f"**{cl12['cluster_over_in_process'] * 100:.1f} %** (best runs; median of pairs "
+              f"{cl12['median_pair_ratio'] * 100:.1f} %"
+              + (f"; CPU seconds {cl12['cpu_ratio'] * 100:.1f} %" if cl12.get("cpu_ratio") else "")
+              + ").", ""]
+    return L
+
+
+def compression_section(co):
+    L = ["## Compression of distance matrices (issue 11)", "",
+         f"**Machine:** {machine_line(co)}. `bench/bench_compression.py` → "
+         "bench/results/compression.json.", "",
+         "Rows of real meshes (tests/data/meshes; contiguous sources, as a task writes them), in "
+         f"chunks of the default shape (~{co['chunk_bytes'] >> 20} MiB), Blosc single-threaded "
+         "(as inside a Dask task). Geometric means over "
+         f"{len(co['meshes'])} meshes ({', '.join(m['mesh'] for m in co['meshes'])}); encode and "
+         "decode in MB/s of raw data:", "",
+         "| codec | float32 ratio | float64 ratio | f32 encode | f32 decode | f64 encode | "
+         "f64 decode |", "|---|---:|---:|---:|---:|---:|---:|"]
+    for a, b in zip(co["geomean"]["float32"], co["geomean"]["float64"]):
+        name = a["codec"] + (" (default)" if a["codec"] == "lz4 bitshuffle" else "")
+        L.append(f"| {name} | {a['ratio']:.3f} | {b['ratio']:.3f} | {a['encode_mb_s']:.0f} | "
+                 f"{a['decode_mb_s']:.0f} | {b['encode_mb_s']:.0f} | {b['decode_mb_s']:.0f} |")
+    names = [c["codec"] for c in co["geomean"]["float32"]]
+    pick = [n for n in ("lz4 bitshuffle", "zstd 3 byte shuffle", "zstd 3 bitshuffle")
+            if n in names]
+    L += ["", "Per mesh (float32 / float64 ratio):", "",
+          "| mesh | vertices | rows | " + " | ".join(pick) + " |",
+          "|---|---:|---:|" + "---:|" * len(pick)]
+    for m in co["meshes"]:
+        cells = []
+        for n in pick:
+            i = names.index(n)
+            cells.append(f"{m['float32'][i]['ratio']:.3f} / {m['float64'][i]['ratio']:.3f}")
+        L.append(f"| {m['mesh']} | {m['n_vertices']:,} | {m['rows']} | " + " | ".join(cells) + " |")
+    L += ["", "Distances compress little: the mantissa's low bits are noise, and neighbouring "
+          "columns are neighbouring vertices only as far as the mesh's vertex order is local. "
+          "The default is lz4 + bit shuffle: as small as the former default (zstd 3 + byte "
+          "shuffle) within 1 %, and ~3x faster to encode, which matters because encoding runs on "
+          "every task's critical path; `compression=\"zstd\"` (zstd 3 + bit shuffle) is ~2 % "
+          "smaller again at zstd's speed. `xor_prev_row` (XOR of each row's bits with the previous "
+          "row's) is an idea measured, not offered: readers would need meshfmm's own codec.", ""]
+    return L
+
+
+def plan_section(pl, cl, co):
+    n = pl["n_vertices"]
+    t = pl["seconds_per_row_1_thread"]
+    cores = pl["node_cores"]
+    eff = cl["cluster_over_in_process"] if cl else None
+    eff_used = min(1.0, eff) if eff else 0.9
+    br = pl["block_rows"]
+    tasks = math.ceil(n / br)
+    raw32 = n * n * 4
+    lz, zs = pl["codecs"]["lz4"]["ratio"], pl["codecs"]["zstd"]["ratio"]
+    real = None
+    if co:
+        g = {c["codec"]: c["ratio"] for c in co["geomean"]["float32"]}
+        real = (g.get("lz4 bitshuffle"), g.get("zstd 3 bitshuffle"))
+    core_h = n * t / 3600
+    node_h = core_h / cores / eff_used
+    chunk = br * n * 4
+    mesh_mib = pl["rss_mib"]["after_mesh"] - pl["rss_mib"]["with_v_f"]
+    vf_mib = pl["v_f_bytes"] / 2**20
+    task_mib = 3 * chunk / 2**20  # the block, its encoded copy, zarr's buffer
+    per_proc = pl["dask_worker_idle_rss_mib"] + vf_mib + mesh_mib + task_mib
+    per_node_threads = pl["dask_worker_idle_rss_mib"] + vf_mib + mesh_mib + cores * task_mib
+    sched = tasks * pl["dask_seconds_per_noop_task"]
+    bw = cores * n / t * 4 / lz  # compressed bytes/s a node writes
+    per_task_s = br * t
+    L = ["## Plan: all pairs on a 1M-vertex mesh (issue 11)", "",
+         f"**Machine:** {machine_line(pl)}; load average "
+         f"{', '.join(f'{x:.1f}' for x in pl.get('load_average', []))}. Numbers from "
+         "`bench/plan_1m.py` (bench/results/plan_1m.json), `bench/bench_cluster.py` and "
+         "`bench/bench_compression.py`; refresh with `python bench/plan_1m.py && python "
+         "bench/make_results_md.py --no-readme` (the vertex renumbering of issue 13 changes the "
+         "per-row time, and the ratio of real meshes).", "",
+         "**Measured** (m) on this machine; **extrapolated** (x) from them by the formula "
+         "given.", "",
+         "| quantity | value | m/x | how |", "|---|---|---|---|",
+         f"| mesh | {pl['mesh']}: {n:,} vertices, {pl['n_faces']:,} faces | m | `meshfmm generate "
+         "sine 1000` |",
+         f"| time per row, 1 thread, float32 | {t * 1e3:.0f} ms "
+         f"({n / t / 1e6:.2f} M entries/s) | m "
+         f"| best of {pl.get('repeats', 2)} blocks of {pl['rows_timed']} contiguous rows |",
+         f"| mesh build on a worker | {pl['mesh_build_seconds']:.1f} s, {mesh_mib:.0f} MiB | m | "
+         "`Mesh(V, F)`, resident memory before/after |",
+         f"| compression ratio, float32, this mesh | lz4 {lz:.2f}, zstd {zs:.2f} | m | rows above, "
+         "bit shuffle |"]
+    if real and real[0]:
+        L.append(f"| compression ratio, float32, real meshes | lz4 {real[0]:.2f}, zstd "
+                 f"{real[1]:.2f} | m | geometric mean, tests/data meshes |")
+    if eff:
+        L.append(f"| cluster efficiency | {eff * 100:.1f} % | m | {cl['mesh']}, LocalCluster "
+                 f"{cl['workers']} x {cl['threads_per_worker']} vs in-process (above) |")
+    L += [f"| Dask cost per task | {pl['dask_seconds_per_noop_task'] * 1e3:.2f} ms | m | no-op "
+          "tasks, 2-process LocalCluster |",
+          f"| idle Dask worker process | {pl['dask_worker_idle_rss_mib']:.0f} MiB | m | resident, "
+          "meshfmm and zarr imported |",
+          f"| entries | {n * n:.3e} | x | N² |",
+          f"| store, raw | float32 {fbytes(raw32)}, float64 {fbytes(2 * raw32)} | x | N² x 4 "
+          "(x 8) bytes |",
+          f"| store, compressed (float32, lz4 default) | {fbytes(raw32 / lz)} (this mesh's "
+          f"ratio)" + (f" to {fbytes(raw32 / real[0])} (real meshes' ratio)" if real and real[0]
+                       else "") + " | x | raw / ratio |",
+          f"| store, compressed (float32, zstd) | {fbytes(raw32 / zs)}"
+          + (f" to {fbytes(raw32 / real[1])}" if real and real[1] else "") + " | x | raw / ratio |",
+          f"| chunk shape | ({br}, {n:,}): {fbytes(chunk)} raw | x | `--block-rows {br}` (the "
+          f"default, ~8 MiB chunks, would give {math.ceil(n / max(1, (8 << 20) // (n * 4))):,} "
+          "tasks of 2 rows) |",
+          f"| tasks | {tasks:,} of {per_task_s:.1f} s each | x | N / {br}; {br} x time per row |",
+          f"| scheduler load | {cores / per_task_s:.1f} tasks/s per node; it ran "
+          f"{1 / pl['dask_seconds_per_noop_task']:.0f} no-op tasks/s here: room for "
+          f"~{int(1 / pl['dask_seconds_per_noop_task'] / (cores / per_task_s)):,} nodes "
+          f"({fmt_time(sched)} of scheduler time over the job) | x | {cores} / task time; "
+          "tasks x cost per task |",
+          f"| compute | {core_h:,.0f} core-hours | x | N x time per row |",
+          f"| on {cores}-core nodes | **{node_h:.1f} node-hours**: "
+          + ", ".join(f"{k} node{'s' * (k > 1)} {fmt_time(node_h / k * 3600)}"
+                      for k in (1, 4, 16))
+          + f" | x | core-hours / {cores} / {eff_used * 100:.0f} % efficiency (measured on 2 "
+          "cores; assumed to hold per node) |",
+          f"| memory, 16 processes x 1 thread per node | {per_proc / 1024:.2f} GiB per worker, "
+          f"{cores * per_proc / 1024:.1f} GiB per node | x | idle worker + V, F + mesh + 3 chunks |",
+          f"| memory, 1 process x 16 threads per node | {per_node_threads / 1024:.1f} GiB per node "
+          "| x | one mesh per worker process, shared by its threads |",
+          f"| write bandwidth | {fbytes(bw)}/s per node, compressed | x | {cores} x N / time per "
+          "row x 4 B / ratio |",
+          "", "Steps:", "",
+          "```sh",
+          "export DASK_DISTRIBUTED__ADMIN__TICK__INTERVAL=1s \\",
+          "       DASK_DISTRIBUTED__ADMIN__SYSTEM_MONITOR__INTERVAL=2s \\",
+          "       DASK_DISTRIBUTED__ADMIN__SYSTEM_MONITOR__GIL__ENABLED=False \\",
+          "       DASK_DISTRIBUTED__WORKER__MEMORY__MONITOR_INTERVAL=1s \\",
+          "       DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False  # meshfmm.distributed.DASK_CONFIG",
+          "dask scheduler                                         # head node",
+          "dask worker tcp://HEAD:8786 --nworkers 1 --nthreads 16  # each 16-core node",
+          f"meshfmm allpairs scan.ply -o s3://bucket/D.zarr --scheduler tcp://HEAD:8786 "
+          f"--block-rows {br}",
+          "# interrupted? the same command with --resume: complete chunks (CRC-checked, as tasks",
+          "# on the cluster) are kept, the rest computed",
+          "```", "",
+          "One worker process of 16 threads per node holds one mesh (tasks run the C code without "
+          "the GIL, each with one library thread: meshfmm gives a task cores / Dask threads on its "
+          "host); 16 one-thread processes hold 16. Writing needs the bandwidth above times the "
+          "nodes from the object store or file system. The sine surface's grid order "
+          "compresses better than real meshes' vertex orders, hence the range of store sizes. "
+          "Resuming reads every stored chunk once, "
+          "spread over the cluster's tasks (the verification is a CRC over the whole chunk), so "
+          "a resume of an almost complete job costs about one read of the store. float64 doubles "
+          "the store and the chunk memory, not the compute.", ""]
+    return L
+
+
 # ---------------------------------------------------------------- document
 def exact_start_section():
     """The exact start (issue 12.2), from bench/results/exact_start.json and
@@ -407,6 +672,17 @@ def main():
               "(interpreter and modules). The heat loops are single-threaded, as the peers "
               "ship them; meshfmm threads uses every core, OpenCL runs on the device listed "
               "above.", ""]
+    sc, cl = load_json("scale.json"), load_json("cluster.json")
+    co, pl = load_json("compression.json"), load_json("plan_1m.json")
+    if sc:
+        D += scale_section(sc)
+    if cl:
+        D += cluster_section(cl, load_json("cluster_1x2.json"),
+                             load_json("cluster_dask_defaults.json"))
+    if co:
+        D += compression_section(co)
+    if pl:
+        D += plan_section(pl, cl, co)
     if figs:
         f8 = figs.get("fig8b", {})
         D += ["## Figures", "",

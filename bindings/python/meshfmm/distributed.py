@@ -19,6 +19,7 @@ Needs ``dask[distributed]`` and ``zarr>=3``.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import math
@@ -32,13 +33,45 @@ import numpy as np
 from . import __version__
 from ._mesh import Mesh
 
-__all__ = ["distance_matrix", "job_description", "complete_blocks", "symmetrize"]
+__all__ = ["distance_matrix", "job_description", "complete_blocks", "symmetrize", "DASK_CONFIG"]
 
 JOB_ATTR = "meshfmm_job"
 RUN_ATTR = "meshfmm_last_run"
 # Bytes of one block: large enough that scheduling is noise, small enough
 # that a 2-worker cluster gets many tasks and a lost worker loses little.
 _BLOCK_BYTES = 8 << 20
+# Blosc (cname, clevel) per `compression`, always with bit shuffle: on real
+# meshes' rows (bench/bench_compression.py) lz4 + bit shuffle stores within
+# 0.5 % of zstd 3 + byte shuffle and encodes ~3x faster (the encoding is on
+# each task's critical path); zstd 3 + bit shuffle is ~2 % smaller again.
+_CODECS: Dict[str, Optional[Tuple[str, int]]] = {"lz4": ("lz4", 5), "zstd": ("zstd", 3),
+                                                 "none": None}
+
+
+# Dask settings for long compute-bound tasks. Dask's defaults poll every
+# 10-500 ms (event-loop tick, memory and system monitors, GIL monitor,
+# statistical profiler) in the scheduler, every nanny and every worker: on a
+# 2-core LocalCluster that cost 5-9 % of the tasks' CPU, these ~2 %
+# (bench/bench_cluster.py). distance_matrix's own LocalCluster runs with them;
+# for a cluster of your own, start it inside dask.config.set(DASK_CONFIG), or
+# give `dask scheduler` / `dask worker` the same as DASK_* variables
+# (DASK_DISTRIBUTED__ADMIN__TICK__INTERVAL=1s, ...).
+DASK_CONFIG: Dict[str, Any] = {
+    "distributed.admin.tick.interval": "1s",
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.admin.system-monitor.gil.enabled": False,
+    "distributed.worker.memory.monitor-interval": "1s",
+    "distributed.worker.profile.enabled": False,
+}
+
+
+def _default_block_rows(n_rows: int, row_bytes: int, dask_threads: int) -> int:
+    """Rows per block: at most ~_BLOCK_BYTES a chunk, at least 4 blocks per
+    Dask thread, and a multiple of the threads in blocks of equal rows, so
+    that no thread idles at the end while another runs a last block alone."""
+    max_rows = max(1, _BLOCK_BYTES // row_bytes)
+    per_thread = max(4, math.ceil(n_rows / (dask_threads * max_rows)))
+    return max(1, math.ceil(n_rows / (per_thread * dask_threads)))
 
 
 def _sha256(*arrays: Optional[np.ndarray]) -> Optional[str]:
@@ -115,29 +148,59 @@ def _worker_cache() -> Dict[str, Mesh]:
     return cache
 
 
+def _cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
+def _task_threads(n_threads: int, host_threads: Dict[str, int]) -> int:
+    """Library threads for one task. 0: this worker's share of its machine's
+    cores, cores / (Dask threads of all workers on this host), so that a
+    LocalCluster of one process per core runs one library thread per task
+    (Dask's own rule: its nannies set OMP_NUM_THREADS=1) while a single
+    one-thread worker on a 16-core node still uses all 16 cores."""
+    if n_threads > 0:
+        return n_threads
+    try:
+        from distributed import get_worker
+        from distributed.comm import get_address_host
+
+        w = get_worker()
+    except (ImportError, ValueError):  # run in the client process
+        return 0
+    total = host_threads.get(get_address_host(w.address)) or w.state.nthreads
+    return max(1, _cores() // max(1, total))
+
+
 def _compute_block(key: str, V: np.ndarray, F: np.ndarray, url: str,
                    storage_options: Optional[dict], r0: int, r1: int,
                    src: Optional[np.ndarray], targets: Optional[np.ndarray],
-                   opts: Dict[str, Any]) -> Tuple[int, int, float]:
+                   opts: Dict[str, Any]) -> Tuple[int, int, float, float, float]:
     """One task: rows [r0, r1) into their own chunk. Idempotent: a retry
-    writes the same bytes."""
+    writes the same bytes. Returns r0, r1, the seconds spent computing and
+    writing (encoding included), and the CPU seconds of the task's thread
+    (library threads started beyond it not counted)."""
     import zarr
 
     cache = _worker_cache()
     mesh = cache.get(key)
     if mesh is None:
         mesh = cache[key] = Mesh(V, F)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.thread_time()
     rows_src = np.arange(r0, r1, dtype=np.int32) if src is None else src[r0:r1]
-    kw = dict(backend=opts["backend"], dtype=opts["dtype"], n_threads=opts["n_threads"],
+    kw = dict(backend=opts["backend"], dtype=opts["dtype"],
+              n_threads=_task_threads(opts["n_threads"], opts.get("host_threads") or {}),
               max_distance=opts["max_distance"], unfolding=opts["unfolding"])
     if opts["cost"] is not None:
         kw.update(cost=opts["cost"], cost_location=opts["cost_location"])
     # the library's target columns: each row stops once its targets settle
     rows = mesh.distance_matrix(rows_src, targets=targets, **kw)
+    t1 = time.perf_counter()
     arr = zarr.open_array(url, mode="r+", storage_options=storage_options)
     arr[r0:r1, :] = rows
-    return r0, r1, time.perf_counter() - t0
+    return r0, r1, t1 - t0, time.perf_counter() - t1, time.thread_time() - c0
 
 
 # ------------------------------------------------------------- client side
@@ -150,13 +213,12 @@ def _open_store(store: Any, storage_options: Optional[dict]) -> Tuple[str, Optio
     return url, storage_options
 
 
-def complete_blocks(arr: Any, block_rows: int) -> List[int]:
-    """Indices of the row blocks of `arr` that are complete and verified: the
-    chunk decodes (its CRC-32C matches) and holds no NaN (the fill value of a
-    chunk never written)."""
+def _verified(arr: Any, blocks: Sequence[int], block_rows: int) -> List[int]:
+    """Those of `blocks` whose chunk decodes (its CRC-32C matches) and holds no
+    NaN (a chunk never written reads as the NaN fill value)."""
     n_rows = arr.shape[0]
     done = []
-    for b in range(math.ceil(n_rows / block_rows)):
+    for b in blocks:
         r0, r1 = b * block_rows, min(n_rows, (b + 1) * block_rows)
         try:
             block = arr[r0:r1, :]
@@ -167,25 +229,69 @@ def complete_blocks(arr: Any, block_rows: int) -> List[int]:
     return done
 
 
+def _verify_task(url: str, storage_options: Optional[dict], blocks: List[int],
+                 block_rows: int) -> List[int]:
+    import zarr
+
+    arr = zarr.open_array(url, mode="r", storage_options=storage_options)
+    return _verified(arr, blocks, block_rows)
+
+
+def complete_blocks(arr: Any, block_rows: int) -> List[int]:
+    """Indices of the row blocks of `arr` that are complete and verified: the
+    chunk decodes (its CRC-32C matches) and holds no NaN (the fill value of a
+    chunk never written). Reads the whole array in this process; a resumed
+    ``distance_matrix`` does the same check as tasks on its cluster."""
+    return _verified(arr, range(math.ceil(arr.shape[0] / block_rows)), block_rows)
+
+
+def _complete_blocks_on(client: Any, url: str, storage_options: Optional[dict], n_rows: int,
+                        block_rows: int, dask_threads: int) -> List[int]:
+    """complete_blocks as tasks on the cluster (each reads and checks a share
+    of the chunks), so resuming a big store does not read it all through the
+    client."""
+    n_blocks = math.ceil(n_rows / block_rows)
+    n_tasks = max(1, min(n_blocks, 4 * dask_threads))
+    batches = [list(range(i, n_blocks, n_tasks)) for i in range(n_tasks)]
+    futures = client.map(_verify_task, [url] * n_tasks, [storage_options] * n_tasks, batches,
+                         [block_rows] * n_tasks, pure=False,
+                         key=[f"meshfmm-verify-{i}-{time.time_ns()}" for i in range(n_tasks)])
+    return sorted(b for done in client.gather(futures) for b in done)
+
+
+def _fmt_seconds(s: float) -> str:
+    if not math.isfinite(s):
+        return "?"
+    s = int(round(s))
+    if s < 60:
+        return f"{s} s"
+    if s < 3600:
+        return f"{s // 60} min {s % 60:02d} s"
+    return f"{s // 3600} h {s % 3600 // 60:02d} min"
+
+
 class _Progress:
     """A progress bar on a terminal (rows done, rows/s, time left), plain lines
-    every ~10 % or 30 s when piped."""
+    every ~10 % or 30 s when piped. `done`: rows already complete (a resumed
+    job); they count in rows done, not in the rate."""
 
-    def __init__(self, total: int, stream=None) -> None:
-        self.total, self.done = total, 0
+    def __init__(self, total: int, stream=None, done: int = 0) -> None:
+        self.total, self.done, self.done0 = total, done, done
         self.stream = stream or sys.stderr
         self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
         self.t0 = self.last = time.monotonic()
-        self.last_frac = 0.0
+        self.last_frac = -1.0
 
     def __call__(self, rows: int) -> None:
         self.done += rows
         now = time.monotonic()
-        rate = self.done / max(now - self.t0, 1e-9)
-        left = (self.total - self.done) / rate if rate > 0 else float("inf")
-        frac = self.done / self.total
-        msg = (f"{self.done}/{self.total} rows ({100 * frac:.1f} %), {rate:.1f} rows/s, "
-               f"{left:.0f} s left")
+        new = self.done - self.done0
+        rate = new / (now - self.t0) if new > 0 and now > self.t0 else float("nan")
+        left = (self.total - self.done) / rate if rate > 0 else float("nan")
+        frac = self.done / self.total if self.total else 1.0
+        rate_s = "?" if not math.isfinite(rate) else f"{rate:.1f}"
+        msg = (f"{self.done}/{self.total} rows ({100 * frac:.1f} %), {rate_s} rows/s, "
+               f"{_fmt_seconds(left)} left")
         if self.tty:
             w = 30
             bar = "#" * int(w * frac) + "-" * (w - int(w * frac))
@@ -205,7 +311,7 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                     n_threads: int = 0, max_distance: Optional[float] = None,
                     cost: Any = None, cost_location: Optional[str] = None,
                     unfolding: bool = True, n_workers: Optional[int] = None,
-                    storage_options: Optional[dict] = None, compression: str = "zstd",
+                    storage_options: Optional[dict] = None, compression: str = "lz4",
                     progress: Any = True, retries: int = 3) -> Any:
     """Computes a dense S x N (or S x T) distance matrix as Dask tasks writing
     a Zarr v3 array at `store`, and returns the ``zarr.Array``.
@@ -216,20 +322,24 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         (T,) for the columns, in the given order; None for every vertex.
     client: a ``distributed.Client``; None starts a ``LocalCluster`` of
         `n_workers` processes (default: the machine's cores) with one thread
-        each, and prints its dashboard address.
+        each and the settings of ``DASK_CONFIG``, and prints its dashboard
+        address.
     dtype: "float32" or "float64"; the values equal ``mesh.distance`` per row
         (float64 bit for bit, float32 the same rounding).
     resume: True skips blocks already complete and verified when the store
         holds the same job, and refuses a store holding another job; False
         starts over, overwriting the store.
     block_rows: rows per task and chunk (default: about 8 MiB a chunk, at
-        least 4 tasks a worker).
+        least 4 tasks per Dask thread of the cluster).
     backend, n_threads: the in-process backend each task runs ("threads",
-        "serial", "opencl", "auto") and its threads (0: all cores of the
-        worker; a LocalCluster's workers get 1).
+        "serial", "opencl", "auto") and its threads (0: the worker's share of
+        its machine, cores / Dask threads on that host, so a LocalCluster of
+        one 1-thread process per core runs 1 library thread per task).
     max_distance, cost, cost_location, unfolding: as in ``Mesh.distance``.
-    compression: "zstd" (Blosc zstd with byte shuffle, the default) or
-        "none"; chunks always carry a CRC-32C.
+    compression: "lz4" (Blosc lz4 with bit shuffle, the default), "zstd"
+        (Blosc zstd level 3 with bit shuffle: ~2 % smaller, ~3x slower to
+        encode) or "none"; chunks always carry a CRC-32C. Measured on real
+        meshes' rows by bench/bench_compression.py (bench/RESULTS.md).
     progress: True for a progress bar on a terminal (plain lines when piped),
         False for none, or a callable ``progress(rows_done, n_rows)``; an
         exception it raises stops the job (blocks in flight still finish).
@@ -237,7 +347,8 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         rescheduled by Dask regardless).
 
     The attribute ``meshfmm_last_run`` of the returned array records how many
-    blocks this call computed and skipped.
+    blocks this call computed and skipped, and the task seconds spent
+    computing and writing (encoding included), summed over the tasks.
     """
     import zarr
     from zarr.codecs import BloscCodec, BloscShuffle, Crc32cCodec
@@ -256,8 +367,9 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         if not (float(max_distance) >= 0.0):
             raise ValueError(f"max_distance must be >= 0, not {max_distance}")
     cost_arr = None if cost is None else np.ascontiguousarray(cost, dtype=np.float64)
-    if compression not in ("zstd", "none"):
-        raise ValueError(f"compression must be 'zstd' or 'none', not {compression!r}")
+    if compression not in _CODECS:
+        raise ValueError(f"compression must be one of {', '.join(map(repr, _CODECS))}, "
+                         f"not {compression!r}")
     if backend not in ("auto", "threads", "serial", "opencl"):
         raise ValueError(f"backend must be auto, threads, serial or opencl, not {backend!r}")
     url, storage_options = _open_store(store, storage_options)
@@ -267,10 +379,13 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                           unfolding)
 
     own_cluster = None
+    quiet = contextlib.ExitStack()
     if client is None:
+        import dask
         from distributed import Client, LocalCluster
 
         workers = n_workers or os.cpu_count() or 1
+        quiet.enter_context(dask.config.set(DASK_CONFIG))
         own_cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                    dashboard_address=":0")
         client = Client(own_cluster)
@@ -278,7 +393,11 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         if progress and link:
             print(f"meshfmm: Dask dashboard at {link}", file=sys.stderr)
     try:
-        n_workers_now = max(1, len(client.scheduler_info().get("workers", {})))
+        host_threads: Dict[str, int] = {}
+        for w in client.scheduler_info().get("workers", {}).values():
+            host = w.get("host", "")
+            host_threads[host] = host_threads.get(host, 0) + int(w.get("nthreads", 1))
+        dask_threads = max(1, sum(host_threads.values()))
         arr = None
         if resume:
             try:
@@ -295,15 +414,14 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                         "to overwrite it")
         if arr is None:
             if block_rows is None:
-                per_row = n_cols * dt.itemsize
-                block_rows = max(1, min(_BLOCK_BYTES // per_row,
-                                        math.ceil(n_rows / (4 * n_workers_now))))
+                block_rows = _default_block_rows(n_rows, n_cols * dt.itemsize, dask_threads)
             if int(block_rows) < 1:
                 raise ValueError(f"block_rows must be >= 1, not {block_rows}")
             compressors = [Crc32cCodec()]
-            if compression == "zstd":
-                compressors.insert(0, BloscCodec(cname="zstd", clevel=3,
-                                                 shuffle=BloscShuffle.shuffle,
+            if _CODECS[compression] is not None:
+                cname, clevel = _CODECS[compression]
+                compressors.insert(0, BloscCodec(cname=cname, clevel=clevel,
+                                                 shuffle=BloscShuffle.bitshuffle,
                                                  typesize=dt.itemsize))
             arr = zarr.create_array(url, shape=(n_rows, n_cols), chunks=(int(block_rows), n_cols),
                                     dtype=dt, fill_value=np.nan, compressors=compressors,
@@ -311,13 +429,15 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                                     storage_options=storage_options)
         block_rows = int(arr.chunks[0])
         n_blocks = math.ceil(n_rows / block_rows)
-        done = set(complete_blocks(arr, block_rows)) if resume else set()
+        done = (set(_complete_blocks_on(client, url, storage_options, n_rows, block_rows,
+                                        dask_threads)) if resume else set())
         todo = [b for b in range(n_blocks) if b not in done]
 
         report: Optional[Callable[[int], None]] = None
         if progress is True:
-            bar = _Progress(n_rows)
-            bar(sum(min(n_rows, (b + 1) * block_rows) - b * block_rows for b in done))
+            bar = _Progress(n_rows, done=sum(min(n_rows, (b + 1) * block_rows) - b * block_rows
+                                             for b in done))
+            bar(0)
             report = bar
         elif callable(progress):
             rows_done = [sum(min(n_rows, (b + 1) * block_rows) - b * block_rows for b in done)]
@@ -328,10 +448,10 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
 
         opts = {"backend": backend, "dtype": dt.name, "max_distance": max_distance,
                 "unfolding": unfolding, "cost": cost_arr, "cost_location": cost_location,
-                "n_threads": n_threads}
+                "n_threads": n_threads, "host_threads": host_threads}
         V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
         F = np.ascontiguousarray(mesh.faces, dtype=np.int32)
-        computed = 0
+        computed, t_compute, t_write, t_cpu = 0, 0.0, 0.0, 0.0
         if todo:
             from distributed import as_completed
 
@@ -345,20 +465,27 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                        for b in todo]
             try:
                 for fut in as_completed(futures):
-                    r0, r1, _ = fut.result()
+                    r0, r1, tc, tw, tcpu = fut.result()
                     computed += 1
+                    t_compute += tc
+                    t_write += tw
+                    t_cpu += tcpu
                     if report:
                         report(r1 - r0)
             except BaseException:
                 client.cancel(futures)
                 raise
         arr.attrs[RUN_ATTR] = {"blocks": n_blocks, "blocks_computed": computed,
-                               "blocks_skipped": len(done), "block_rows": block_rows}
+                               "blocks_skipped": len(done), "block_rows": block_rows,
+                               "task_compute_seconds": t_compute,
+                               "task_write_seconds": t_write,
+                               "task_thread_cpu_seconds": t_cpu}
         return arr
     finally:
         if own_cluster is not None:
             client.close()
             own_cluster.close()
+        quiet.close()
 
 
 def symmetrize(store: Any, out: Any, storage_options: Optional[dict] = None) -> Any:
@@ -411,6 +538,8 @@ def cli_allpairs_zarr(argv: Sequence[str]) -> int:
     ap.add_argument("--cost", help="per-vertex or per-face cost (.npy or .txt)")
     ap.add_argument("--backend", choices=["threads", "serial", "opencl", "auto"], default="threads")
     ap.add_argument("--block-rows", type=int)
+    ap.add_argument("--compression", choices=list(_CODECS), default="lz4",
+                    help="Blosc lz4 or zstd (bit shuffle), or none (default: lz4)")
     ap.add_argument("--no-progress", action="store_true")
     a = ap.parse_args(list(argv))
     try:
@@ -427,10 +556,14 @@ def cli_allpairs_zarr(argv: Sequence[str]) -> int:
             from distributed import Client
 
             client = Client(a.scheduler)
+            link = getattr(client, "dashboard_link", None)
+            if link and not a.no_progress:
+                print(f"meshfmm: Dask dashboard at {link}", file=sys.stderr)
         Z = distance_matrix(mesh, a.output, sources=src, targets=tgt, client=client,
                             dtype=a.dtype, resume=a.resume, block_rows=a.block_rows,
                             backend=a.backend, max_distance=a.max_distance, cost=cost,
-                            n_workers=a.workers, progress=not a.no_progress)
+                            n_workers=a.workers, progress=not a.no_progress,
+                            compression=a.compression)
         run = Z.attrs.get(RUN_ATTR, {})
         print(f"meshfmm: wrote {Z.shape[0]} x {Z.shape[1]} {Z.dtype} to {a.output} "
               f"({run.get('blocks_computed')} blocks computed, {run.get('blocks_skipped')} "
