@@ -339,3 +339,46 @@ def test_own_local_cluster_runs_with_the_quiet_dask_settings(hand, serial64, tmp
     assert seen == md.DASK_CONFIG
     # and the settings do not leak into the caller's configuration
     assert dask.config.get("distributed.admin.tick.interval") != "1s"
+
+
+def test_a_fresh_store_is_not_verified_and_a_resumed_one_is(hand, client, tmp_path,
+                                                            monkeypatch):
+    # verifying reads every chunk: worth it on resume, waste on a store just created
+    calls = []
+    real = md._complete_blocks_on
+
+    def spy(*args):
+        calls.append(args)
+        return real(*args)
+
+    monkeypatch.setattr(md, "_complete_blocks_on", spy)
+    store = str(tmp_path / "f.zarr")
+    md.distance_matrix(hand, store, sources=SOURCES, client=client, progress=False)
+    assert calls == []
+    Z = md.distance_matrix(hand, store, sources=SOURCES, client=client, progress=False)
+    assert len(calls) == 1 and Z.attrs[md.RUN_ATTR]["blocks_computed"] == 0
+
+
+def test_settings_do_not_leak_when_the_cluster_fails_to_start(hand, tmp_path, monkeypatch):
+    import dask
+    import distributed
+
+    before = dask.config.get("distributed.admin.tick.interval")
+
+    def broken(*args, **kw):
+        raise RuntimeError("no cluster today")
+
+    monkeypatch.setattr(distributed, "LocalCluster", broken)
+    with pytest.raises(RuntimeError, match="no cluster"):
+        md.distance_matrix(hand, str(tmp_path / "n.zarr"), client=None, progress=False)
+    assert dask.config.get("distributed.admin.tick.interval") == before
+
+
+def test_back_to_back_jobs_on_one_mesh_and_client(hand, serial64, client, tmp_path):
+    # each job scatters V and F; scattered by content hash, the second job got
+    # the keys the first job's futures were releasing and lost them ("lost
+    # dependencies": a failed or hung job)
+    for k in range(8):
+        Z = md.distance_matrix(hand, str(tmp_path / f"b{k}.zarr"), sources=SOURCES[:24],
+                               client=client, dtype="float64", block_rows=4, progress=False)
+        assert np.array_equal(Z[:], serial64[:24])

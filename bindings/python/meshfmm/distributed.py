@@ -347,8 +347,9 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         rescheduled by Dask regardless).
 
     The attribute ``meshfmm_last_run`` of the returned array records how many
-    blocks this call computed and skipped, and the task seconds spent
-    computing and writing (encoding included), summed over the tasks.
+    blocks this call computed and skipped, the task seconds spent computing
+    and writing (encoding included) and the CPU seconds of the tasks' threads,
+    summed over the tasks.
     """
     import zarr
     from zarr.codecs import BloscCodec, BloscShuffle, Crc32cCodec
@@ -386,9 +387,15 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
 
         workers = n_workers or os.cpu_count() or 1
         quiet.enter_context(dask.config.set(DASK_CONFIG))
-        own_cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=":0")
-        client = Client(own_cluster)
+        try:
+            own_cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                       dashboard_address=":0")
+            client = Client(own_cluster)
+        except BaseException:
+            if own_cluster is not None:
+                own_cluster.close()
+            quiet.close()  # the settings never outlive the call
+            raise
         link = getattr(own_cluster, "dashboard_link", None)
         if progress and link:
             print(f"meshfmm: Dask dashboard at {link}", file=sys.stderr)
@@ -399,6 +406,7 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
             host_threads[host] = host_threads.get(host, 0) + int(w.get("nthreads", 1))
         dask_threads = max(1, sum(host_threads.values()))
         arr = None
+        fresh = False
         if resume:
             try:
                 arr = zarr.open_array(url, mode="r+", storage_options=storage_options)
@@ -423,14 +431,16 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                 compressors.insert(0, BloscCodec(cname=cname, clevel=clevel,
                                                  shuffle=BloscShuffle.bitshuffle,
                                                  typesize=dt.itemsize))
+            fresh = True
             arr = zarr.create_array(url, shape=(n_rows, n_cols), chunks=(int(block_rows), n_cols),
                                     dtype=dt, fill_value=np.nan, compressors=compressors,
                                     attributes={JOB_ATTR: job}, overwrite=True,
                                     storage_options=storage_options)
         block_rows = int(arr.chunks[0])
         n_blocks = math.ceil(n_rows / block_rows)
+        # a store just created holds nothing to verify
         done = (set(_complete_blocks_on(client, url, storage_options, n_rows, block_rows,
-                                        dask_threads)) if resume else set())
+                                        dask_threads)) if resume and not fresh else set())
         todo = [b for b in range(n_blocks) if b not in done]
 
         report: Optional[Callable[[int], None]] = None
@@ -455,8 +465,13 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         if todo:
             from distributed import as_completed
 
-            V_f, F_f = client.scatter([V, F], broadcast=True)
-            src_f = client.scatter(src, broadcast=True) if src is not None else None
+            # hash=False: keys of this call alone. Scattered by content hash, a
+            # second job on the same mesh reused the keys the first job's
+            # futures were releasing, and the scheduler lost them under the new
+            # tasks ("lost dependencies": the job failed, or hung)
+            V_f, F_f = client.scatter([V, F], broadcast=True, hash=False)
+            src_f = (client.scatter(src, broadcast=True, hash=False) if src is not None
+                     else None)
             key = job["mesh_sha256"]
             futures = [client.submit(_compute_block, key, V_f, F_f, url, storage_options,
                                      b * block_rows, min(n_rows, (b + 1) * block_rows),
