@@ -17,23 +17,11 @@
 #include <string.h>
 
 #include "meshfmm.h"
+#include "byte_reader.h"
 #include "core/order.h"
 #include "exact/exact.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
-
-typedef struct reader {
-    const uint8_t *p;
-    size_t n;
-} reader;
-
-static uint8_t next(reader *r)
-{
-    if (r->n == 0)
-        return 0;
-    r->n--;
-    return *r->p++;
-}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {

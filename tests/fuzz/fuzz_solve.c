@@ -20,21 +20,9 @@
 #include <string.h>
 
 #include "meshfmm.h"
+#include "byte_reader.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
-
-typedef struct reader {
-    const uint8_t *p;
-    size_t n;
-} reader;
-
-static uint8_t next(reader *r)
-{
-    if (r->n == 0)
-        return 0;
-    r->n--;
-    return *r->p++;
-}
 
 static void check_row(const double *row, int32_t nv)
 {
