@@ -436,7 +436,7 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
     }
     /* renumbered: coordinates in internal order, face corners' ids mapped */
-    if (mfmm_order_build(vertices, nv, faces, nf, &m->to_internal, &m->to_external) != MFMM_OK) {
+    if (mfmm_order_build(vertices, nv, &m->to_internal, &m->to_external) != MFMM_OK) {
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
     }

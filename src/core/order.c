@@ -8,8 +8,9 @@
 #include "order.h"
 
 /* MFMM_VERTEX_ORDER, for A/B runs: 1 Morton cells, rows inside (default),
- * 4 Morton at full resolution, 2 Hilbert, 3 breadth-first from the Morton
- * order, 0 the input order. Measured (bench_solve, solve ms, one run each,
+ * 0 the input order. Variants measured and removed: 4 Morton at full
+ * resolution, 2 Hilbert (Skilling 2004; 1M 227 ms, 125k 29.6-30.5 ms), 3
+ * breadth-first from the Morton order. Measured (bench_solve, solve ms, one run each,
  * shared machine; input / 4 / 3 / 1): 1M sine 250-279 / 208-222 / 250 /
  * 195-196; 125k sine 19.2-21.5 / 23.6-25.6 / 21.8-22.0 / 22.7-22.8 (a
  * generated grid's row-major order is already good at that size); igea
@@ -47,90 +48,8 @@ static uint64_t spread3(uint64_t x)
     return x;
 }
 
-/* Hilbert key of 21-bit coordinates x[3] (J. Skilling, "Programming the
- * Hilbert curve", AIP Conf. Proc. 707, 2004: axes to transpose, then the
- * bits interleaved as Morton's). */
-static uint64_t hilbert3(uint32_t x[3])
-{
-    const uint32_t top = 1u << 20;
-    for (uint32_t q = top; q > 1; q >>= 1) { /* inverse undo */
-        uint32_t p = q - 1;
-        for (int i = 0; i < 3; i++) {
-            if (x[i] & q) {
-                x[0] ^= p;
-            } else {
-                uint32_t t = (x[0] ^ x[i]) & p;
-                x[0] ^= t;
-                x[i] ^= t;
-            }
-        }
-    }
-    for (int i = 1; i < 3; i++) /* Gray encode */
-        x[i] ^= x[i - 1];
-    uint32_t t = 0;
-    for (uint32_t q = top; q > 1; q >>= 1)
-        if (x[2] & q)
-            t ^= q - 1;
-    for (int i = 0; i < 3; i++)
-        x[i] ^= t;
-    return spread3(x[2]) | spread3(x[1]) << 1 | spread3(x[0]) << 2;
-}
-
-/* Breadth-first over the faces' edges from the curve order's vertices in
- * turn (ex: the curve order, replaced by the BFS order). */
-static mfmm_status bfs_reorder(int32_t nv, const int32_t *faces, int32_t nf, int32_t *ex)
-{
-    size_t nc = 3 * (size_t)nf;
-    int32_t *off = calloc((size_t)nv + 1, sizeof *off);
-    int32_t *vf = malloc((nc ? nc : 1) * sizeof *vf);
-    int32_t *out = malloc((size_t)nv * sizeof *out);
-    unsigned char *seen = calloc((size_t)nv, 1);
-    if (!off || !vf || !out || !seen) {
-        free(off);
-        free(vf);
-        free(out);
-        free(seen);
-        return MFMM_ERR_OUT_OF_MEMORY;
-    }
-    for (size_t c = 0; c < nc; c++)
-        off[faces[c] + 1]++;
-    for (int32_t v = 0; v < nv; v++)
-        off[v + 1] += off[v];
-    for (size_t c = 0; c < nc; c++)
-        vf[off[faces[c]]++] = (int32_t)c;
-    for (int32_t v = nv; v > 0; v--)
-        off[v] = off[v - 1];
-    off[0] = 0;
-    int32_t head = 0, tail = 0;
-    for (int32_t i = 0; i < nv; i++) {
-        if (seen[ex[i]])
-            continue;
-        seen[ex[i]] = 1;
-        out[tail++] = ex[i];
-        while (head < tail) {
-            int32_t v = out[head++];
-            for (int32_t j = off[v]; j < off[v + 1]; j++) {
-                int32_t f = vf[j] / 3, k = vf[j] % 3;
-                for (int t = 1; t < 3; t++) {
-                    int32_t w = faces[3 * f + (k + t) % 3];
-                    if (!seen[w]) {
-                        seen[w] = 1;
-                        out[tail++] = w;
-                    }
-                }
-            }
-        }
-    }
-    memcpy(ex, out, (size_t)nv * sizeof *ex);
-    free(off);
-    free(vf);
-    free(out);
-    free(seen);
-    return MFMM_OK;
-}
-
-mfmm_status mfmm_order_build(const double *xyz, int32_t nv, const int32_t *faces, int32_t nf,
-                             int32_t **to_internal, int32_t **to_external)
+mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_internal,
+                             int32_t **to_external)
 {
     int32_t *in = malloc((size_t)nv * sizeof *in);
     int32_t *ex = malloc((size_t)nv * sizeof *ex);
@@ -159,13 +78,10 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, const int32_t *faces
          * level L) along the curve; inside a cell, rows by position (rows
          * beat the curve's own order at that scale: 125k sine 22.8 vs 23.8
          * ms; 1M 196 vs 212 ms) */
-        int shift = 0;
-        if (MFMM_VERTEX_ORDER == 1) {
-            int L = 0;
-            while (L < 21 && ((double)nv / 64.0) > (double)(1u << L) * (double)(1u << L))
-                L++;
-            shift = 21 - L;
-        }
+        int L = 0;
+        while (L < 21 && ((double)nv / 64.0) > (double)(1u << L) * (double)(1u << L))
+            L++;
+        int shift = 21 - L;
         for (int32_t v = 0; v < nv; v++) {
             uint32_t u[3];
             for (int k = 0; k < 3; k++) {
@@ -175,21 +91,13 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, const int32_t *faces
             keys[v].fine = (uint64_t)u[1] << 42 | (uint64_t)u[0] << 21 | u[2];
             for (int k = 0; k < 3; k++)
                 u[k] >>= shift;
-            uint64_t key = MFMM_VERTEX_ORDER == 2
-                               ? hilbert3(u)
-                               : spread3(u[0]) | spread3(u[1]) << 1 | spread3(u[2]) << 2;
-            keys[v].key = key;
+            keys[v].key = spread3(u[0]) | spread3(u[1]) << 1 | spread3(u[2]) << 2;
             keys[v].id = v;
         }
         qsort(keys, (size_t)nv, sizeof *keys, order_key_cmp);
         for (int32_t i = 0; i < nv; i++)
             ex[i] = keys[i].id;
         free(keys);
-        if (MFMM_VERTEX_ORDER == 3 && bfs_reorder(nv, faces, nf, ex) != MFMM_OK) {
-            free(in);
-            free(ex);
-            return MFMM_ERR_OUT_OF_MEMORY;
-        }
     }
     for (int32_t i = 0; i < nv; i++)
         in[ex[i]] = i;

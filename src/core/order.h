@@ -14,8 +14,8 @@
  * input ids in internal order, *to_internal (nv,) is its inverse (both
  * malloc'd). Deterministic: a function of the coordinates and the input
  * ids only. MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
-mfmm_status mfmm_order_build(const double *xyz, int32_t nv, const int32_t *faces, int32_t nf,
-                             int32_t **to_internal, int32_t **to_external);
+mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_internal,
+                             int32_t **to_external);
 
 /* Internal id of input vertex v (checked to be in range). */
 static inline int32_t mfmm_vertex_in(const mfmm_mesh *mesh, int32_t v)
