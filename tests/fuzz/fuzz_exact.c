@@ -31,10 +31,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     double radius = (double)(next(&r) % 32) / 8.0;
     double V[66 * 3];
     int32_t F[128 * 3];
-    for (int32_t i = 0; i < 3 * nv; i++)
-        V[i] = (double)(int8_t)next(&r) / 8.0;
-    for (int32_t i = 0; i < 3 * nf; i++)
-        F[i] = next(&r) % nv;
+    read_mesh(&r, nv, nf, V, F);
     mfmm_mesh *mesh = NULL;
     mfmm_error err;
     if (mfmm_mesh_create(V, nv, F, nf, NULL, &mesh, &err) != MFMM_OK)
