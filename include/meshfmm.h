@@ -403,7 +403,8 @@ MFMM_API mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distan
 /* --------------------------------------------------------- matrix (rows) */
 
 typedef enum mfmm_backend {
-    MFMM_BACKEND_AUTO = 0,   /* OpenCL when a device is usable, else threads */
+    MFMM_BACKEND_AUTO = 0,   /* OpenCL on a usable device that is not a CPU (or that the
+                                caller named), else threads */
     MFMM_BACKEND_SERIAL = 1, /* one solver, this thread */
     MFMM_BACKEND_THREADS = 2,/* one serial solver per thread */
     MFMM_BACKEND_OPENCL = 3  /* many sources at once on an OpenCL device */
@@ -550,7 +551,10 @@ MFMM_API void mfmm_matrix_options_init(mfmm_matrix_options *options);
  * With backend AUTO, threads run instead of OpenCL when OpenCL fails (from the
  * first row not yet delivered), and when OpenCL could not keep every compute
  * unit busy (a batch of rows smaller than the device's compute units within
- * memory_limit); options->backend_used tells which ran and
+ * memory_limit), and when the device is a CPU that the caller did not name
+ * (mfmm_opencl_options.device or MESHFMM_OPENCL_DEVICE): on the same cores
+ * the threads backend runs the same rows faster (README, "Command line");
+ * options->backend_used tells which ran and
  * options->fallback_reason why. OpenCL: the device and program cache are
  * options->opencl's, else options->opencl_options' (see
  * mfmm_opencl_options). A batch holds at least one row per compute unit

@@ -133,6 +133,8 @@ typedef struct ocl {
     char name[256];
     cl_ulong global_mem, max_alloc;
     cl_uint compute_units;
+    int cpu;   /* the device is a CPU (PoCL's, say) */
+    int named; /* the caller named it (option or MESHFMM_OPENCL_DEVICE) */
 } ocl;
 
 static void device_string(const ocl *cl, cl_device_info what, char *buf, size_t n)
@@ -227,6 +229,11 @@ static mfmm_status select_device(ocl *cl, const char *want, mfmm_error *err)
     }
     cl->device = devs[pick];
     device_string(cl, CL_DEVICE_NAME, cl->name, sizeof cl->name);
+    cl_device_type type = 0;
+    cl->cpu = api->clGetDeviceInfo(cl->device, CL_DEVICE_TYPE, sizeof type, &type, NULL) ==
+                  CL_SUCCESS &&
+              (type & CL_DEVICE_TYPE_CPU) != 0;
+    cl->named = want && *want;
     cl_device_fp_config fp64 = 0;
     if (api->clGetDeviceInfo(cl->device, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof fp64, &fp64, NULL) !=
             CL_SUCCESS ||
@@ -594,9 +601,27 @@ static void ocl_release(ocl *cl)
 }
 
 /* Device, context and built program. */
-static mfmm_status ocl_open(ocl *cl, const mfmm_opencl_options *o, mfmm_error *err)
+/* Under auto: a CPU device the caller did not name is left to the threads
+ * backend, which runs the same rows on the same cores faster (issue 13.4:
+ * camelhead 2000 rows, wall 0.86-0.93x of OpenCL's; README "Command line"). */
+static mfmm_status auto_refuses(const ocl *cl, const mfmm_rows_job *job, mfmm_error *err)
+{
+    if (!job->full_batches || !cl->cpu || cl->named)
+        return MFMM_OK;
+    return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1,
+                     "OpenCL device '%s' is a CPU, where the threads backend runs the same rows "
+                     "faster (name the device or ask for opencl to use it)",
+                     cl->name);
+}
+
+/* Opens device, context and program; job: a job under auto (the device may
+ * be refused before anything is built), or NULL. */
+static mfmm_status ocl_open(ocl *cl, const mfmm_opencl_options *o, const mfmm_rows_job *job,
+                            mfmm_error *err)
 {
     mfmm_status st = select_device(cl, o ? o->device : NULL, err);
+    if (st == MFMM_OK && job)
+        st = auto_refuses(cl, job, err);
     if (st != MFMM_OK)
         return st;
     cl_int e;
@@ -626,8 +651,8 @@ struct mfmm_opencl_context {
     ocl cl;          /* device, context, program; no queue or kernel */
 };
 
-mfmm_status mfmm_opencl_context_create(const mfmm_opencl_options *options,
-                                       mfmm_opencl_context **out, mfmm_error *err)
+static mfmm_status context_create(const mfmm_opencl_options *options, const mfmm_rows_job *job,
+                                  mfmm_opencl_context **out, mfmm_error *err)
 {
     mfmm_status st = check_create_args(options, out, err);
     if (st != MFMM_OK)
@@ -641,13 +666,19 @@ mfmm_status mfmm_opencl_context_create(const mfmm_opencl_options *options,
         return st;
     }
     ctx->cl.api = &ctx->api;
-    st = ocl_open(&ctx->cl, options, err);
+    st = ocl_open(&ctx->cl, options, job, err);
     if (st != MFMM_OK) {
         mfmm_opencl_context_destroy(ctx);
         return st;
     }
     *out = ctx;
     return MFMM_OK;
+}
+
+mfmm_status mfmm_opencl_context_create(const mfmm_opencl_options *options,
+                                       mfmm_opencl_context **out, mfmm_error *err)
+{
+    return context_create(options, NULL, out, err);
 }
 
 void mfmm_opencl_context_destroy(mfmm_opencl_context *context)
@@ -1103,10 +1134,12 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
         return MFMM_OK;
     mfmm_opencl_context *own = NULL, *ctx = job->opt->opencl;
     if (!ctx) {
-        mfmm_status cs = mfmm_opencl_context_create(job->opt->opencl_options, &own, err);
+        mfmm_status cs = context_create(job->opt->opencl_options, job, &own, err);
         if (cs != MFMM_OK)
             return cs;
         ctx = own;
+    } else if (auto_refuses(&ctx->cl, job, err) != MFMM_OK) {
+        return MFMM_ERR_NO_OPENCL;
     }
     mfmm_status st = run_rows(&ctx->cl, job, start, rows_done, err);
     mfmm_opencl_context_destroy(own);

@@ -25,6 +25,20 @@
 static char cache_dir[64] = "/tmp/mfmm_clcache_XXXXXX";
 static int have_device = -1;
 
+/* Whether the default OpenCL device is a CPU (PoCL names its CPU devices
+ * "pthread-..." or "cpu-..."): auto leaves such a device to threads. */
+static int device_is_cpu(void)
+{
+    mfmm_opencl_context *ctx = NULL;
+    mfmm_error err;
+    if (mfmm_opencl_context_create(NULL, &ctx, &err) != MFMM_OK)
+        return 0;
+    const char *name = mfmm_opencl_context_device_name(ctx);
+    int cpu = strncmp(name, "pthread", 7) == 0 || strncmp(name, "cpu", 3) == 0;
+    mfmm_opencl_context_destroy(ctx);
+    return cpu;
+}
+
 /* OpenCL rows (into out, or by callback with a small memory limit: many
  * batches) compared with ref. Returns 0 when there is no device (skip). */
 static int check_opencl(const mfmm_mesh *mesh, const int32_t *src, int32_t n, const double *ref,
@@ -455,8 +469,9 @@ static void test_cache_altered_entries(void **state)
         free(key2);
         free(bin2);
     }
-    /* auto runs OpenCL on an altered entry too */
+    /* auto runs OpenCL on an altered entry too (a CPU device, named) */
     write_entry(path, key, klen, flipped, n, 0);
+    setenv("MESHFMM_OPENCL_DEVICE", "0", 1);
     double *out = malloc(6 * (size_t)g.nv * sizeof *out);
     assert_non_null(out);
     mfmm_matrix_options o;
@@ -465,6 +480,7 @@ static void test_cache_altered_entries(void **state)
     o.out = out;
     mfmm_error err;
     assert_int_equal(mfmm_distance_matrix(mesh, src, 6, &o, &err), MFMM_OK);
+    unsetenv("MESHFMM_OPENCL_DEVICE");
     assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL);
     assert_memory_equal(out, ref, 6 * (size_t)g.nv * sizeof *out);
     free(out);
@@ -494,7 +510,8 @@ static int first_batch(void *user, int32_t first, int32_t n, const void *rows)
  * mesh above ~227k vertices (37 bytes per vertex and row), and OpenCL ran on
  * one core. A batch now holds a row per compute unit (this machine's cores,
  * on PoCL); and auto runs threads, saying why, when memory_limit keeps
- * OpenCL from filling every compute unit. */
+ * OpenCL from filling every compute unit, or when the device is a CPU the
+ * caller did not name (threads run the same rows faster there). */
 static void test_batches_fill_compute_units(void **state)
 {
     (void)state;
@@ -528,6 +545,14 @@ static void test_batches_fill_compute_units(void **state)
     mfmm_matrix_options_init(&o);
     o.dtype = MFMM_FLOAT64;
     o.out = out;
+    int cpu = device_is_cpu();
+    if (cpu) { /* a CPU device, not named: threads, saying why */
+        assert_int_equal(mfmm_distance_matrix(mesh, src, 2, &o, &err), MFMM_OK);
+        assert_int_equal(o.backend_used, MFMM_BACKEND_THREADS);
+        assert_non_null(strstr(o.fallback_reason, "is a CPU"));
+        assert_memory_equal(out, ref, 2 * (size_t)nv * sizeof *out);
+        setenv("MESHFMM_OPENCL_DEVICE", "0", 1); /* named: auto may take it */
+    }
     o.memory_limit = (size_t)nv * 40; /* one row at a time */
     assert_int_equal(mfmm_distance_matrix(mesh, src, 2, &o, &err), MFMM_OK);
     assert_int_equal(o.backend_used, MFMM_BACKEND_THREADS);
@@ -538,6 +563,7 @@ static void test_batches_fill_compute_units(void **state)
     assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL);
     assert_string_equal(o.fallback_reason, "");
     assert_memory_equal(out, ref, 2 * (size_t)nv * sizeof *out);
+    unsetenv("MESHFMM_OPENCL_DEVICE");
     free(out);
     free(ref);
     mfmm_mesh_destroy(mesh);
@@ -697,6 +723,10 @@ static void test_device_selection_and_cancel(void **state)
     assert_int_equal(o.backend_used, MFMM_BACKEND_THREADS);
     unsetenv("MESHFMM_OPENCL_DEVICE");
     assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &err), MFMM_OK);
+    assert_int_equal(o.backend_used,
+                     device_is_cpu() ? MFMM_BACKEND_THREADS : MFMM_BACKEND_OPENCL);
+    setenv("MESHFMM_OPENCL_DEVICE", "0", 1); /* named: auto takes it */
+    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &err), MFMM_OK);
     assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL);
 
     /* cancel after the second batch */
@@ -707,6 +737,7 @@ static void test_device_selection_and_cancel(void **state)
     o.memory_limit = (size_t)nv * 60 * 4; /* a few rows per batch */
     assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &err), MFMM_ERR_CANCELLED);
     assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL); /* no fallback after a cancel */
+    unsetenv("MESHFMM_OPENCL_DEVICE");
     assert_int_equal(c.calls, 2);
     assert_true(c.next < nv);
     free(out);

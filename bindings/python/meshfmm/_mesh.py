@@ -707,7 +707,9 @@ class Mesh:
         ``targets``.
 
         sources: vertex ids; None for all vertices in order (an N x N matrix).
-        backend: "auto" (OpenCL when a device is usable, else threads),
+        backend: "auto" (OpenCL on a usable device that is not a CPU, or
+            that MESHFMM_OPENCL_DEVICE names; else threads, which run the same
+            rows faster on a CPU),
             "opencl", "threads" or "serial". The backend that ran is stored in
             :attr:`backend_used`.
         dtype: "float32" or "float64" output (arithmetic is always float64).
