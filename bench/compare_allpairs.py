@@ -190,10 +190,20 @@ def main():
         print(msg, flush=True)
 
     # mesh, rows computed (None: all), gdist.local_gdist_matrix radius (fraction of diagonal)
+    # (issue 13 names camelhead 2000 rows, nefertiti and a 250k+ mesh: sine 500,
+    # generated into the results' scratch folder; absolute paths pass through
+    # bl.DATA / "meshes" / name unchanged)
+    gen_dir = Path(tempfile.gettempdir()) / "mfmm_bench_meshes"
+    gen_dir.mkdir(exist_ok=True)
+    bl.generate("sine", 500, gen_dir)
+    sine500 = str(gen_dir / "sine_500.obj")
     plan = [("hand_lowres.obj", None, [None, 0.15]),
             ("spot.obj", None, [0.1]),
-            ("nefertiti-lowres.obj", 1000, [])]
-    gdist_rows = {"hand_lowres.obj": 16, "spot.obj": 16, "nefertiti-lowres.obj": 4}
+            ("camelhead.off", 2000, []),
+            ("nefertiti-lowres.obj", 1000, []),
+            (sine500, 64, [])]
+    gdist_rows = {"hand_lowres.obj": 16, "spot.obj": 16, "camelhead.off": 4,
+                  "nefertiti-lowres.obj": 4}  # none on sine 500 (~0.5 min a row)
     if args.quick:
         plan = [("hand_lowres.obj", None, [0.15]), ("spot.obj", 200, [])]
         gdist_rows = {"hand_lowres.obj": 4, "spot.obj": 2}
@@ -230,7 +240,7 @@ def main():
             full = nv * nv
 
             def add(method, time_s, wall, rss, n, extra=None, radius=None, full_s=None):
-                r = {"mesh": name, "n_vertices": nv, "method": method, "rows": int(n),
+                r = {"mesh": Path(name).name, "n_vertices": nv, "method": method, "rows": int(n),
                      "radius": radius, "time_s": time_s, "wall_s": wall, "peak_rss_mib": rss,
                      "entries_per_s": n * nv / time_s,
                      "full_matrix_s": full_s if full_s is not None else time_s * nv / n,
@@ -257,12 +267,13 @@ def main():
                     full_s=res["precompute_s"] + res["rows_s"] * nv / rows.size)
                 out_file.unlink(missing_ok=True)
             # exact rows: a few, extrapolated
-            k = gdist_rows[name]
-            g_rows = new_of_old[rows[(np.arange(k) * rows.size) // k]]
-            np.save(tmp / "g_rows.npy", g_rows.astype(np.int64))
-            wall, rss, res = py_worker("gdist_loop", name, tmp / "g_rows.npy", out_file)
-            add("gdist_loop", res["rows_s"], wall, rss, k, res)
-            out_file.unlink(missing_ok=True)
+            k = gdist_rows.get(name, 0)
+            if k:
+                g_rows = new_of_old[rows[(np.arange(k) * rows.size) // k]]
+                np.save(tmp / "g_rows.npy", g_rows.astype(np.int64))
+                wall, rss, res = py_worker("gdist_loop", name, tmp / "g_rows.npy", out_file)
+                add("gdist_loop", res["rows_s"], wall, rss, k, res)
+                out_file.unlink(missing_ok=True)
             # gdist.local_gdist_matrix against meshfmm --max-distance, same radius
             for frac in radii:
                 radius = 1e100 if frac is None else frac * diag

@@ -253,7 +253,29 @@ ALLP_NAMES = {
     "igl_heat_loop": "libigl heat, loop of solves",
     "gdist_loop": "gdist.compute_gdist per row (exact)",
     "gdist_local": "gdist.local_gdist_matrix (exact, sparse)",
+    "heat_batched_p1": "heat method batched (32 sources, CHOLMOD), 1 process",
+    "heat_batched_p2": "heat method batched (32 sources, CHOLMOD), 2 processes",
 }
+
+
+def heat_batched_ratios(ap):
+    """Issue 13's yardstick: meshfmm's entries/s over the batched heat
+    method's at the same core count (serial vs 1 process, threads vs 2)."""
+    L = []
+    by = {(r["mesh"], r["method"]): r for r in ap["results"] if r.get("radius") is None}
+    for mesh in dict.fromkeys(r["mesh"] for r in ap["results"]):
+        cells = []
+        for ours, theirs, what in (("meshfmm_serial", "heat_batched_p1", "1 core"),
+                                   ("meshfmm_threads", "heat_batched_p2", "2 cores")):
+            a, b = by.get((mesh, ours)), by.get((mesh, theirs))
+            if a and b:
+                cells.append(f"{what} {a['entries_per_s'] / b['entries_per_s']:.2f}x")
+        agree = by.get((mesh, "heat_batched_p1"), {}).get("mean_rel_diff_vs_meshfmm_pct")
+        if cells:
+            L.append(f"- {mesh}: meshfmm / batched heat " + ", ".join(cells)
+                     + (f"; its rows agree with ours to {agree:.2f} % mean relative difference"
+                        if agree is not None else ""))
+    return L
 
 
 def fmt_time(s):
@@ -665,7 +687,7 @@ def main():
     if allp:
         D += ["## All pairs", "",
               f"**Machine:** {machine_line(allp)}.", "",
-              allpairs_table(allp), "",
+              allpairs_table(allp), ""] + heat_batched_ratios(allp) + ["",
               "Bold: the highest rate per mesh and radius. "
               + " ".join(n + "." for n in allp["notes"]) + " The Python peers' children start "
               f"from a baseline of {allp['python_worker_baseline']['peak_rss_mib']:.0f} MiB "
