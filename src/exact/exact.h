@@ -12,7 +12,23 @@
 
 typedef struct mfmm_exact_solver mfmm_exact_ws;
 
-/* The same as mfmm_exact_solver_create / _destroy. */
+/* A mesh's read-only tables (face records, fans, pseudo-source flags): built
+ * once and shared by the workspaces of any number of threads, which keep
+ * only a solve's state (issue 12: each thread built its own, ~430 B/vertex).
+ * The mesh must outlive them, and they every workspace made from them.
+ * mfmm_exact_tables_bytes: their size; mfmm_exact_ws_bytes: a workspace's
+ * (per vertex state, without the queue, which grows with the patch). */
+typedef struct mfmm_exact_tables mfmm_exact_tables;
+mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **out);
+void mfmm_exact_tables_destroy(mfmm_exact_tables *tables);
+size_t mfmm_exact_tables_bytes(const mfmm_mesh *mesh);
+size_t mfmm_exact_ws_bytes(const mfmm_mesh *mesh);
+
+/* A workspace on shared tables (not freed with it). */
+mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *tables, mfmm_exact_ws **out);
+
+/* A workspace with tables of its own: the same as mfmm_exact_solver_create
+ * / _destroy. */
 mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out);
 void mfmm_exact_ws_destroy(mfmm_exact_ws *ws);
 

@@ -14,8 +14,12 @@ mfmm_status mfmm_check_exact_start(double radius, mfmm_error *err)
 
 size_t mfmm_exact_start_bytes(const mfmm_mesh *mesh)
 {
-    /* exact.h: about 180 bytes per face and 45 per vertex */
-    return 192 * (size_t)mesh->nf + 48 * (size_t)mesh->nv;
+    return mfmm_exact_ws_bytes(mesh);
+}
+
+size_t mfmm_exact_start_shared_bytes(const mfmm_mesh *mesh)
+{
+    return mfmm_exact_tables_bytes(mesh);
 }
 
 static double dist3(const double *p, const double *q)

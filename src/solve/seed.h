@@ -40,8 +40,10 @@ mfmm_status mfmm_exact_start_seed(const mfmm_mesh *mesh, mfmm_exact_ws **ws,
                                   mfmm_march_state *st, const mfmm_source *src, double radius,
                                   const double *uniform, int fixed);
 
-/* Bytes an exact workspace takes for this mesh (its tables; the queue of a
- * patch is small), for memory budgets. */
+/* Bytes the exact start takes: per thread (a workspace's state; the queue
+ * of a patch is small), and once per mesh or job (the read-only tables,
+ * exact.h, shared by the threads of a matrix job), for memory budgets. */
 size_t mfmm_exact_start_bytes(const mfmm_mesh *mesh);
+size_t mfmm_exact_start_shared_bytes(const mfmm_mesh *mesh);
 
 #endif
