@@ -243,8 +243,10 @@ typedef struct mfmm_solve_options {
 } mfmm_solve_options;
 
 /* Default exact_start_radius, in mean edge lengths (chosen by measurement:
- * bench/RESULTS.md, "Exact start"). */
-#define MFMM_EXACT_START_RADIUS 6.0
+ * bench/RESULTS.md, "Exact start"). The patch also holds the vertices just
+ * beyond the radius whose exact distances the propagation has found anyway
+ * (within a face's height of it). */
+#define MFMM_EXACT_START_RADIUS 7.0
 
 /* Fills `options` with the defaults: no cost, no limit, no targets, unfolding on,
  * exact start within MFMM_EXACT_START_RADIUS mean edge lengths. */

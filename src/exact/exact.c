@@ -171,6 +171,7 @@ struct mfmm_exact_solver {
     int32_t *touched;  /* vertices with finite d, in order of first touch */
     int32_t n_touched;
     double *patch_d;   /* (nv,) distances of mfmm_exact_patch */
+    uint8_t *in_patch; /* (nv,) whether in the last patch (mfmm_exact_in_patch) */
     /* the queue */
     ex_entry *heap;    /* the entries of the bucket queue, linked by next */
     int32_t heap_cap, heap_n, heap_used, qfree;
@@ -219,6 +220,7 @@ void mfmm_exact_ws_destroy(mfmm_exact_ws *ws)
     free(ws->emitted);
     free(ws->touched);
     free(ws->patch_d);
+    free(ws->in_patch);
     free(ws->heap);
     free(ws->bhead);
     free(ws);
@@ -317,7 +319,7 @@ size_t mfmm_exact_tables_bytes(const mfmm_mesh *mesh)
 
 size_t mfmm_exact_ws_bytes(const mfmm_mesh *mesh)
 {
-    return sizeof(mfmm_exact_ws) + (size_t)mesh->nv * (4 * sizeof(double) + sizeof(int32_t)) +
+    return sizeof(mfmm_exact_ws) + (size_t)mesh->nv * (4 * sizeof(double) + sizeof(int32_t) + 1) +
            EX_NB * sizeof(int32_t);
 }
 
@@ -501,8 +503,10 @@ mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *t, mfmm_exact_w
     ws->touched = malloc((nv ? nv : 1) * sizeof *ws->touched);
     ws->patch_d = malloc((nv ? nv : 1) * sizeof *ws->patch_d);
     ws->in_angle = malloc((nv ? nv : 1) * sizeof *ws->in_angle);
+    ws->in_patch = calloc(nv ? nv : 1, sizeof *ws->in_patch);
     ws->bhead = malloc(EX_NB * sizeof *ws->bhead);
-    if (!ws->d || !ws->emitted || !ws->touched || !ws->patch_d || !ws->in_angle || !ws->bhead) {
+    if (!ws->d || !ws->emitted || !ws->touched || !ws->patch_d || !ws->in_angle ||
+        !ws->in_patch || !ws->bhead) {
         mfmm_exact_ws_destroy(ws);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
@@ -985,6 +989,7 @@ static void ex_reset(mfmm_exact_ws *ws)
         int32_t v = ws->touched[i];
         ws->d[v] = INFINITY;
         ws->emitted[v] = INFINITY;
+        ws->in_patch[v] = 0;
     }
     ws->n_touched = 0;
     ws->heap_n = 0;
@@ -1171,12 +1176,34 @@ mfmm_status mfmm_exact_patch(mfmm_exact_ws *ws, const mfmm_source *sources, int3
     ex_fill_info(ws, info);
     if (st != MFMM_OK)
         return st;
-    /* touched vertices within the radius, moved to the front of touched
-     * (the rest stay behind them, so the next reset still clears them) */
+    /* the vertices whose distances are final, moved to the front of touched
+     * (the rest stay behind them, so the next reset still clears them):
+     * those within the radius, and those beyond it by less than their
+     * least height h over the opposite edges of their faces. A path to v
+     * ends with a segment in one of v's faces from the opposite edge (or
+     * along an edge from a neighbour u, |u v| >= h), so it crosses that
+     * edge (or passes u) at a distance <= d(v) - h <= radius: every window
+     * and pseudo-source on it was propagated, and d(v) is exact (d is an
+     * upper bound, the length of a real path, so d(v) - h <= radius holds
+     * for the true distance too). That ring is free and, seeded with the
+     * rest, lowers the march's mean error by 5-15 % (issue 12). */
     int32_t n = 0;
     for (int32_t i = 0; i < ws->n_touched; i++) {
         int32_t v = ws->touched[i];
-        if (ws->d[v] <= radius) {
+        double dv = ws->d[v];
+        int final = dv <= radius;
+        if (!final && dv < INFINITY) {
+            double h = INFINITY;
+            for (int32_t j = ws->vf_offset[v]; j < ws->vf_offset[v + 1]; j++) {
+                int32_t c = ex_corner(ws->vf_corner, ws->face_in, j);
+                const ex_face *r = ws->fr + c / 3;
+                if (!r->skip && r->cy[c % 3] < h)
+                    h = r->cy[c % 3];
+            }
+            final = dv - h <= radius;
+        }
+        if (final) {
+            ws->in_patch[v] = 1;
             ws->touched[i] = ws->touched[n];
             ws->touched[n] = v;
             ws->patch_d[n] = ws->d[v];
@@ -1185,4 +1212,9 @@ mfmm_status mfmm_exact_patch(mfmm_exact_ws *ws, const mfmm_source *sources, int3
     }
     *n_vertices = n;
     return MFMM_OK;
+}
+
+int mfmm_exact_in_patch(const mfmm_exact_ws *ws, int32_t v)
+{
+    return ws->in_patch[v];
 }

@@ -34,7 +34,7 @@ static double reach_around(const mfmm_mesh *m, int32_t v, const double *p)
     return r;
 }
 
-/* mfmm_exact_start, and the patch's radius in *patch_radius (0 when *n is 0). */
+/* mfmm_exact_start, and in *patch_radius the patch's radius (0 when *n is 0). */
 static mfmm_status exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const mfmm_source *src,
                                double radius, const double *cost, const double *uniform,
                                int32_t *n, const int32_t **vertices, const double **distances,
@@ -129,6 +129,7 @@ mfmm_status mfmm_exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const mf
 
 typedef struct beyond_ctx {
     mfmm_march_state *st;
+    const mfmm_exact_ws *ws;
     double value, R;
 } beyond_ctx;
 
@@ -136,7 +137,10 @@ typedef struct beyond_ctx {
 static int seed_beyond(void *user, const mfmm_start_hit *h)
 {
     beyond_ctx *c = user;
-    if (h->length > c->R)
+    /* not in the patch, whose exact values it must not undercut (the
+     * straight walk gave up to 0.18 % less than the exact solver at the
+     * patch's outer ring on beetle) */
+    if (h->length > c->R && !mfmm_exact_in_patch(c->ws, h->vertex))
         mfmm_march_seed(c->st, h->vertex, c->value + h->cost_length);
     return 0;
 }
@@ -168,7 +172,7 @@ mfmm_status mfmm_exact_start_seed(const mfmm_mesh *mesh, mfmm_exact_ws **ws,
          * the mesh's longest edge (start.c), up to 12 mean edges on the
          * test meshes, exact where the surface is flat; without them a
          * face source started worse than the plain start (fertility 1.12x) */
-        beyond_ctx c = {st, src->value, R};
+        beyond_ctx c = {st, *ws, src->value, R};
         mfmm_start_walk(mesh, src, st->cost, st->cost_location, seed_beyond, &c);
     }
     return MFMM_OK;

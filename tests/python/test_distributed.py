@@ -405,7 +405,7 @@ def test_exact_start_is_passed_through_and_part_of_the_job(hand, client, tmp_pat
                                                       exact_start=3.5))
     # the default is recorded as the library's radius, and a radius is checked
     job = md.job_description(hand, src, None, "float64", None, None, None, True)
-    assert job["exact_start_radius"] == 6.0
+    assert job["exact_start_radius"] == 7.0
     with pytest.raises(ValueError):
         md.distance_matrix(hand, str(tmp_path / "bad.zarr"), sources=src, client=client,
                            progress=False, exact_start=-1.0)
