@@ -4,10 +4,11 @@ with and without it, against potpourri3d's robust heat method, the choice of
 the default radius, and the time per source.
 
 Cases (3 sources each; references as in compare_peers.py):
-  choice set (the radius is chosen on these): hand, spot, fertility (stored
-    igl.exact_geodesic), sphere 4 (2.5k, great circle), sine 50 (exact);
+  choice set (the radius is chosen on these): hand, spot, fertility, bunny
+    (stored igl.exact_geodesic; the bunny set r = 7, the one mesh above 0.6x
+    at 6), sphere 4 (2.5k, great circle), sine 50 (exact);
   held out (not used to choose it): wingnut, decimated-max, camelhead,
-    nefertiti, bunny (stored igl), sphere 5 (10k), lattice 50 and 100
+    nefertiti (stored igl), sphere 5 (10k), lattice 50 and 100
     (Euclidean), sine 100, and two cases made for this benchmark: a jittered
     sine surface (70 x 70, vertices moved by up to 0.3 h) and a random planar
     Delaunay mesh (3000 points in the unit square, Euclidean reference).
@@ -21,7 +22,7 @@ the meshes of 10k vertices and more; ratios from one run.
 
 Writes bench/results/exact_start.json.
 
-    python bench/bench_exact_start.py [--radii 0 2 3 5 8] [--rounds 5]
+    python bench/bench_exact_start.py [--radii 0 3 5 6 7 8 10] [--rounds 5]
 """
 
 from __future__ import annotations
@@ -40,7 +41,19 @@ import benchlib as bl  # noqa: E402
 
 import meshfmm  # noqa: E402
 
-CHOICE = ["hand_lowres.obj", "spot.obj", "fertility_FE_10k.off", "sphere 4", "sine 50"]
+CHOICE = ["hand_lowres.obj", "spot.obj", "fertility_FE_10k.off", "sphere 4", "sine 50",
+          "stanford-bunny.obj"]
+
+
+def default_radius():
+    """The library's default exact_start radius (MFMM_EXACT_START_RADIUS)."""
+    import ctypes
+
+    from meshfmm import _lib
+
+    o = _lib.mfmm_solve_options()
+    _lib.mfmm_solve_options_init(ctypes.byref(o))
+    return float(o.exact_start_radius)
 
 
 def nearest(V, pts):
@@ -108,14 +121,14 @@ def cases(workdir):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--radii", type=float, nargs="*", default=[0, 2, 3, 5, 8, 10])
+    ap.add_argument("--radii", type=float, nargs="*", default=[0, 3, 5, 6, 7, 8, 10])
     ap.add_argument("--rounds", type=int, default=5)
     args = ap.parse_args()
     import potpourri3d as pp3d
 
     out = {"what": __doc__.split("\n\n")[0], "machine": bl.machine_info(),
            "versions": bl.versions(), "choice_set": CHOICE, "radii": args.radii,
-           "default_radius": None, "cases": []}
+           "default_radius": default_radius(), "cases": []}
     with tempfile.TemporaryDirectory() as wd:
         for name, V, F, src, ref, ref_kind in cases(wd):
             m = meshfmm.Mesh(V, F)

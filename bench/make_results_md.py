@@ -587,16 +587,23 @@ def exact_start_section():
         return []
     es = json.loads(es_path.read_text())
     radii = [str(r) for r in es["radii"]]
-    default = next((r for r in radii if float(r) == 6.0), radii[-1])
+    want = es.get("default_radius") or 6.0
+    default = next((r for r in radii if float(r) == float(want)), radii[-1])
     D = ["## Exact start", "",
          f"**Machine:** {machine_line(es)}.", "",
          "The march starts from the exact distances (mfmm_solve_exact's window propagation) of "
          "the vertices within r mean edge lengths of each source, instead of the paper's start "
          "(r = 0). Mean relative error % / max error % of the diagonal over 3 sources per case "
-         "(`bench/bench_exact_start.py`). The default r = 6 was chosen on the *choice* cases "
-         "(" + ", ".join(es["choice_set"]) + "): the error falls with r on every one of them, "
-         "and r is the largest whose time per source stays within 1.2x of the plain start's on "
-         "the meshes of 10k vertices and more (r = 8 costs 1.14-1.26x there). The other cases "
+         f"(`bench/bench_exact_start.py`). The default r = {float(default):g} was chosen on the "
+         "*choice* cases (" + ", ".join(es["choice_set"]) + "; the bunny, the one mesh above "
+         "0.6x at r = 6, set it): the error falls with r on every case, and r = 7 is the least "
+         "that brings the bunny to 0.6x. Its time per source is 1.05-1.16x the plain start's on "
+         "the meshes of 10k vertices and more but sine 100, which is at the 1.2x limit and over "
+         "it in some runs (1.25x in the table's run; 1.18-1.25x in repeated runs, 1.19-1.21x "
+         "best-of-60 in C; its centre source, among saddles, costs the most). The patch also "
+         "holds the "
+         "vertices just beyond r whose distances the propagation made exact anyway (within their "
+         "faces' least height of r). The other cases "
          "were not used to choose it (two made for this benchmark: a jittered sine surface and "
          "a random Delaunay mesh). Heat: potpourri3d's robust heat method "
          "(`MeshHeatMethodDistanceSolver(use_robust=True)`). Time: per source, plain and exact "

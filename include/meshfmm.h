@@ -198,13 +198,14 @@ typedef struct mfmm_solver mfmm_solver;
 
 /* A reusable workspace (heap, labels, a touched list) for one mesh and one
  * thread: about 40 bytes per vertex, plus, made by the first solve that uses
- * the exact start, an exact solver's workspace (about 180 bytes per face and
- * 45 per vertex, see mfmm_exact_solver_create). After that first solve,
- * solving allocates nothing beyond a copy of its arguments in the mesh's
- * internal vertex order (sources, targets, a per-vertex cost), kept and
- * reused while large enough (the exact start's queue grows only for a
- * larger patch than any before). Between
- * solves the workspace is kept clean by resetting only the vertices the
+ * the exact start, an exact solver's workspace (about 156 bytes per face and
+ * 45 per vertex, see mfmm_exact_solver_create; the threads of
+ * mfmm_distance_matrix share its read-only part and keep 36 bytes per vertex
+ * each). After that first solve, solving allocates nothing beyond a copy of
+ * its arguments in the mesh's internal vertex order (sources, targets, a
+ * per-vertex cost), kept and reused while large enough (the exact start's
+ * queue grows only for a larger patch than any before). Between solves the
+ * workspace is kept clean by resetting only the vertices the
  * last march reached, so a local solve (max_distance, targets) costs in
  * proportion to what it reaches, apart from filling `distances`. */
 MFMM_API mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out);
@@ -242,8 +243,10 @@ typedef struct mfmm_solve_options {
 } mfmm_solve_options;
 
 /* Default exact_start_radius, in mean edge lengths (chosen by measurement:
- * bench/RESULTS.md, "Exact start"). */
-#define MFMM_EXACT_START_RADIUS 6.0
+ * bench/RESULTS.md, "Exact start"). The patch also holds the vertices just
+ * beyond the radius whose exact distances the propagation has found anyway
+ * (within a face's height of it). */
+#define MFMM_EXACT_START_RADIUS 7.0
 
 /* Fills `options` with the defaults: no cost, no limit, no targets, unfolding on,
  * exact start within MFMM_EXACT_START_RADIUS mean edge lengths. */
@@ -273,7 +276,7 @@ MFMM_API mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources,
 typedef struct mfmm_exact_solver mfmm_exact_solver;
 
 /* A workspace for one mesh and one thread: the mesh's edge geometry (about
- * 180 bytes per face) and per-vertex state (about 45 bytes per vertex),
+ * 156 bytes per face) and per-vertex state (about 45 bytes per vertex),
  * plus a queue of windows (56 bytes each) that grows as needed and is kept
  * for the next solve (mfmm_exact_info.peak_bytes tells the total). Several
  * exact solvers may share one mesh, one per thread. */

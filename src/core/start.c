@@ -36,10 +36,38 @@ static double norm2(v2 a)
     return sqrt(a.x * a.x + a.y * a.y);
 }
 
-static double dist3(const double *p, const double *q)
+void mfmm_source_locate(const mfmm_mesh *mesh, const mfmm_source *src, mfmm_source_loc *loc)
 {
-    double d[3] = {p[0] - q[0], p[1] - q[1], p[2] - q[2]};
-    return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    const int32_t *fv = mesh->faces + 3 * (size_t)src->face;
+    int n_zero = 0, zero = -1, top = 0;
+    for (int k = 0; k < 3; k++) {
+        if (src->bary[k] <= 0.0) {
+            n_zero++;
+            zero = k;
+        }
+        if (src->bary[k] > src->bary[top])
+            top = k;
+    }
+    loc->vertex = fv[top];
+    loc->zero = -1;
+    loc->across = -1;
+    if (n_zero >= 2) {
+        loc->kind = MFMM_AT_VERTEX;
+        memcpy(loc->p, mesh->xyz + 3 * (size_t)fv[top], sizeof loc->p);
+        return;
+    }
+    loc->kind = n_zero == 1 ? MFMM_ON_EDGE : MFMM_IN_FACE;
+    if (n_zero == 1) {
+        loc->zero = zero;
+        loc->across = mesh->face_neighbor[3 * (size_t)src->face + zero];
+    }
+    for (int c = 0; c < 3; c++)
+        loc->p[c] = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double bk = src->bary[k] > 0.0 ? src->bary[k] : 0.0;
+        for (int c = 0; c < 3; c++)
+            loc->p[c] += bk * mesh->xyz[3 * (size_t)fv[k] + c];
+    }
 }
 
 /* Distance from the origin to the segment [x, y]. */
@@ -129,7 +157,7 @@ static void enter(walk *w, int depth, int32_t g, int32_t ia, int32_t ib, v2 pa, 
     if (!(len > 0.0))
         return;
     const double *xq = m->xyz + 3 * (size_t)q;
-    double r1 = dist3(m->xyz + 3 * (size_t)ia, xq), r2 = dist3(m->xyz + 3 * (size_t)ib, xq);
+    double r1 = mfmm_dist3(m->xyz + 3 * (size_t)ia, xq), r2 = mfmm_dist3(m->xyz + 3 * (size_t)ib, xq);
     double s = (len * len + r1 * r1 - r2 * r2) / (2.0 * len);
     double h2 = r1 * r1 - s * s, h = h2 > 0.0 ? sqrt(h2) : 0.0;
     v2 e = {d.x / len, d.y / len}, n = {-e.y, e.x};
@@ -181,7 +209,7 @@ static void start_face(walk *w, int32_t f, const double *p)
     int far = 0;
     for (int k = 0; k < 3; k++) {
         X[k] = m->xyz + 3 * (size_t)fv[k];
-        r[k] = dist3(X[k], p);
+        r[k] = mfmm_dist3(X[k], p);
         if (r[k] > r[far])
             far = k;
     }
@@ -255,19 +283,11 @@ void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double
     w.fn = fn;
     w.user = user;
     const int32_t *fv = mesh->faces + 3 * (size_t)src->face;
-    int n_zero = 0, zero = -1, top = 0;
-    double p[3] = {0.0, 0.0, 0.0};
-    for (int k = 0; k < 3; k++) {
-        if (src->bary[k] <= 0.0) {
-            n_zero++;
-            zero = k;
-        }
-        if (src->bary[k] > src->bary[top])
-            top = k;
-    }
-    if (n_zero >= 2) { /* at a vertex: every face around it */
-        int32_t v = fv[top];
-        memcpy(p, mesh->xyz + 3 * (size_t)v, sizeof p);
+    mfmm_source_loc at;
+    mfmm_source_locate(mesh, src, &at);
+    const double *p = at.p;
+    if (at.kind == MFMM_AT_VERTEX) { /* every face around it */
+        int32_t v = at.vertex;
         if (w.loc == 1)
             w.fp = cost[v];
         for (int32_t i = mesh->vertex_face_offset[v]; i < mesh->vertex_face_offset[v + 1] && !w.stop; i++) {
@@ -277,14 +297,10 @@ void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double
         }
         return;
     }
-    for (int k = 0; k < 3; k++) {
-        double bk = src->bary[k] > 0.0 ? src->bary[k] : 0.0;
-        for (int c = 0; c < 3; c++)
-            p[c] += bk * mesh->xyz[3 * (size_t)fv[k] + c];
-        if (w.loc == 1)
-            w.fp += bk * cost[fv[k]];
-    }
-    int32_t g = zero >= 0 ? mesh->face_neighbor[3 * (size_t)src->face + zero] : -1;
+    if (w.loc == 1)
+        for (int k = 0; k < 3; k++)
+            w.fp += (src->bary[k] > 0.0 ? src->bary[k] : 0.0) * cost[fv[k]];
+    int32_t g = at.across;
     if (g >= 0 && mesh->degenerate[g])
         g = -1;
     /* on an edge: both faces, in the same order whichever names the point */

@@ -6,6 +6,8 @@
 #ifndef MFMM_START_H
 #define MFMM_START_H
 
+#include <math.h>
+
 #include "mesh.h"
 
 /* The walk reaches faces whose entry edge is nearer the point than this many
@@ -13,6 +15,28 @@
  * MFMM_START_DEPTH edges from it. */
 #define MFMM_START_RADIUS 2.0
 #define MFMM_START_DEPTH 32
+
+/* Where a checked point source (face >= 0) lies, from its barycentric
+ * coordinates (weights <= 0 count as 0): at a vertex (two zero weights), on
+ * an edge (one), or inside its face. Shared by the straight start and the
+ * exact start (solve/seed.c), which must agree on it. */
+typedef enum mfmm_source_kind { MFMM_AT_VERTEX, MFMM_ON_EDGE, MFMM_IN_FACE } mfmm_source_kind;
+typedef struct mfmm_source_loc {
+    mfmm_source_kind kind;
+    int32_t vertex; /* at a vertex: it; else the face's corner of largest weight */
+    int zero;       /* on an edge: the corner of the face opposite it; else -1 */
+    int32_t across; /* on an edge: the face across it (-1 at a wall; may be degenerate) */
+    double p[3];    /* the point */
+} mfmm_source_loc;
+
+void mfmm_source_locate(const mfmm_mesh *mesh, const mfmm_source *src, mfmm_source_loc *loc);
+
+/* Euclidean distance between two points (3 doubles each). */
+static inline double mfmm_dist3(const double *p, const double *q)
+{
+    double a = p[0] - q[0], b = p[1] - q[1], c = p[2] - q[2];
+    return sqrt(a * a + b * b + c * c);
+}
 
 /* A vertex the walk reached, with the segment's way there. */
 typedef struct mfmm_start_hit {

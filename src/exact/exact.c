@@ -103,13 +103,16 @@
 /* A face: for each corner k, the edge opposite it (half-edge 3f+k, from
  * corner k+1 to k+2): its length, corner k in its frame (x along the edge,
  * y > 0), and the same edge in the face across it (3g+m, -1 at a wall) with
- * whether it runs the other way there; the corners' vertices; whether the
- * face has zero area (skipped). 128 bytes, aligned to cache lines. */
+ * whether it runs the other way there; the corners' vertices and angles;
+ * whether the face has zero area (skipped). 128 bytes, aligned to cache
+ * lines. */
 typedef struct ex_face {
     double len[3], cx[3], cy[3];
+    double angle[3]; /* the corners' angles */
     int32_t v[3], across[3];
     uint8_t flip[3], skip;
-    uint8_t pad[128 - 9 * sizeof(double) - 6 * sizeof(int32_t) - 4];
+    int8_t sgn[3];   /* the corners' fan_sgn (see mfmm_exact_tables) */
+    uint8_t pad[128 - 12 * sizeof(double) - 6 * sizeof(int32_t) - 7];
 } ex_face;
 
 /* An entry of the queue: a window, or a vertex to start as a pseudo-source. */
@@ -123,11 +126,17 @@ typedef struct ex_entry {
     int32_t next;    /* the next entry in its bucket or in the free list */
 } ex_entry;
 
-struct mfmm_exact_solver {
+/* The read-only tables of a mesh (exact.h): built once, shared by the
+ * workspaces of any number of threads. Faces are laid out in the order of
+ * their least (internal, Morton-ordered: core/order.c) vertex, so that a
+ * patch's faces lie together in memory: in the files' order the faces
+ * around a vertex were 12,000 records apart on the bunny. */
+struct mfmm_exact_tables {
     const mfmm_mesh *mesh;
     int32_t nv, nf;
-    const int32_t *faces;
-    const int32_t *vf_offset, *vf_corner;
+    const int32_t *vf_offset;
+    const int32_t *vf_corner; /* the mesh's vertex -> corner CSR (ex_corner) */
+    int32_t *face_in;   /* (nf,) the mesh's face id -> its record */
     /* per face, its three half-edges 3f+k (the edge opposite corner k, from
      * corner k+1 to k+2) in one record, so that crossing a face reads one or
      * two cache lines: see ex_face */
@@ -136,17 +145,33 @@ struct mfmm_exact_solver {
     uint8_t *pseudo;   /* (nv,) vertices that may bend a path */
     /* the fan of corners around a vertex, by angle: corner 3f+k (at v = f[k])
      * spans the angles between fan_a0 (the direction to f[k+1]) and
-     * fan_a0 + fan_sgn * angle (to f[k+2]); fan_total (nv) is the angle sum,
+     * fan_a0 + sgn * angle (to f[k+2], ex_face); fan_total (nv) is the angle sum,
      * NaN where the fan is not one closed disk (walls, zero-area faces,
      * non-manifold vertices): those start windows in every direction */
-    double *angle, *fan_a0, *fan_total;
-    int8_t *fan_sgn;
+    double *fan_a0, *fan_total;
+    double inv_w;      /* 1 / bucket width */
+    size_t bytes;
+};
+
+/* A workspace: the tables (its own or shared) and one solve's state. */
+struct mfmm_exact_solver {
+    const mfmm_exact_tables *t;
+    mfmm_exact_tables *own; /* t, when this workspace built it */
+    const mfmm_mesh *mesh;
+    int32_t nv, nf;
+    /* the tables' arrays (see mfmm_exact_tables) */
+    const int32_t *vf_offset, *vf_corner, *face_in;
+    const ex_face *fr;
+    const uint8_t *pseudo;
+    const double *fan_a0, *fan_total;
+    double inv_w;
     double *in_angle;  /* (nv,) direction (fan angle) back along the path that gave d */
     double *d;         /* (nv,) best distance so far, +inf untouched */
     double *emitted;   /* (nv,) the distance a pseudo-source was started with */
     int32_t *touched;  /* vertices with finite d, in order of first touch */
     int32_t n_touched;
     double *patch_d;   /* (nv,) distances of mfmm_exact_patch */
+    uint8_t *in_patch; /* (nv,) whether in the last patch (mfmm_exact_in_patch) */
     /* the queue */
     ex_entry *heap;    /* the entries of the bucket queue, linked by next */
     int32_t heap_cap, heap_n, heap_used, qfree;
@@ -154,7 +179,6 @@ struct mfmm_exact_solver {
     int32_t over;      /* entries beyond the window, unsorted */
     int64_t cur, redist; /* current bucket; where the window was last refilled */
     int32_t n_in;      /* entries in the window's buckets */
-    double inv_w;      /* 1 / bucket width */
     size_t fixed_bytes, memory_limit, peak_bytes;
     double max_d;
     int failed; /* MFMM_ERR_MEMORY_LIMIT or MFMM_ERR_OUT_OF_MEMORY once a growth fails */
@@ -174,21 +198,29 @@ void mfmm_exact_options_init(mfmm_exact_options *options)
     options->memory_limit = 0;
 }
 
+void mfmm_exact_tables_destroy(mfmm_exact_tables *t)
+{
+    if (!t)
+        return;
+    free(t->face_in);
+    free(t->fr_block);
+    free(t->pseudo);
+    free(t->fan_a0);
+    free(t->fan_total);
+    free(t);
+}
+
 void mfmm_exact_ws_destroy(mfmm_exact_ws *ws)
 {
     if (!ws)
         return;
-    free(ws->fr_block);
-    free(ws->pseudo);
-    free(ws->angle);
-    free(ws->fan_a0);
-    free(ws->fan_total);
-    free(ws->fan_sgn);
+    mfmm_exact_tables_destroy(ws->own);
     free(ws->in_angle);
     free(ws->d);
     free(ws->emitted);
     free(ws->touched);
     free(ws->patch_d);
+    free(ws->in_patch);
     free(ws->heap);
     free(ws->bhead);
     free(ws);
@@ -205,6 +237,13 @@ static double vdist(const double *p, const double *q)
     return sqrt(a * a + b * b + c * c);
 }
 
+/* Corner i of the vertex -> corner CSR, as 3 * record + k. */
+static int32_t ex_corner(const int32_t *vf_corner, const int32_t *face_in, int32_t i)
+{
+    int32_t c = vf_corner[i];
+    return 3 * face_in[c / 3] + c % 3;
+}
+
 static int ex_corner_of(const int32_t *fv, int32_t v)
 {
     return fv[0] == v ? 0 : fv[1] == v ? 1 : fv[2] == v ? 2 : -1;
@@ -213,67 +252,78 @@ static int ex_corner_of(const int32_t *fv, int32_t v)
 /* Walks the fan of every vertex through the faces across its edges, giving
  * each corner its angles (fan_a0, fan_sgn) and each vertex its angle sum;
  * NaN for vertices whose corners do not form one closed disk. */
-static mfmm_status ex_build_fans(mfmm_exact_ws *ws)
+static void ex_build_fans(mfmm_exact_tables *t)
 {
-    const int32_t *F = ws->faces;
-    for (int32_t v = 0; v < ws->nv; v++) {
-        int32_t n_c = ws->vf_offset[v + 1] - ws->vf_offset[v];
-        ws->fan_total[v] = NAN;
-        ws->in_angle[v] = NAN;
+    for (int32_t v = 0; v < t->nv; v++) {
+        int32_t n_c = t->vf_offset[v + 1] - t->vf_offset[v];
+        t->fan_total[v] = NAN;
         if (n_c < 3)
             continue;
         int ok = 1;
-        for (int32_t i = ws->vf_offset[v]; i < ws->vf_offset[v + 1]; i++)
-            if (ws->fr[ws->vf_corner[i] / 3].skip)
+        for (int32_t i = t->vf_offset[v]; i < t->vf_offset[v + 1]; i++)
+            if (t->fr[ex_corner(t->vf_corner, t->face_in, i) / 3].skip)
                 ok = 0;
         if (!ok)
             continue;
-        int32_t c0 = ws->vf_corner[ws->vf_offset[v]];
+        int32_t c0 = ex_corner(t->vf_corner, t->face_in, t->vf_offset[v]);
         int32_t f = c0 / 3, k = c0 % 3;
-        int32_t ent = F[3 * (size_t)f + (k + 1) % 3];
+        int32_t ent = t->fr[f].v[(k + 1) % 3];
         double e = 0.0;
         int32_t steps = 0;
         for (;;) {
-            const int32_t *fv = F + 3 * (size_t)f;
+            const int32_t *fv = t->fr[f].v;
             int32_t c = 3 * f + k, far;
             int kent;
             if (fv[(k + 1) % 3] == ent) {
-                ws->fan_a0[c] = e;
-                ws->fan_sgn[c] = 1;
+                t->fan_a0[c] = e;
+                t->fr[f].sgn[k] = 1;
                 far = fv[(k + 2) % 3];
                 kent = (k + 1) % 3;
             } else {
-                ws->fan_a0[c] = e + ws->angle[c];
-                ws->fan_sgn[c] = -1;
+                t->fan_a0[c] = e + t->fr[f].angle[k];
+                t->fr[f].sgn[k] = -1;
                 far = fv[(k + 1) % 3];
                 kent = (k + 2) % 3;
             }
-            e += ws->angle[c];
+            e += t->fr[f].angle[k];
             steps++;
-            int32_t nx = ws->fr[f].across[kent];
+            int32_t nx = t->fr[f].across[kent];
             if (nx < 0 || steps > n_c) {
                 ok = 0;
                 break;
             }
             f = nx / 3;
-            k = ex_corner_of(F + 3 * (size_t)f, v);
+            k = ex_corner_of(t->fr[f].v, v);
             ent = far;
             if (k < 0) {
                 ok = 0;
                 break;
             }
             if (3 * f + k == c0) {
-                ok = steps == n_c && F[3 * (size_t)f + (k + 1) % 3] == ent;
+                ok = steps == n_c && t->fr[f].v[(k + 1) % 3] == ent;
                 break;
             }
         }
         if (ok)
-            ws->fan_total[v] = e;
+            t->fan_total[v] = e;
     }
-    return MFMM_OK;
 }
 
-mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
+size_t mfmm_exact_tables_bytes(const mfmm_mesh *mesh)
+{
+    size_t nv = (size_t)mesh->nv, nf = (size_t)mesh->nf;
+    return sizeof(mfmm_exact_tables) + nf * sizeof(ex_face) + 64 +
+           nf * (sizeof(int32_t) + 3 * sizeof(double)) +
+           nv * (1 + sizeof(double));
+}
+
+size_t mfmm_exact_ws_bytes(const mfmm_mesh *mesh)
+{
+    return sizeof(mfmm_exact_ws) + (size_t)mesh->nv * (4 * sizeof(double) + sizeof(int32_t) + 1) +
+           EX_NB * sizeof(int32_t);
+}
+
+mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **out)
 {
     if (!out)
         return MFMM_ERR_NULL_POINTER;
@@ -282,49 +332,54 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
         return MFMM_ERR_NULL_POINTER;
     if (mesh->nf > INT32_MAX / 3 - 1 || (size_t)mesh->nf > (SIZE_MAX - 64) / sizeof(ex_face))
         return MFMM_ERR_BAD_COUNT;
-    mfmm_exact_ws *ws = calloc(1, sizeof *ws);
-    if (!ws)
+    mfmm_exact_tables *t = calloc(1, sizeof *t);
+    if (!t)
         return MFMM_ERR_OUT_OF_MEMORY;
     size_t nv = (size_t)mesh->nv, nf = (size_t)mesh->nf, nh = 3 * nf;
-    ws->mesh = mesh;
-    ws->nv = mesh->nv;
-    ws->nf = mesh->nf;
-    ws->faces = mesh->faces;
-    ws->vf_offset = mesh->vertex_face_offset;
-    ws->vf_corner = mesh->vertex_face_corner;
-    ws->fr_block = malloc((nf ? nf : 1) * sizeof(ex_face) + 64);
-    if (ws->fr_block) {
-        uintptr_t a = (uintptr_t)ws->fr_block;
-        ws->fr = (ex_face *)(void *)((char *)ws->fr_block + ((64 - a % 64) % 64));
+    t->mesh = mesh;
+    t->nv = mesh->nv;
+    t->nf = mesh->nf;
+    t->vf_offset = mesh->vertex_face_offset;
+    t->fr_block = malloc((nf ? nf : 1) * sizeof(ex_face) + 64);
+    if (t->fr_block) {
+        uintptr_t a = (uintptr_t)t->fr_block;
+        t->fr = (ex_face *)(void *)((char *)t->fr_block + ((64 - a % 64) % 64));
     }
-    ws->pseudo = calloc(nv ? nv : 1, sizeof *ws->pseudo);
-    ws->d = malloc((nv ? nv : 1) * sizeof *ws->d);
-    ws->emitted = malloc((nv ? nv : 1) * sizeof *ws->emitted);
-    ws->touched = malloc((nv ? nv : 1) * sizeof *ws->touched);
-    ws->patch_d = malloc((nv ? nv : 1) * sizeof *ws->patch_d);
+    t->vf_corner = mesh->vertex_face_corner;
+    t->face_in = malloc((nf ? nf : 1) * sizeof *t->face_in);
+    t->pseudo = calloc(nv ? nv : 1, sizeof *t->pseudo);
     double *angle = calloc(nv ? nv : 1, sizeof *angle);
-    ws->angle = malloc(nh * sizeof *ws->angle);
-    ws->fan_a0 = malloc(nh * sizeof *ws->fan_a0);
-    ws->fan_sgn = malloc(nh * sizeof *ws->fan_sgn);
-    ws->fan_total = malloc((nv ? nv : 1) * sizeof *ws->fan_total);
-    ws->bhead = malloc(EX_NB * sizeof *ws->bhead);
-    ws->in_angle = malloc((nv ? nv : 1) * sizeof *ws->in_angle);
-    if (!ws->fr_block || !ws->pseudo ||
-        !ws->d || !ws->emitted || !ws->touched || !ws->patch_d || !angle || !ws->angle ||
-        !ws->fan_a0 || !ws->fan_sgn || !ws->fan_total || !ws->in_angle || !ws->bhead) {
+    /* counting sort of the faces by their least vertex: cnt (nv + 1) */
+    int32_t *cnt = calloc(nv + 1, sizeof *cnt);
+    t->fan_a0 = malloc((nh ? nh : 1) * sizeof *t->fan_a0);
+    t->fan_total = malloc((nv ? nv : 1) * sizeof *t->fan_total);
+    if (!t->fr_block || !t->face_in || !t->pseudo || !angle || !cnt ||
+        !t->fan_a0 || !t->fan_total) {
         free(angle);
-        mfmm_exact_ws_destroy(ws);
+        free(cnt);
+        mfmm_exact_tables_destroy(t);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
-    ws->fixed_bytes = sizeof *ws + nf * sizeof(ex_face) + 64 + nh * (2 * sizeof(double) + 1) +
-                      nv * (1 + 5 * sizeof(double) + sizeof(int32_t)) +
-                      EX_NB * sizeof(int32_t);
+    t->bytes = mfmm_exact_tables_bytes(mesh);
     const double *X = mesh->xyz;
     const int32_t *F = mesh->faces;
     for (size_t f = 0; f < nf; f++) {
         const int32_t *fv = F + 3 * f;
+        int32_t lo = fv[0] < fv[1] ? fv[0] : fv[1];
+        cnt[(lo < fv[2] ? lo : fv[2]) + 1]++;
+    }
+    for (size_t v = 0; v < nv; v++)
+        cnt[v + 1] += cnt[v];
+    for (size_t f = 0; f < nf; f++) {
+        const int32_t *fv = F + 3 * f;
+        int32_t lo = fv[0] < fv[1] ? fv[0] : fv[1];
+        t->face_in[f] = cnt[lo < fv[2] ? lo : fv[2]]++;
+    }
+    free(cnt);
+    for (size_t f = 0; f < nf; f++) {
+        const int32_t *fv = F + 3 * f;
         int bad = mesh->degenerate[f] != 0;
-        ex_face *r = ws->fr + f;
+        ex_face *r = t->fr + t->face_in[f];
         memset(r, 0, sizeof *r);
         for (int k = 0; k < 3; k++) {
             r->len[k] = vdist(X + 3 * (size_t)fv[(k + 1) % 3], X + 3 * (size_t)fv[(k + 2) % 3]);
@@ -354,19 +409,19 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
     }
     for (size_t f = 0; f < nf; f++) {
         const int32_t *fv = F + 3 * f;
+        ex_face *r = t->fr + t->face_in[f];
         for (int k = 0; k < 3; k++) {
-            size_t h = 3 * f + k;
-            int32_t g = mesh->face_neighbor[h];
-            ws->fr[f].across[k] = -1;
-            ws->fr[f].flip[k] = 0;
-            if (g < 0 || ws->fr[f].skip || ws->fr[g].skip)
+            int32_t g = mesh->face_neighbor[3 * f + k];
+            r->across[k] = -1;
+            r->flip[k] = 0;
+            if (g < 0 || r->skip || t->fr[t->face_in[g]].skip)
                 continue;
             int32_t a = fv[(k + 1) % 3], b = fv[(k + 2) % 3];
             const int32_t *gv = F + 3 * (size_t)g;
             for (int m = 0; m < 3; m++) {
                 if (gv[m] != a && gv[m] != b) {
-                    ws->fr[f].across[k] = 3 * g + m;
-                    ws->fr[f].flip[k] = gv[(m + 1) % 3] != a;
+                    r->across[k] = 3 * t->face_in[g] + m;
+                    r->flip[k] = gv[(m + 1) % 3] != a;
                 }
             }
         }
@@ -374,57 +429,115 @@ mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
     /* pseudo-source candidates: saddles, vertices at a wall, and vertices of
      * zero-area faces; unreferenced vertices have nothing to start */
     for (size_t f = 0; f < nf; f++) {
-        const int32_t *fv = F + 3 * f;
-        if (ws->fr[f].skip) {
+        const ex_face *r = t->fr + f;
+        const int32_t *fv = r->v;
+        if (r->skip) {
             for (int k = 0; k < 3; k++)
-                ws->pseudo[fv[k]] = 1;
+                t->pseudo[fv[k]] = 1;
             continue;
         }
         for (int k = 0; k < 3; k++) {
             /* angle at corner k, seen in the frame of the opposite edge */
-            double x = ws->fr[f].cx[k], y = ws->fr[f].cy[k], L = ws->fr[f].len[k];
+            double x = r->cx[k], y = r->cy[k], L = r->len[k];
             double a = atan2(y * L, y * y - x * (L - x));
-            ws->angle[3 * f + k] = a;
+            t->fr[f].angle[k] = a;
             angle[fv[k]] += a;
-            if (ws->fr[f].across[k] < 0) {
-                ws->pseudo[fv[(k + 1) % 3]] = 1;
-                ws->pseudo[fv[(k + 2) % 3]] = 1;
+            if (r->across[k] < 0) {
+                t->pseudo[fv[(k + 1) % 3]] = 1;
+                t->pseudo[fv[(k + 2) % 3]] = 1;
             }
         }
     }
-    for (size_t v = 0; v < nv; v++) {
+    for (size_t v = 0; v < nv; v++)
         if (angle[v] > EX_TWO_PI + EX_SADDLE_TOL)
-            ws->pseudo[v] = 1;
-        ws->d[v] = INFINITY;
-        ws->emitted[v] = INFINITY;
-    }
+            t->pseudo[v] = 1;
     free(angle);
     double sum_len = 0.0;
     size_t n_len = 0;
     for (size_t hh = 0; hh < nh; hh++) {
-        if (!ws->fr[hh / 3].skip) {
-            sum_len += ws->fr[hh / 3].len[hh % 3];
+        if (!t->fr[hh / 3].skip) {
+            sum_len += t->fr[hh / 3].len[hh % 3];
             n_len++;
         }
     }
     double width = n_len ? EX_BUCKET_WIDTH * sum_len / (double)n_len : 1.0;
-    ws->inv_w = width > 0.0 && isfinite(1.0 / width) ? 1.0 / width : 1.0;
-    mfmm_status st = ex_build_fans(ws);
-    if (st != MFMM_OK) {
-        mfmm_exact_ws_destroy(ws);
-        return st;
-    }
+    t->inv_w = width > 0.0 && isfinite(1.0 / width) ? 1.0 / width : 1.0;
+    ex_build_fans(t);
     /* a vertex whose faces are not one closed fan (several fans meeting at
      * it, as two copies of a face make a closed fan of their own) joins
      * parts of the surface that share no edge: only a pseudo-source there
      * carries distances from one part to the other (a fuzzed mesh's doubled
      * face left d(20) 0.10 above d(27) + |20 27|) */
     for (size_t v = 0; v < nv; v++)
-        if (ws->vf_offset[v + 1] > ws->vf_offset[v] && isnan(ws->fan_total[v]))
-            ws->pseudo[v] = 1;
+        if (t->vf_offset[v + 1] > t->vf_offset[v] && isnan(t->fan_total[v]))
+            t->pseudo[v] = 1;
+    *out = t;
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *t, mfmm_exact_ws **out)
+{
+    if (!out)
+        return MFMM_ERR_NULL_POINTER;
+    *out = NULL;
+    if (!t)
+        return MFMM_ERR_NULL_POINTER;
+    mfmm_exact_ws *ws = calloc(1, sizeof *ws);
+    if (!ws)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    size_t nv = (size_t)t->nv;
+    ws->t = t;
+    ws->mesh = t->mesh;
+    ws->nv = t->nv;
+    ws->nf = t->nf;
+    ws->vf_offset = t->vf_offset;
+    ws->vf_corner = t->vf_corner;
+    ws->face_in = t->face_in;
+    ws->fr = t->fr;
+    ws->pseudo = t->pseudo;
+    ws->fan_a0 = t->fan_a0;
+    ws->fan_total = t->fan_total;
+    ws->inv_w = t->inv_w;
+    ws->d = malloc((nv ? nv : 1) * sizeof *ws->d);
+    ws->emitted = malloc((nv ? nv : 1) * sizeof *ws->emitted);
+    ws->touched = malloc((nv ? nv : 1) * sizeof *ws->touched);
+    ws->patch_d = malloc((nv ? nv : 1) * sizeof *ws->patch_d);
+    ws->in_angle = malloc((nv ? nv : 1) * sizeof *ws->in_angle);
+    ws->in_patch = calloc(nv ? nv : 1, sizeof *ws->in_patch);
+    ws->bhead = malloc(EX_NB * sizeof *ws->bhead);
+    if (!ws->d || !ws->emitted || !ws->touched || !ws->patch_d || !ws->in_angle ||
+        !ws->in_patch || !ws->bhead) {
+        mfmm_exact_ws_destroy(ws);
+        return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    for (size_t v = 0; v < nv; v++) {
+        ws->d[v] = INFINITY;
+        ws->emitted[v] = INFINITY;
+        ws->in_angle[v] = NAN;
+    }
+    /* memory_limit counts the tables too, shared or not */
+    ws->fixed_bytes = t->bytes + mfmm_exact_ws_bytes(t->mesh);
     ws->max_d = INFINITY;
     ws->peak_bytes = ws->fixed_bytes;
     *out = ws;
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
+{
+    if (!out)
+        return MFMM_ERR_NULL_POINTER;
+    *out = NULL;
+    mfmm_exact_tables *t = NULL;
+    mfmm_status st = mfmm_exact_tables_create(mesh, &t);
+    if (st != MFMM_OK)
+        return st;
+    st = mfmm_exact_ws_create_shared(t, out);
+    if (st != MFMM_OK) {
+        mfmm_exact_tables_destroy(t);
+        return st;
+    }
+    (*out)->own = t;
     return MFMM_OK;
 }
 
@@ -622,13 +735,13 @@ static void ex_set_in(mfmm_exact_ws *ws, int32_t v, int32_t c, double psi, doubl
         return;
     /* a direction outside the corner (rounding at a grazing ray) is not
      * trusted: in_angle stays NaN and v starts windows all around */
-    if (!(psi >= -1e-9 && psi <= ws->angle[c] + 1e-9))
+    if (!(psi >= -1e-9 && psi <= ws->fr[c / 3].angle[c % 3] + 1e-9))
         return;
     if (psi < 0.0)
         psi = 0.0;
-    if (psi > ws->angle[c])
-        psi = ws->angle[c];
-    ws->in_angle[v] = ws->fan_a0[c] + ws->fan_sgn[c] * psi;
+    if (psi > ws->fr[c / 3].angle[c % 3])
+        psi = ws->fr[c / 3].angle[c % 3];
+    ws->in_angle[v] = ws->fan_a0[c] + ws->fr[c / 3].sgn[c % 3] * psi;
 }
 
 /* Trims the interval [*b0, *b1] of an edge of length L (in the frame where
@@ -683,7 +796,7 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
         ex_set_in(ws, va, h - k + (k == 2 ? 0 : k + 1), atan2(iy, ix), ra, L);
     if (s1 >= L - EX_POS_TOL * L && ex_update(ws, vb, sigma + rb, 0)) {
         int32_t c = h - k + (k == 0 ? 2 : k - 1);
-        ex_set_in(ws, vb, c, ws->angle[c] - atan2(iy, L - ix), rb, L);
+        ex_set_in(ws, vb, c, ws->fr[c / 3].angle[c % 3] - atan2(iy, L - ix), rb, L);
     }
     int32_t g = r->across[k];
     if (g < 0 || !(s1 - s0 > EX_MIN_WIDTH * L))
@@ -809,7 +922,7 @@ static void ex_start_vertex(mfmm_exact_ws *ws, int32_t v, double dv)
     double th = ws->in_angle[v], total = ws->fan_total[v];
     if (!(th == th) || !(total == total)) {
         for (int32_t i = ws->vf_offset[v]; i < ws->vf_offset[v + 1]; i++) {
-            int32_t c = ws->vf_corner[i];
+            int32_t c = ex_corner(ws->vf_corner, ws->face_in, i);
             const ex_face *r = ws->fr + c / 3;
             if (r->skip)
                 continue;
@@ -825,9 +938,9 @@ static void ex_start_vertex(mfmm_exact_ws *ws, int32_t v, double dv)
     if (!(hi > lo))
         return;
     for (int32_t i = ws->vf_offset[v]; i < ws->vf_offset[v + 1]; i++) {
-        int32_t c = ws->vf_corner[i];
-        double ang = ws->angle[c];
-        double f0 = ws->fan_sgn[c] > 0 ? ws->fan_a0[c] : ws->fan_a0[c] - ang, f1 = f0 + ang;
+        int32_t c = ex_corner(ws->vf_corner, ws->face_in, i);
+        double ang = ws->fr[c / 3].angle[c % 3];
+        double f0 = ws->fr[c / 3].sgn[c % 3] > 0 ? ws->fan_a0[c] : ws->fan_a0[c] - ang, f1 = f0 + ang;
         for (int wrap = -1; wrap <= 1; wrap++) {
             double a = lo + wrap * total, b = hi + wrap * total;
             if (a < f0)
@@ -838,7 +951,7 @@ static void ex_start_vertex(mfmm_exact_ws *ws, int32_t v, double dv)
                 continue;
             /* psi: angles from the direction to the corner's first vertex */
             double p0, p1;
-            if (ws->fan_sgn[c] > 0) {
+            if (ws->fr[c / 3].sgn[c % 3] > 0) {
                 p0 = a - f0;
                 p1 = b - f0;
             } else {
@@ -876,6 +989,7 @@ static void ex_reset(mfmm_exact_ws *ws)
         int32_t v = ws->touched[i];
         ws->d[v] = INFINITY;
         ws->emitted[v] = INFINITY;
+        ws->in_patch[v] = 0;
     }
     ws->n_touched = 0;
     ws->heap_n = 0;
@@ -915,7 +1029,7 @@ static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t
             ex_update(ws, s->vertex, s->value, 1);
             continue;
         }
-        const int32_t *fv = ws->faces + 3 * (size_t)s->face;
+        const int32_t *fv = ws->mesh->faces + 3 * (size_t)s->face;
         double w[3], sum = 0.0;
         for (int k = 0; k < 3; k++) {
             w[k] = s->bary[k] > 0.0 ? s->bary[k] : 0.0;
@@ -937,7 +1051,7 @@ static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t
             ex_update(ws, fv[corner], s->value + vdist(p, X + 3 * (size_t)fv[corner]), 1);
             continue;
         }
-        ex_start_face(ws, s->face, w, s->value);
+        ex_start_face(ws, ws->face_in[s->face], w, s->value);
     }
     while (ws->heap_n > 0 && !ws->failed) {
         ex_entry e;
@@ -974,7 +1088,7 @@ static mfmm_status ex_check_sources(const mfmm_exact_ws *ws, const mfmm_source *
         mfmm_status st = mfmm_check_source(ws->mesh, sources + i, i, err);
         if (st != MFMM_OK)
             return st;
-        if (sources[i].face >= 0 && ws->fr[sources[i].face].skip)
+        if (sources[i].face >= 0 && ws->fr[ws->face_in[sources[i].face]].skip)
             return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, i,
                              "source %ld lies on face %ld, which has zero area", (long)i,
                              (long)sources[i].face);
@@ -1062,12 +1176,34 @@ mfmm_status mfmm_exact_patch(mfmm_exact_ws *ws, const mfmm_source *sources, int3
     ex_fill_info(ws, info);
     if (st != MFMM_OK)
         return st;
-    /* touched vertices within the radius, moved to the front of touched
-     * (the rest stay behind them, so the next reset still clears them) */
+    /* the vertices whose distances are final, moved to the front of touched
+     * (the rest stay behind them, so the next reset still clears them):
+     * those within the radius, and those beyond it by less than their
+     * least height h over the opposite edges of their faces. A path to v
+     * ends with a segment in one of v's faces from the opposite edge (or
+     * along an edge from a neighbour u, |u v| >= h), so it crosses that
+     * edge (or passes u) at a distance <= d(v) - h <= radius: every window
+     * and pseudo-source on it was propagated, and d(v) is exact (d is an
+     * upper bound, the length of a real path, so d(v) - h <= radius holds
+     * for the true distance too). That ring is free and, seeded with the
+     * rest, lowers the march's mean error by 5-15 % (issue 12). */
     int32_t n = 0;
     for (int32_t i = 0; i < ws->n_touched; i++) {
         int32_t v = ws->touched[i];
-        if (ws->d[v] <= radius) {
+        double dv = ws->d[v];
+        int final = dv <= radius;
+        if (!final && dv < INFINITY) {
+            double h = INFINITY;
+            for (int32_t j = ws->vf_offset[v]; j < ws->vf_offset[v + 1]; j++) {
+                int32_t c = ex_corner(ws->vf_corner, ws->face_in, j);
+                const ex_face *r = ws->fr + c / 3;
+                if (!r->skip && r->cy[c % 3] < h)
+                    h = r->cy[c % 3];
+            }
+            final = dv - h <= radius;
+        }
+        if (final) {
+            ws->in_patch[v] = 1;
             ws->touched[i] = ws->touched[n];
             ws->touched[n] = v;
             ws->patch_d[n] = ws->d[v];
@@ -1076,4 +1212,9 @@ mfmm_status mfmm_exact_patch(mfmm_exact_ws *ws, const mfmm_source *sources, int3
     }
     *n_vertices = n;
     return MFMM_OK;
+}
+
+int mfmm_exact_in_patch(const mfmm_exact_ws *ws, int32_t v)
+{
+    return ws->in_patch[v];
 }

@@ -12,17 +12,35 @@
 
 typedef struct mfmm_exact_solver mfmm_exact_ws;
 
-/* The same as mfmm_exact_solver_create / _destroy. */
+/* A mesh's read-only tables (face records, fans, pseudo-source flags): built
+ * once and shared by the workspaces of any number of threads, which keep
+ * only a solve's state (issue 12: each thread built its own, ~430 B/vertex).
+ * The mesh must outlive them, and they every workspace made from them.
+ * mfmm_exact_tables_bytes: their size; mfmm_exact_ws_bytes: a workspace's
+ * (per vertex state, without the queue, which grows with the patch). */
+typedef struct mfmm_exact_tables mfmm_exact_tables;
+mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **out);
+void mfmm_exact_tables_destroy(mfmm_exact_tables *tables);
+size_t mfmm_exact_tables_bytes(const mfmm_mesh *mesh);
+size_t mfmm_exact_ws_bytes(const mfmm_mesh *mesh);
+
+/* A workspace on shared tables (not freed with it). */
+mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *tables, mfmm_exact_ws **out);
+
+/* A workspace with tables of its own: the same as mfmm_exact_solver_create
+ * / _destroy. */
 mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out);
 void mfmm_exact_ws_destroy(mfmm_exact_ws *ws);
 
-/* Exact distances from point sources within `radius` only: the "exact
- * start" of a march. Propagation stops once every window and pseudo-source
- * left is farther than radius, so the cost grows with the patch, not the
- * mesh (about 0.2 ms for 150 vertices on the 35k-vertex test meshes).
+/* Exact distances from point sources near them: the "exact start" of a
+ * march. Propagation stops once every window and pseudo-source left is
+ * farther than radius, so the cost grows with the patch, not the mesh
+ * (about 0.2 ms for 150 vertices on the 35k-vertex test meshes).
  * Sources as for mfmm_solve_exact (checked: MFMM_ERR_BAD_SOURCE and the
- * like); T = value + distance, and the patch is where T <= radius.
- *   n_vertices: receives the number of vertices with T <= radius.
+ * like); T = value + distance. The patch: every vertex with T <= radius,
+ * and the ring of those beyond it by less than their least height in their
+ * faces, whose T the propagation has also made final (exact.c).
+ *   n_vertices: receives the number of vertices in the patch.
  *   vertices, distances: receive arrays of that length owned by ws, valid
  *   until its next call (vertex ids, and their exact T), in no particular
  *   order.
@@ -34,5 +52,8 @@ mfmm_status mfmm_exact_patch(mfmm_exact_ws *ws, const mfmm_source *sources, int3
                              double radius, size_t memory_limit, int32_t *n_vertices,
                              const int32_t **vertices, const double **distances,
                              mfmm_exact_info *info);
+
+/* Whether vertex v is in the patch of ws's last mfmm_exact_patch. */
+int mfmm_exact_in_patch(const mfmm_exact_ws *ws, int32_t v);
 
 #endif /* MFMM_EXACT_H */

@@ -52,8 +52,9 @@ static int32_t cpu_block_rows(const mfmm_rows_job *job, int n_workers, int ring)
     size_t nv = (size_t)job->mesh->nv;
     size_t row_bytes = job->slot_bytes;
     size_t work = (size_t)n_workers * nv * 32; /* solver + a float64 row */
-    if (job->opt->exact_start_radius > 0.0) /* each solver's exact start */
-        work += (size_t)n_workers * mfmm_exact_start_bytes(job->mesh);
+    if (job->opt->exact_start_radius > 0.0) /* the exact start: tables once, state per solver */
+        work += mfmm_exact_start_shared_bytes(job->mesh) +
+                (size_t)n_workers * mfmm_exact_start_bytes(job->mesh);
     size_t left = job->budget > work ? job->budget - work : 0;
     /* ring 0: rows go straight into the caller's buffer */
     size_t rows = left / ((size_t)(ring > 0 ? ring : 1) * row_bytes);
@@ -251,6 +252,7 @@ typedef struct pool {
     mfmm_error fail_err;
     char *ring;               /* 2 blocks, or NULL when writing into out */
     int64_t settled;          /* vertices settled so far */
+    mfmm_exact_tables *exact; /* the workers' shared exact-start tables, or NULL */
 } pool;
 
 static int32_t block_len(const pool *p, int32_t b)
@@ -290,8 +292,10 @@ static void *pool_worker(void *arg)
     const mfmm_rows_job *job = p->job;
     mfmm_solver *solver = NULL;
     mfmm_status st = mfmm_solver_create(job->mesh, &solver);
-    if (st == MFMM_OK)
+    if (st == MFMM_OK) {
         mfmm_solver_fix_cost(solver, job->cost, job->cost_location);
+        mfmm_solver_share_exact(solver, p->exact);
+    }
     mfmm_solve_options so;
     fill_solve_options(job, &so);
     pthread_mutex_lock(&p->mu);
@@ -351,20 +355,29 @@ static mfmm_status run_threads(const mfmm_rows_job *job, int32_t start, mfmm_err
             return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1,
                              "out of memory for two blocks of %d rows", (int)p.block);
     }
+    /* one set of exact-start tables for all workers (seed.h) */
+    if (job->opt->exact_start_radius > 0.0 &&
+        mfmm_exact_tables_create(job->mesh, &p.exact) != MFMM_OK) {
+        free(p.ring);
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the exact start");
+    }
     pthread_t *tid = malloc((size_t)n_threads * sizeof *tid);
     if (!tid) {
+        mfmm_exact_tables_destroy(p.exact);
         free(p.ring);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for threads");
     }
     if (pthread_mutex_init(&p.mu, NULL) != 0) {
         free(tid);
         free(p.ring);
+        mfmm_exact_tables_destroy(p.exact);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "could not create a mutex");
     }
     if (pthread_cond_init(&p.cv_main, NULL) != 0) {
         pthread_mutex_destroy(&p.mu);
         free(tid);
         free(p.ring);
+        mfmm_exact_tables_destroy(p.exact);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "could not create a condition");
     }
     if (pthread_cond_init(&p.cv_worker, NULL) != 0) {
@@ -372,6 +385,7 @@ static mfmm_status run_threads(const mfmm_rows_job *job, int32_t start, mfmm_err
         pthread_mutex_destroy(&p.mu);
         free(tid);
         free(p.ring);
+        mfmm_exact_tables_destroy(p.exact);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "could not create a condition");
     }
     int started = 0;
@@ -422,6 +436,7 @@ static mfmm_status run_threads(const mfmm_rows_job *job, int32_t start, mfmm_err
     pthread_mutex_destroy(&p.mu);
     free(tid);
     free(p.ring);
+    mfmm_exact_tables_destroy(p.exact);
     return st;
 }
 

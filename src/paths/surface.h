@@ -6,15 +6,11 @@
 #include <math.h>
 
 #include "core/mesh.h"
+#include "core/start.h" /* mfmm_dist3 */
 
 #define ON_EDGE 1e-12 /* barycentric coordinate treated as 0 (on the edge) */
 
 static inline double mfmm_dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-static inline double mfmm_dist3(const double *a, const double *b)
-{
-    double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-    return sqrt(mfmm_dot3(d, d));
-}
 
 static inline void mfmm_bary_to_xyz(const mfmm_mesh *m, int32_t f, const double b[3], double x[3])
 {

@@ -8,6 +8,7 @@
 #define MFMM_SOLVE_SEED_H
 
 #include "core/mesh.h"
+#include "core/start.h"
 #include "exact/exact.h"
 
 /* Validates an exact_start_radius option (finite and >= 0). */
@@ -29,8 +30,20 @@ mfmm_status mfmm_exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const mf
                              int32_t *n, const int32_t **vertices, const double **distances,
                              double *F);
 
-/* Bytes an exact workspace takes for this mesh (its tables; the queue of a
- * patch is small), for memory budgets. */
+/* Seeds one checked source into a reset march state (cost fields set): its
+ * exact start (mfmm_exact_start, uniform as there) where that applies, at
+ * value + F * d, final where `fixed` (one source: the march never lowers
+ * them); for a point, also the straight start's vertices (core/start.h)
+ * beyond the patch, which the march may lower. Elsewhere the straight
+ * start alone. MFMM_ERR_OUT_OF_MEMORY as mfmm_exact_start. */
+mfmm_status mfmm_exact_start_seed(const mfmm_mesh *mesh, mfmm_exact_ws **ws,
+                                  mfmm_march_state *st, const mfmm_source *src, double radius,
+                                  const double *uniform, int fixed);
+
+/* Bytes the exact start takes: per thread (a workspace's state; the queue
+ * of a patch is small), and once per mesh or job (the read-only tables,
+ * exact.h, shared by the threads of a matrix job), for memory budgets. */
 size_t mfmm_exact_start_bytes(const mfmm_mesh *mesh);
+size_t mfmm_exact_start_shared_bytes(const mfmm_mesh *mesh);
 
 #endif

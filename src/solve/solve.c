@@ -26,6 +26,7 @@ struct mfmm_solver {
     const double *fixed_cost;
     int fixed_location;
     mfmm_exact_ws *exact; /* the exact start's workspace, made on first use */
+    const mfmm_exact_tables *exact_tables; /* shared tables for it, or NULL */
     mfmm_mapped_args args; /* mfmm_solve's arguments in internal order (order.h) */
 };
 
@@ -169,29 +170,22 @@ void mfmm_solver_fix_cost(mfmm_solver *solver, const double *cost, int cost_loca
     }
 }
 
-/* Seeds one source: its exact start where that applies (seed.h), else the
- * straight start. fixed: the exact values are final (one source; with
- * several, a vertex in one's patch may be nearer another, whose march must
- * be able to lower it). -1 when out of memory. */
+void mfmm_solver_share_exact(mfmm_solver *solver, const mfmm_exact_tables *tables)
+{
+    solver->exact_tables = tables;
+}
+
+/* Seeds one source (seed.h). fixed: the exact values are final (one source;
+ * with several, a vertex in one's patch may be nearer another, whose march
+ * must be able to lower it). -1 when out of memory. */
 static int seed_source(mfmm_solver *solver, mfmm_march_state *s, const mfmm_source *src,
                        double radius, int fixed)
 {
-    int32_t n = 0;
-    const int32_t *pv = NULL;
-    const double *pd = NULL;
-    double f = 1.0;
-    if (mfmm_exact_start(solver->mesh, &solver->exact, src, radius, s->cost,
-                         s->cost ? solver->uniform : NULL, &n, &pv, &pd, &f) != MFMM_OK)
+    if (!solver->exact && solver->exact_tables && radius > 0.0 &&
+        mfmm_exact_ws_create_shared(solver->exact_tables, &solver->exact) != MFMM_OK)
         return -1;
-    for (int32_t i = 0; i < n; i++) {
-        if (fixed)
-            mfmm_march_seed_fixed(s, pv[i], src->value + f * pd[i]);
-        else
-            mfmm_march_seed(s, pv[i], src->value + f * pd[i]);
-    }
-    if (n == 0)
-        mfmm_start_seed(solver->mesh, s, src);
-    return 0;
+    return mfmm_exact_start_seed(solver->mesh, &solver->exact, s, src, radius, solver->uniform,
+                                 fixed) == MFMM_OK ? 0 : -1;
 }
 
 /* One march into T (the caller's +inf-filled row, or the solver's own T);

@@ -663,15 +663,25 @@ static void test_patch(void **state)
         const double *ds = NULL;
         double r = 0.1;
         assert_int_equal(mfmm_exact_patch(fx.solver, &ps, 1, r, 0, &n, &vs, &ds, &part), MFMM_OK);
-        int32_t want = 0;
-        for (int32_t v = 0; v < fx.g.nv; v++)
-            want += dist3(fx.g.V + 3 * v, fx.g.V + 3 * src) <= r + 1e-12;
-        assert_true(n >= want - 4 && n <= want + 4); /* ties at the radius */
+        /* every vertex within r, and a ring beyond it of at most a
+         * face's height (1/40 here), all exact */
+        int32_t want = 0, most = 0;
+        for (int32_t v = 0; v < fx.g.nv; v++) {
+            double dv = dist3(fx.g.V + 3 * v, fx.g.V + 3 * src);
+            want += dv <= r + 1e-12;
+            most += dv <= r + 1.0 / 40 + 1e-12;
+        }
+        assert_true(n >= want - 4 && n <= most + 4); /* ties at the radius */
+        assert_true(n > want + 4);
+        int32_t inside = 0;
         for (int32_t i = 0; i < n; i++) {
             tm_assert_close(ds[i], dist3(fx.g.V + 3 * fx.mesh->to_external[vs[i]], fx.g.V + 3 * src),
                             1e-12);
-            assert_true(ds[i] <= r);
+            assert_true(ds[i] <= r + 1.0 / 40);
+            inside += ds[i] <= r;
+            assert_true(mfmm_exact_in_patch(fx.solver, vs[i]));
         }
+        assert_true(inside >= want - 4 && inside <= want + 4);
         assert_true(part.n_windows * 10 < full.n_windows);
     }
     /* NULLs and bad counts */

@@ -382,3 +382,30 @@ def test_back_to_back_jobs_on_one_mesh_and_client(hand, serial64, client, tmp_pa
         Z = md.distance_matrix(hand, str(tmp_path / f"b{k}.zarr"), sources=SOURCES[:24],
                                client=client, dtype="float64", block_rows=4, progress=False)
         assert np.array_equal(Z[:], serial64[:24])
+
+
+def test_exact_start_is_passed_through_and_part_of_the_job(hand, client, tmp_path):
+    """Issue 12: the option reaches the tasks (the rows equal the plain
+    start's serial rows), and the job records the radius, so a store
+    computed with one start is not resumed with another."""
+    src = SOURCES[:20]
+    store = str(tmp_path / "plain.zarr")
+    plain = hand.distance_matrix(src, backend="serial", dtype="float64", exact_start=False)
+    assert not np.array_equal(plain, hand.distance_matrix(src, backend="serial", dtype="float64"))
+    Z = md.distance_matrix(hand, store, sources=src, client=client, dtype="float64",
+                           block_rows=8, progress=False, exact_start=False)
+    assert np.array_equal(Z[:], plain)
+    assert Z.attrs[md.JOB_ATTR]["exact_start_radius"] == 0.0
+    with pytest.raises(ValueError, match="exact_start_radius"):
+        md.distance_matrix(hand, store, sources=src, client=client, dtype="float64",
+                           progress=False)
+    Z = md.distance_matrix(hand, str(tmp_path / "r3.zarr"), sources=src, client=client,
+                           dtype="float64", block_rows=8, progress=False, exact_start=3.5)
+    assert np.array_equal(Z[:], hand.distance_matrix(src, backend="serial", dtype="float64",
+                                                      exact_start=3.5))
+    # the default is recorded as the library's radius, and a radius is checked
+    job = md.job_description(hand, src, None, "float64", None, None, None, True)
+    assert job["exact_start_radius"] == 7.0
+    with pytest.raises(ValueError):
+        md.distance_matrix(hand, str(tmp_path / "bad.zarr"), sources=src, client=client,
+                           progress=False, exact_start=-1.0)

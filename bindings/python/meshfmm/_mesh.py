@@ -511,7 +511,7 @@ class Mesh:
             (then only settled vertices are final, the rest may be +inf).
         unfolding: False uses plain stencils at obtuse corners (for comparison).
         exact_start: True (default): the march starts from the exact
-            distances of the vertices within 6 mean edge lengths of each
+            distances of the vertices within 7 mean edge lengths of each
             source (about half the mean error of the paper's start); a
             number: that radius in mean edge lengths; False (or 0): the
             paper's plain start. With a cost, it applies where the cost is

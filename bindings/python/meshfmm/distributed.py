@@ -20,6 +20,7 @@ Needs ``dask[distributed]`` and ``zarr>=3``.
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import hashlib
 import json
 import math
@@ -31,7 +32,8 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from . import __version__
-from ._mesh import Mesh
+from . import _lib
+from ._mesh import Mesh, _exact_start
 
 __all__ = ["distance_matrix", "job_description", "complete_blocks", "symmetrize", "DASK_CONFIG"]
 
@@ -101,10 +103,13 @@ def _ids(x: Any, what: str, n: int) -> np.ndarray:
 
 def job_description(mesh: Mesh, sources: Optional[np.ndarray], targets: Optional[np.ndarray],
                     dtype: str, max_distance: Optional[float], cost: Optional[np.ndarray],
-                    cost_location: Optional[str], unfolding: bool) -> Dict[str, Any]:
+                    cost_location: Optional[str], unfolding: bool,
+                    exact_start_radius: Optional[float] = None) -> Dict[str, Any]:
     """What identifies a job (stored in the array's attributes): hashes of the
     mesh, sources, targets and cost, and the options that change the numbers.
-    The backend and block size do not change them and are not part of it."""
+    The backend and block size do not change them and are not part of it.
+    exact_start_radius: the radius of the exact start in mean edge lengths
+    (0: the plain start; None: the library's default, recorded as its value)."""
     V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
     F = np.ascontiguousarray(mesh.faces, dtype=np.int32)
     return {
@@ -121,7 +126,17 @@ def job_description(mesh: Mesh, sources: Optional[np.ndarray], targets: Optional
         "cost_sha256": _sha256(cost) if cost is not None else None,
         "cost_location": cost_location if cost is not None else None,
         "unfolding": bool(unfolding),
+        "exact_start_radius": _start_radius(exact_start_radius),
     }
+
+
+def _start_radius(radius: Optional[float]) -> float:
+    """The exact start's radius a job runs with: None -> the library's default."""
+    if radius is not None:
+        return float(radius)
+    o = _lib.mfmm_matrix_options()
+    _lib.mfmm_matrix_options_init(ctypes.byref(o))
+    return float(o.exact_start_radius)
 
 
 def _same_job(stored: Dict[str, Any], job: Dict[str, Any]) -> List[str]:
@@ -192,7 +207,8 @@ def _compute_block(key: str, V: np.ndarray, F: np.ndarray, url: str,
     rows_src = np.arange(r0, r1, dtype=np.int32) if src is None else src[r0:r1]
     kw = dict(backend=opts["backend"], dtype=opts["dtype"],
               n_threads=_task_threads(opts["n_threads"], opts.get("host_threads") or {}),
-              max_distance=opts["max_distance"], unfolding=opts["unfolding"])
+              max_distance=opts["max_distance"], unfolding=opts["unfolding"],
+              exact_start=opts.get("exact_start", True))
     if opts["cost"] is not None:
         kw.update(cost=opts["cost"], cost_location=opts["cost_location"])
     # the library's target columns: each row stops once its targets settle
@@ -310,7 +326,8 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                     block_rows: Optional[int] = None, backend: str = "threads",
                     n_threads: int = 0, max_distance: Optional[float] = None,
                     cost: Any = None, cost_location: Optional[str] = None,
-                    unfolding: bool = True, n_workers: Optional[int] = None,
+                    unfolding: bool = True, exact_start: Any = True,
+                    n_workers: Optional[int] = None,
                     storage_options: Optional[dict] = None, compression: str = "lz4",
                     progress: Any = True, retries: int = 3) -> Any:
     """Computes a dense S x N (or S x T) distance matrix as Dask tasks writing
@@ -335,7 +352,9 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         "serial", "opencl", "auto") and its threads (0: the worker's share of
         its machine, cores / Dask threads on that host, so a LocalCluster of
         one 1-thread process per core runs 1 library thread per task).
-    max_distance, cost, cost_location, unfolding: as in ``Mesh.distance``.
+    max_distance, cost, cost_location, unfolding, exact_start: as in
+        ``Mesh.distance``; the job records the exact start's radius, so a
+        store computed with another one is a different job.
     compression: "lz4" (Blosc lz4 with bit shuffle, the default), "zstd"
         (Blosc zstd level 3 with bit shuffle: ~2 % smaller, ~3x slower to
         encode) or "none"; chunks always carry a CRC-32C. Measured on real
@@ -368,6 +387,7 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         if not (float(max_distance) >= 0.0):
             raise ValueError(f"max_distance must be >= 0, not {max_distance}")
     cost_arr = None if cost is None else np.ascontiguousarray(cost, dtype=np.float64)
+    radius = _start_radius(_exact_start(exact_start))
     if compression not in _CODECS:
         raise ValueError(f"compression must be one of {', '.join(map(repr, _CODECS))}, "
                          f"not {compression!r}")
@@ -377,7 +397,7 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
     n_rows = nv if src is None else src.shape[0]
     n_cols = nv if tgt is None else tgt.shape[0]
     job = job_description(mesh, src, tgt, dt.name, max_distance, cost_arr, cost_location,
-                          unfolding)
+                          unfolding, radius)
 
     own_cluster = None
     quiet = contextlib.ExitStack()
@@ -457,7 +477,8 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                 progress(rows_done[0], n_rows)
 
         opts = {"backend": backend, "dtype": dt.name, "max_distance": max_distance,
-                "unfolding": unfolding, "cost": cost_arr, "cost_location": cost_location,
+                "unfolding": unfolding, "exact_start": radius,
+                "cost": cost_arr, "cost_location": cost_location,
                 "n_threads": n_threads, "host_threads": host_threads}
         V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
         F = np.ascontiguousarray(mesh.faces, dtype=np.int32)
@@ -552,6 +573,10 @@ def cli_allpairs_zarr(argv: Sequence[str]) -> int:
     ap.add_argument("--max-distance", type=float)
     ap.add_argument("--cost", help="per-vertex or per-face cost (.npy or .txt)")
     ap.add_argument("--backend", choices=["threads", "serial", "opencl", "auto"], default="threads")
+    st = ap.add_mutually_exclusive_group()
+    st.add_argument("--exact-start-radius", type=float, metavar="R",
+                    help="radius of the exact start in mean edge lengths (default: the library's)")
+    st.add_argument("--plain-start", action="store_true", help="the paper's plain start")
     ap.add_argument("--block-rows", type=int)
     ap.add_argument("--compression", choices=list(_CODECS), default="lz4",
                     help="Blosc lz4 or zstd (bit shuffle), or none (default: lz4)")
@@ -578,6 +603,9 @@ def cli_allpairs_zarr(argv: Sequence[str]) -> int:
                             dtype=a.dtype, resume=a.resume, block_rows=a.block_rows,
                             backend=a.backend, max_distance=a.max_distance, cost=cost,
                             n_workers=a.workers, progress=not a.no_progress,
+                            exact_start=(False if a.plain_start else
+                                         True if a.exact_start_radius is None
+                                         else a.exact_start_radius),
                             compression=a.compression)
         run = Z.attrs.get(RUN_ATTR, {})
         print(f"meshfmm: wrote {Z.shape[0]} x {Z.shape[1]} {Z.dtype} to {a.output} "
