@@ -198,10 +198,9 @@ typedef struct mfmm_solver mfmm_solver;
 
 /* A reusable workspace (heap, labels, a touched list) for one mesh and one
  * thread: about 40 bytes per vertex, plus, made by the first solve that uses
- * the exact start, an exact solver's workspace (about 156 bytes per face and
- * 45 per vertex, see mfmm_exact_solver_create; the threads of
- * mfmm_distance_matrix share its read-only part and keep 36 bytes per vertex
- * each). After that first solve, solving allocates nothing beyond a copy of
+ * the exact start, an exact solver's workspace (about 45 bytes per vertex;
+ * the mesh's exact tables, about 156 bytes per face, are built once per mesh
+ * and shared: see mfmm_exact_solver_create). After that first solve, solving allocates nothing beyond a copy of
  * its arguments in the mesh's internal vertex order (sources, targets, a
  * per-vertex cost), kept and reused while large enough (the exact start's
  * queue grows only for a larger patch than any before). Between solves the
@@ -275,11 +274,14 @@ MFMM_API mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources,
  * on no other face is +inf). Not for a cost: see mfmm_solve. */
 typedef struct mfmm_exact_solver mfmm_exact_solver;
 
-/* A workspace for one mesh and one thread: the mesh's edge geometry (about
- * 156 bytes per face) and per-vertex state (about 45 bytes per vertex),
- * plus a queue of windows (56 bytes each) that grows as needed and is kept
- * for the next solve (mfmm_exact_info.peak_bytes tells the total). Several
- * exact solvers may share one mesh, one per thread. */
+/* A workspace for one mesh and one thread: per-vertex state (about 45
+ * bytes per vertex) and a queue of windows (56 bytes each) that grows as
+ * needed and is kept for the next solve (mfmm_exact_info.peak_bytes tells
+ * the total). The mesh's edge geometry (about 156 bytes per face) is built by
+ * the first exact solver or exact start on the mesh, under a lock, kept by the
+ * mesh until mfmm_mesh_destroy and shared by every solver and thread on it,
+ * so a later job does not pay for it again. Several exact solvers may share
+ * one mesh, one per thread. */
 MFMM_API mfmm_status mfmm_exact_solver_create(const mfmm_mesh *mesh, mfmm_exact_solver **out);
 
 /* Frees an exact solver; NULL is a no-op. */

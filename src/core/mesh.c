@@ -44,6 +44,9 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh->virt_offset);
     free(mesh->virt_steps);
     free(mesh->strip);
+    if (mesh->exact_tables)
+        mesh->exact_tables_free(mesh->exact_tables);
+    pthread_mutex_destroy(&mesh->cache_lock);
     free(mesh);
 }
 
@@ -421,6 +424,10 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
     mfmm_mesh *m = calloc(1, sizeof *m);
     if (!m)
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
+    if (pthread_mutex_init(&m->cache_lock, NULL) != 0) {
+        free(m);
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "cannot make the mesh's lock");
+    }
     m->nv = nv;
     m->nf = nf;
     size_t nc = (size_t)nf * 3;
@@ -550,6 +557,7 @@ int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, i
         {"virt_offset", (nc + 1) * sizeof(int32_t)},
         {"virt_steps", n_steps * sizeof(mfmm_virt_step)},
         {"mesh struct", sizeof *mesh},
+        {"exact tables (once built)", mesh->exact_tables_bytes},
     };
     int n = (int)(sizeof a / sizeof a[0]);
     for (int i = 0; i < n && i < max; i++) {

@@ -153,10 +153,9 @@ struct mfmm_exact_tables {
     size_t bytes;
 };
 
-/* A workspace: the tables (its own or shared) and one solve's state. */
+/* A workspace: shared tables (the mesh's) and one solve's state. */
 struct mfmm_exact_solver {
     const mfmm_exact_tables *t;
-    mfmm_exact_tables *own; /* t, when this workspace built it */
     const mfmm_mesh *mesh;
     int32_t nv, nf;
     /* the tables' arrays (see mfmm_exact_tables) */
@@ -214,7 +213,6 @@ void mfmm_exact_ws_destroy(mfmm_exact_ws *ws)
 {
     if (!ws)
         return;
-    mfmm_exact_tables_destroy(ws->own);
     free(ws->in_angle);
     free(ws->d);
     free(ws->emitted);
@@ -523,22 +521,46 @@ mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *t, mfmm_exact_w
     return MFMM_OK;
 }
 
+static void tables_free(void *t)
+{
+    mfmm_exact_tables_destroy(t);
+}
+
+mfmm_status mfmm_exact_tables_of(const mfmm_mesh *mesh, const mfmm_exact_tables **out)
+{
+    if (!out)
+        return MFMM_ERR_NULL_POINTER;
+    *out = NULL;
+    if (!mesh)
+        return MFMM_ERR_NULL_POINTER;
+    /* the mesh's cache is the one mutable part of a built mesh (mesh.h) */
+    mfmm_mesh *m = (mfmm_mesh *)(uintptr_t)mesh;
+    mfmm_status st = MFMM_OK;
+    pthread_mutex_lock(&m->cache_lock);
+    if (!m->exact_tables) {
+        mfmm_exact_tables *t = NULL;
+        st = mfmm_exact_tables_create(mesh, &t);
+        if (st == MFMM_OK) {
+            m->exact_tables = t;
+            m->exact_tables_free = tables_free;
+            m->exact_tables_bytes = t->bytes;
+        }
+    }
+    *out = m->exact_tables;
+    pthread_mutex_unlock(&m->cache_lock);
+    return st;
+}
+
 mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out)
 {
     if (!out)
         return MFMM_ERR_NULL_POINTER;
     *out = NULL;
-    mfmm_exact_tables *t = NULL;
-    mfmm_status st = mfmm_exact_tables_create(mesh, &t);
+    const mfmm_exact_tables *t = NULL;
+    mfmm_status st = mfmm_exact_tables_of(mesh, &t);
     if (st != MFMM_OK)
         return st;
-    st = mfmm_exact_ws_create_shared(t, out);
-    if (st != MFMM_OK) {
-        mfmm_exact_tables_destroy(t);
-        return st;
-    }
-    (*out)->own = t;
-    return MFMM_OK;
+    return mfmm_exact_ws_create_shared(t, out);
 }
 
 mfmm_status mfmm_exact_solver_create(const mfmm_mesh *mesh, mfmm_exact_solver **out)

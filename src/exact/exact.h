@@ -24,11 +24,16 @@ void mfmm_exact_tables_destroy(mfmm_exact_tables *tables);
 size_t mfmm_exact_tables_bytes(const mfmm_mesh *mesh);
 size_t mfmm_exact_ws_bytes(const mfmm_mesh *mesh);
 
+/* The mesh's own tables (mesh->exact_tables): built on first use under the
+ * mesh's lock, then shared by every workspace on the mesh until the mesh is
+ * destroyed. MFMM_ERR_OUT_OF_MEMORY when they cannot be built. */
+mfmm_status mfmm_exact_tables_of(const mfmm_mesh *mesh, const mfmm_exact_tables **out);
+
 /* A workspace on shared tables (not freed with it). */
 mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *tables, mfmm_exact_ws **out);
 
-/* A workspace with tables of its own: the same as mfmm_exact_solver_create
- * / _destroy. */
+/* A workspace on the mesh's tables (mfmm_exact_tables_of): the same as
+ * mfmm_exact_solver_create / _destroy. */
 mfmm_status mfmm_exact_ws_create(const mfmm_mesh *mesh, mfmm_exact_ws **out);
 void mfmm_exact_ws_destroy(mfmm_exact_ws *ws);
 

@@ -252,7 +252,6 @@ typedef struct pool {
     mfmm_error fail_err;
     char *ring;               /* 2 blocks, or NULL when writing into out */
     int64_t settled;          /* vertices settled so far */
-    mfmm_exact_tables *exact; /* the workers' shared exact-start tables, or NULL */
 } pool;
 
 static int32_t block_len(const pool *p, int32_t b)
@@ -292,10 +291,8 @@ static void *pool_worker(void *arg)
     const mfmm_rows_job *job = p->job;
     mfmm_solver *solver = NULL;
     mfmm_status st = mfmm_solver_create(job->mesh, &solver);
-    if (st == MFMM_OK) {
+    if (st == MFMM_OK)
         mfmm_solver_fix_cost(solver, job->cost, job->cost_location);
-        mfmm_solver_share_exact(solver, p->exact);
-    }
     mfmm_solve_options so;
     fill_solve_options(job, &so);
     pthread_mutex_lock(&p->mu);
@@ -355,29 +352,27 @@ static mfmm_status run_threads(const mfmm_rows_job *job, int32_t start, mfmm_err
             return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1,
                              "out of memory for two blocks of %d rows", (int)p.block);
     }
-    /* one set of exact-start tables for all workers (seed.h) */
+    /* the exact start's tables: the mesh's, built now if not yet (exact.h) */
+    const mfmm_exact_tables *tables = NULL;
     if (job->opt->exact_start_radius > 0.0 &&
-        mfmm_exact_tables_create(job->mesh, &p.exact) != MFMM_OK) {
+        mfmm_exact_tables_of(job->mesh, &tables) != MFMM_OK) {
         free(p.ring);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the exact start");
     }
     pthread_t *tid = malloc((size_t)n_threads * sizeof *tid);
     if (!tid) {
-        mfmm_exact_tables_destroy(p.exact);
         free(p.ring);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for threads");
     }
     if (pthread_mutex_init(&p.mu, NULL) != 0) {
         free(tid);
         free(p.ring);
-        mfmm_exact_tables_destroy(p.exact);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "could not create a mutex");
     }
     if (pthread_cond_init(&p.cv_main, NULL) != 0) {
         pthread_mutex_destroy(&p.mu);
         free(tid);
         free(p.ring);
-        mfmm_exact_tables_destroy(p.exact);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "could not create a condition");
     }
     if (pthread_cond_init(&p.cv_worker, NULL) != 0) {
@@ -385,7 +380,6 @@ static mfmm_status run_threads(const mfmm_rows_job *job, int32_t start, mfmm_err
         pthread_mutex_destroy(&p.mu);
         free(tid);
         free(p.ring);
-        mfmm_exact_tables_destroy(p.exact);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "could not create a condition");
     }
     int started = 0;
@@ -436,7 +430,6 @@ static mfmm_status run_threads(const mfmm_rows_job *job, int32_t start, mfmm_err
     pthread_mutex_destroy(&p.mu);
     free(tid);
     free(p.ring);
-    mfmm_exact_tables_destroy(p.exact);
     return st;
 }
 

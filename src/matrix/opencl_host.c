@@ -805,7 +805,8 @@ static mfmm_status batch_seeds(const mfmm_rows_job *job, mfmm_exact_ws **ws,
         const double *pd = NULL;
         double f = 1.0;
         mfmm_status st = mfmm_exact_start(job->mesh, ws, &src, job->opt->exact_start_radius,
-                                          job->cost, job->cost ? uniform : NULL, &n, &pv, &pd, &f);
+                                          job->opt->max_distance, job->cost,
+                                          job->cost ? uniform : NULL, &n, &pv, &pd, &f);
         if (st != MFMM_OK)
             return st;
         b->idx[i] = (int32_t)pos;

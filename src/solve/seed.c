@@ -36,9 +36,9 @@ static double reach_around(const mfmm_mesh *m, int32_t v, const double *p)
 
 /* mfmm_exact_start, and in *patch_radius the patch's radius (0 when *n is 0). */
 static mfmm_status exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const mfmm_source *src,
-                               double radius, const double *cost, const double *uniform,
-                               int32_t *n, const int32_t **vertices, const double **distances,
-                               double *F, double *patch_radius)
+                               double radius, double max_d, const double *cost,
+                               const double *uniform, int32_t *n, const int32_t **vertices,
+                               const double **distances, double *F, double *patch_radius)
 {
     *n = 0;
     *patch_radius = 0.0;
@@ -73,8 +73,8 @@ static mfmm_status exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const 
             s.bary[0] = b[0];
             s.bary[1] = b[1];
             s.bary[2] = b[2];
-            return exact_start(mesh, ws, &s, radius, cost, uniform, n, vertices, distances, F,
-                               patch_radius);
+            return exact_start(mesh, ws, &s, radius, max_d, cost, uniform, n, vertices,
+                               distances, F, patch_radius);
         } else {
             /* its own faces' corners (both faces of an edge it lies on) */
             for (int k = 0; k < 3; k++)
@@ -97,7 +97,12 @@ static mfmm_status exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const 
         if (st != MFMM_OK)
             return st;
     }
-    double R = fmax(radius * mesh->info.mean_edge_length, reach * (1.0 + 1e-12));
+    double R = radius * mesh->info.mean_edge_length;
+    /* past max_d the row is +inf: a local row (issue 11) needs no more, and
+     * is then exact where it is finite */
+    if (max_d < R * f)
+        R = max_d / f * (1.0 + 1e-9);
+    R = fmax(R, reach * (1.0 + 1e-12));
     int32_t np = 0;
     const int32_t *pv = NULL;
     const double *pd = NULL;
@@ -119,12 +124,13 @@ static mfmm_status exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const 
 }
 
 mfmm_status mfmm_exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const mfmm_source *src,
-                             double radius, const double *cost, const double *uniform,
-                             int32_t *n, const int32_t **vertices, const double **distances,
-                             double *F)
+                             double radius, double max_distance, const double *cost,
+                             const double *uniform, int32_t *n, const int32_t **vertices,
+                             const double **distances, double *F)
 {
     double R;
-    return exact_start(mesh, ws, src, radius, cost, uniform, n, vertices, distances, F, &R);
+    return exact_start(mesh, ws, src, radius, max_distance - src->value, cost, uniform, n,
+                       vertices, distances, F, &R);
 }
 
 typedef struct beyond_ctx {
@@ -153,8 +159,8 @@ mfmm_status mfmm_exact_start_seed(const mfmm_mesh *mesh, mfmm_exact_ws **ws,
     const int32_t *pv = NULL;
     const double *pd = NULL;
     double f = 1.0, R = 0.0;
-    mfmm_status status = exact_start(mesh, ws, src, radius, st->cost, st->cost ? uniform : NULL,
-                                     &n, &pv, &pd, &f, &R);
+    mfmm_status status = exact_start(mesh, ws, src, radius, st->max_distance - src->value,
+                                     st->cost, st->cost ? uniform : NULL, &n, &pv, &pd, &f, &R);
     if (status != MFMM_OK)
         return status;
     if (n == 0) {

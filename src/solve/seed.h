@@ -20,15 +20,17 @@ mfmm_status mfmm_check_exact_start(double radius, mfmm_error *err);
  * order. Applies only where the cost is one F over the patch: uniform (see
  * mfmm_uniform_cost, NULL when cost is NULL) equal at every patch vertex;
  * elsewhere, and for radius 0, *n is 0 and the caller takes the straight
- * start (core/start.h). *ws is the exact workspace, made here on first use
+ * start (core/start.h). The patch ends at max_distance (T beyond it is
+ * +inf in the row), so that a local row costs its reach and is exact where
+ * it is finite within the radius. *ws is the exact workspace, made here on first use
  * (the caller frees it with mfmm_exact_ws_destroy).
  *   n, vertices, distances: the patch (arrays of *ws, valid until its next
  *   use); F: the cost there (1 without a cost).
  * MFMM_ERR_OUT_OF_MEMORY when the workspace or its queue cannot grow. */
 mfmm_status mfmm_exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const mfmm_source *src,
-                             double radius, const double *cost, const double *uniform,
-                             int32_t *n, const int32_t **vertices, const double **distances,
-                             double *F);
+                             double radius, double max_distance, const double *cost,
+                             const double *uniform, int32_t *n, const int32_t **vertices,
+                             const double **distances, double *F);
 
 /* Seeds one checked source into a reset march state (cost fields set): its
  * exact start (mfmm_exact_start, uniform as there) where that applies, at
@@ -41,8 +43,8 @@ mfmm_status mfmm_exact_start_seed(const mfmm_mesh *mesh, mfmm_exact_ws **ws,
                                   const double *uniform, int fixed);
 
 /* Bytes the exact start takes: per thread (a workspace's state; the queue
- * of a patch is small), and once per mesh or job (the read-only tables,
- * exact.h, shared by the threads of a matrix job), for memory budgets. */
+ * of a patch is small), and once per mesh (the read-only tables, exact.h,
+ * built on first use and kept by the mesh), for memory budgets. */
 size_t mfmm_exact_start_bytes(const mfmm_mesh *mesh);
 size_t mfmm_exact_start_shared_bytes(const mfmm_mesh *mesh);
 

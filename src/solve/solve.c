@@ -26,7 +26,6 @@ struct mfmm_solver {
     const double *fixed_cost;
     int fixed_location;
     mfmm_exact_ws *exact; /* the exact start's workspace, made on first use */
-    const mfmm_exact_tables *exact_tables; /* shared tables for it, or NULL */
     mfmm_mapped_args args; /* mfmm_solve's arguments in internal order (order.h) */
 };
 
@@ -170,20 +169,12 @@ void mfmm_solver_fix_cost(mfmm_solver *solver, const double *cost, int cost_loca
     }
 }
 
-void mfmm_solver_share_exact(mfmm_solver *solver, const mfmm_exact_tables *tables)
-{
-    solver->exact_tables = tables;
-}
-
 /* Seeds one source (seed.h). fixed: the exact values are final (one source;
  * with several, a vertex in one's patch may be nearer another, whose march
  * must be able to lower it). -1 when out of memory. */
 static int seed_source(mfmm_solver *solver, mfmm_march_state *s, const mfmm_source *src,
                        double radius, int fixed)
 {
-    if (!solver->exact && solver->exact_tables && radius > 0.0 &&
-        mfmm_exact_ws_create_shared(solver->exact_tables, &solver->exact) != MFMM_OK)
-        return -1;
     return mfmm_exact_start_seed(solver->mesh, &solver->exact, s, src, radius, solver->uniform,
                                  fixed) == MFMM_OK ? 0 : -1;
 }

@@ -28,11 +28,6 @@ int32_t mfmm_solve_local(mfmm_solver *solver, const mfmm_source *sources, int32_
  * per solve. NULL cost: forget it. */
 void mfmm_solver_fix_cost(mfmm_solver *solver, const double *cost, int cost_location);
 
-/* For the threads of one job: the exact start's workspace, made on first
- * use, takes these read-only tables (built once for the job, outliving the
- * solver's solves) instead of building its own. Call before the first solve. */
-void mfmm_solver_share_exact(mfmm_solver *solver, const mfmm_exact_tables *tables);
-
 /* mfmm_solve after its checks: maps the sources, targets and a per-vertex
  * cost (input vertex ids) to internal order, marches, and writes
  * distances in input order. options must not be NULL. */

@@ -168,3 +168,35 @@ def test_point_sources_never_worse(name):
         assert np.all(np.isfinite(ours) == np.isfinite(e))
         ours = np.mean(np.abs(ours[ok] - e[ok]) / e[ok])
         assert ours <= plain, (p.face, list(p.bary), ours / plain)
+
+
+@pytest.mark.parametrize("backend", ["serial", "threads", "opencl"])
+def test_local_rows_within_the_radius_are_exact(backend):
+    """A row with max_distance inside the exact start's radius is the exact
+    patch (issue 11: the patch ends at max_distance, so a local row costs its
+    reach): equal to the exact solver to 1e-12 where finite, +inf exactly
+    where the exact distance passes max_distance; the same on every backend
+    (sparse on the CPU ones, dense rows on OpenCL)."""
+    need_data()
+    m = mesh("wingnut.obj")
+    h = m.info.mean_edge_length
+    r = 4.0 * h  # inside the default radius (7 mean edges)
+    src = [5, 80, 2593, 1000]
+    exact = np.stack([m.distance(s, method="exact") for s in src])
+    try:
+        if backend == "opencl":
+            D = m.distance_matrix(src, backend=backend, dtype="float64", max_distance=r)
+        else:
+            D = m.distance_matrix(src, backend=backend, dtype="float64", max_distance=r,
+                                  sparse=True, n_threads=2).toarray()
+            D[D == 0] = np.inf
+            D[np.arange(len(src)), src] = 0.0
+    except meshfmm.OpenCLError as exc:
+        pytest.skip(f"no OpenCL device: {exc}")
+    finite = np.isfinite(D)
+    near = exact <= r * (1 - 1e-9)
+    far = exact > r * (1 + 1e-9)
+    assert np.all(finite[near]) and not np.any(finite[far])
+    assert np.max(np.abs(D[finite] - exact[finite]) / np.maximum(exact[finite], h)) < 1e-12
+    plain = np.stack([m.distance(s, max_distance=r, exact_start=False) for s in src])
+    assert np.max(np.abs(plain[near] - exact[near])) > 1e-6  # what the patch replaces
