@@ -198,5 +198,7 @@ def test_local_rows_within_the_radius_are_exact(backend):
     far = exact > r * (1 + 1e-9)
     assert np.all(finite[near]) and not np.any(finite[far])
     assert np.max(np.abs(D[finite] - exact[finite]) / np.maximum(exact[finite], h)) < 1e-12
+    ref = np.stack([m.distance(s, max_distance=r) for s in src])  # the serial core
+    assert np.array_equal(D.view(np.uint64), ref.view(np.uint64))
     plain = np.stack([m.distance(s, max_distance=r, exact_start=False) for s in src])
     assert np.max(np.abs(plain[near] - exact[near])) > 1e-6  # what the patch replaces
