@@ -539,6 +539,11 @@ int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, i
     size_t nv = (size_t)mesh->nv, nf = (size_t)mesh->nf, nc = 3 * nf;
     size_t n_steps = (size_t)mesh->virt_offset[nc];
     size_t n_upd = (size_t)mesh->update_offset[nv];
+    /* the exact tables may be built by another thread meanwhile (mesh.h) */
+    pthread_mutex_t *lock = (pthread_mutex_t *)(uintptr_t)&mesh->cache_lock;
+    pthread_mutex_lock(lock);
+    size_t exact_bytes = mesh->exact_tables_bytes;
+    pthread_mutex_unlock(lock);
     const struct {
         const char *name;
         size_t bytes;
@@ -557,7 +562,7 @@ int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, i
         {"virt_offset", (nc + 1) * sizeof(int32_t)},
         {"virt_steps", n_steps * sizeof(mfmm_virt_step)},
         {"mesh struct", sizeof *mesh},
-        {"exact tables (once built)", mesh->exact_tables_bytes},
+        {"exact tables (once built)", exact_bytes},
     };
     int n = (int)(sizeof a / sizeof a[0]);
     for (int i = 0; i < n && i < max; i++) {
