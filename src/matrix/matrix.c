@@ -52,9 +52,9 @@ static int32_t cpu_block_rows(const mfmm_rows_job *job, int n_workers, int ring)
     size_t nv = (size_t)job->mesh->nv;
     size_t row_bytes = job->slot_bytes;
     size_t work = (size_t)n_workers * nv * 32; /* solver + a float64 row */
-    if (job->opt->exact_start_radius > 0.0) /* the exact start: tables once, state per solver */
-        work += mfmm_exact_start_shared_bytes(job->mesh) +
-                (size_t)n_workers * mfmm_exact_start_bytes(job->mesh);
+    if (job->opt->exact_start_radius > 0.0) /* each solver's exact-start state (the tables
+                                               are the mesh's, not the job's) */
+        work += (size_t)n_workers * mfmm_exact_start_bytes(job->mesh);
     size_t left = job->budget > work ? job->budget - work : 0;
     /* ring 0: rows go straight into the caller's buffer */
     size_t rows = left / ((size_t)(ring > 0 ? ring : 1) * row_bytes);

@@ -17,11 +17,6 @@ size_t mfmm_exact_start_bytes(const mfmm_mesh *mesh)
     return mfmm_exact_ws_bytes(mesh);
 }
 
-size_t mfmm_exact_start_shared_bytes(const mfmm_mesh *mesh)
-{
-    return mfmm_exact_tables_bytes(mesh);
-}
-
 /* The longest distance from p to a corner of a face around vertex v. */
 static double reach_around(const mfmm_mesh *m, int32_t v, const double *p)
 {

@@ -42,10 +42,9 @@ mfmm_status mfmm_exact_start_seed(const mfmm_mesh *mesh, mfmm_exact_ws **ws,
                                   mfmm_march_state *st, const mfmm_source *src, double radius,
                                   const double *uniform, int fixed);
 
-/* Bytes the exact start takes: per thread (a workspace's state; the queue
- * of a patch is small), and once per mesh (the read-only tables, exact.h,
- * built on first use and kept by the mesh), for memory budgets. */
+/* Bytes the exact start takes per thread (a workspace's state; the queue
+ * of a patch is small), for memory budgets; the read-only tables (exact.h)
+ * are the mesh's, built on first use and kept with it. */
 size_t mfmm_exact_start_bytes(const mfmm_mesh *mesh);
-size_t mfmm_exact_start_shared_bytes(const mfmm_mesh *mesh);
 
 #endif
