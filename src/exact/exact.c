@@ -100,6 +100,10 @@
 /* a vertex whose angle sum exceeds 2 pi by this much is a saddle */
 #define EX_SADDLE_TOL 1e-12
 
+/* k + 1 and k - 1 modulo 3, looked up: with k of a random window, a
+ * comparison there is a branch mispredicted about half the time */
+static const int8_t ex_next[3] = {1, 2, 0}, ex_prev[3] = {2, 0, 1};
+
 /* A face: for each corner k, the edge opposite it (half-edge 3f+k, from
  * corner k+1 to k+2): its length, corner k in its frame (x along the edge,
  * y > 0), and the same edge in the face across it (3g+m, -1 at a wall) with
@@ -772,29 +776,51 @@ static void ex_set_in(mfmm_exact_ws *ws, int32_t v, int32_t c, double psi, doubl
  * and dB (at L). sigma + |I X| - (dA + t) does not increase with t, so the
  * part beaten by A is [0, t*), t* the root of
  * sigma + sqrt((t - px)^2 + py^2) = dA + t; likewise from B. Returns 0 when
- * too little is left. */
+ * too little is left, and in *cut whether an end moved. Most windows are not
+ * cut: t* <= b0 is decided by a product (with 1e-12 L to spare, far more
+ * than the rounding of the quotient), and the division is done only when it
+ * may not hold, so the ends are those the quotient gives. */
 static int ex_trim(double px, double py, double sigma, double L, double dA, double dB,
-                   double *b0, double *b1)
+                   double *b0, double *b1, int *cut)
 {
     double py2 = py * py;
     double a = dA - sigma;
     if (a < INFINITY) {
         if (px + a <= 0.0)
             return 0;
-        double t = (px * px + py2 - a * a) / (2.0 * (px + a));
-        if (t > *b0)
-            *b0 = t;
+        double num = px * px + py2 - a * a, den = 2.0 * (px + a);
+        if (num >= (*b0 - 1e-12 * L) * den) {
+            double t = num / den;
+            if (t > *b0) {
+                *b0 = t;
+                *cut = 1;
+            }
+        }
     }
     a = dB - sigma;
     if (a < INFINITY) {
         double qx = L - px;
         if (qx + a <= 0.0)
             return 0;
-        double t = L - (qx * qx + py2 - a * a) / (2.0 * (qx + a));
-        if (t < *b1)
-            *b1 = t;
+        double num = qx * qx + py2 - a * a, den = 2.0 * (qx + a);
+        if (num >= (L - *b1 - 1e-12 * L) * den) {
+            double t = L - num / den;
+            if (t < *b1) {
+                *b1 = t;
+                *cut = 1;
+            }
+        }
     }
     return *b1 - *b0 > EX_MIN_WIDTH * L;
+}
+
+/* The distance from x to the interval [s0, s1] (s0 <= s1), as maxima
+ * (no branch) */
+static double ex_gap(double x, double s0, double s1)
+{
+    double lo = s0 - x, hi = x - s1;
+    double g = lo > hi ? lo : hi;
+    return g > 0.0 ? g : 0.0;
 }
 
 /* A window on half-edge h = 3f+k in f's frame (I on f's side: iy >= 0),
@@ -806,31 +832,45 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
 {
     const ex_face *r = ws->fr + h / 3;
     int k = h % 3;
-    int32_t va = r->v[k == 2 ? 0 : k + 1], vb = r->v[k == 0 ? 2 : k - 1], vr = r->v[k];
+    int k1 = ex_next[k], k2 = ex_prev[k];
+    int32_t va = r->v[k1], vb = r->v[k2], vr = r->v[k];
     double L = r->len[k];
     if (s0 < 0.0)
         s0 = 0.0;
     if (s1 > L)
         s1 = L;
     double iy2 = iy * iy;
-    double ra = sqrt(ix * ix + iy2), rb = sqrt((ix - L) * (ix - L) + iy2);
-    if (s0 <= EX_POS_TOL * L && ex_update(ws, va, sigma + ra, 0))
-        ex_set_in(ws, va, h - k + (k == 2 ? 0 : k + 1), atan2(iy, ix), ra, L);
-    if (s1 >= L - EX_POS_TOL * L && ex_update(ws, vb, sigma + rb, 0)) {
-        int32_t c = h - k + (k == 0 ? 2 : k - 1);
-        ex_set_in(ws, vb, c, ws->fr[c / 3].angle[c % 3] - atan2(iy, L - ix), rb, L);
+    if (s0 <= EX_POS_TOL * L) {
+        double ra = sqrt(ix * ix + iy2);
+        if (ex_update(ws, va, sigma + ra, 0))
+            ex_set_in(ws, va, h - k + k1, atan2(iy, ix), ra, L);
+    }
+    if (s1 >= L - EX_POS_TOL * L) {
+        double rb = sqrt((ix - L) * (ix - L) + iy2);
+        if (ex_update(ws, vb, sigma + rb, 0)) {
+            int32_t c = h - k + k2;
+            ex_set_in(ws, vb, c, ws->fr[c / 3].angle[c % 3] - atan2(iy, L - ix), rb, L);
+        }
     }
     int32_t g = r->across[k];
     if (g < 0 || !(s1 - s0 > EX_MIN_WIDTH * L))
         return;
-    /* pruning against the face the window leaves */
-    if (!ex_trim(ix, -iy, sigma, L, ws->d[va], ws->d[vb], &s0, &s1))
-        return;
-    /* the least distance: at the foot of I, or at the nearer end */
-    double dx = ix < s0 ? s0 - ix : ix > s1 ? ix - s1 : 0.0;
+    /* the least distance: at the foot of I, or at the nearer end; trimming
+     * only raises it, so a window beyond max_d is dropped before it */
+    double dx = ex_gap(ix, s0, s1);
     double key = sigma + (dx > 0.0 ? sqrt(dx * dx + iy2) : iy);
     if (key > ws->max_d)
         return;
+    /* pruning against the face the window leaves */
+    int cut = 0;
+    if (!ex_trim(ix, -iy, sigma, L, ws->d[va], ws->d[vb], &s0, &s1, &cut))
+        return;
+    if (cut) {
+        dx = ex_gap(ix, s0, s1);
+        key = sigma + (dx > 0.0 ? sqrt(dx * dx + iy2) : iy);
+        if (key > ws->max_d)
+            return;
+    }
     /* key > d(R) + max |R E|, without a square root */
     double rx = r->cx[k], ry = r->cy[k];
     double r0 = (rx - s0) * (rx - s0), r1 = (rx - s1) * (rx - s1);
@@ -841,15 +881,12 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
     if (wi < 0)
         return;
     ex_entry *w = ws->heap + wi;
-    if (r->flip[k]) {
-        w->b0 = L - s1;
-        w->b1 = L - s0;
-        w->px = L - ix;
-    } else {
-        w->b0 = s0;
-        w->b1 = s1;
-        w->px = ix;
-    }
+    /* the edge as the face across sees it (selected, not branched on) */
+    int fl = r->flip[k];
+    double e0[2] = {s0, L - s1}, e1[2] = {s1, L - s0}, ex[2] = {ix, L - ix};
+    w->b0 = e0[fl];
+    w->b1 = e1[fl];
+    w->px = ex[fl];
     w->py = -iy;
     w->sigma = sigma;
     w->he = g;
@@ -898,7 +935,7 @@ static void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
             ex_set_in(ws, vc, h, atan2(fabs(cr), dt), rc, L);
         }
     }
-    int m1 = m == 2 ? 0 : m + 1, m2 = m == 0 ? 2 : m - 1;
+    int m1 = ex_next[m], m2 = ex_prev[m];
     if (b0 < tc) {
         /* left child: edge C -> A (half-edge 3f+m2), rays through [b0, min(b1, tc)] */
         int32_t hl = 3 * f + m2;
