@@ -855,6 +855,12 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
     int32_t g = r->across[k];
     if (g < 0 || !(s1 - s0 > EX_MIN_WIDTH * L))
         return;
+#ifdef __GNUC__
+    /* the face the window will cross, read when it is popped: after a
+     * march has run through the mesh its record is far from the core */
+    __builtin_prefetch((const char *)(ws->fr + g / 3));
+    __builtin_prefetch((const char *)(ws->fr + g / 3) + 64);
+#endif
     /* the least distance: at the foot of I, or at the nearer end; trimming
      * only raises it, so a window beyond max_d is dropped before it */
     double dx = ex_gap(ix, s0, s1);
