@@ -67,8 +67,8 @@
  *
  * Memory: per-mesh tables (a 128-byte record per face with its edges'
  * lengths, each corner in the frame of the opposite edge, the edges across
- * and the vertices; corner and fan angles: about 180 bytes per face, 45 per
- * vertex), and the queue's entries (windows and vertex events, 56 bytes
+ * and the vertices; corner and fan angles: about 160 bytes per face; per
+ * vertex its flags, angle sum and least height, 17 bytes), and the queue's entries (windows and vertex events, 56 bytes
  * each), grown by doubling within memory_limit. No recursion. */
 #include <float.h>
 #include <math.h>
@@ -153,6 +153,9 @@ struct mfmm_exact_tables {
      * NaN where the fan is not one closed disk (walls, zero-area faces,
      * non-manifold vertices): those start windows in every direction */
     double *fan_a0, *fan_total;
+    /* (nv,) a vertex's least height over the opposite edges of its faces
+     * (+inf with none): the patch's free ring (mfmm_exact_patch) */
+    double *height;
     double inv_w;      /* 1 / bucket width */
     size_t bytes;
 };
@@ -166,7 +169,7 @@ struct mfmm_exact_solver {
     const int32_t *vf_offset, *vf_corner, *face_in;
     const ex_face *fr;
     const uint8_t *pseudo;
-    const double *fan_a0, *fan_total;
+    const double *fan_a0, *fan_total, *height;
     double inv_w;
     double *in_angle;  /* (nv,) direction (fan angle) back along the path that gave d */
     double *d;         /* (nv,) best distance so far, +inf untouched */
@@ -210,6 +213,7 @@ void mfmm_exact_tables_destroy(mfmm_exact_tables *t)
     free(t->pseudo);
     free(t->fan_a0);
     free(t->fan_total);
+    free(t->height);
     free(t);
 }
 
@@ -316,7 +320,7 @@ size_t mfmm_exact_tables_bytes(const mfmm_mesh *mesh)
     size_t nv = (size_t)mesh->nv, nf = (size_t)mesh->nf;
     return sizeof(mfmm_exact_tables) + nf * sizeof(ex_face) + 64 +
            nf * (sizeof(int32_t) + 3 * sizeof(double)) +
-           nv * (1 + sizeof(double));
+           nv * (1 + 2 * sizeof(double));
 }
 
 size_t mfmm_exact_ws_bytes(const mfmm_mesh *mesh)
@@ -355,8 +359,9 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
     int32_t *cnt = calloc(nv + 1, sizeof *cnt);
     t->fan_a0 = malloc((nh ? nh : 1) * sizeof *t->fan_a0);
     t->fan_total = malloc((nv ? nv : 1) * sizeof *t->fan_total);
+    t->height = malloc((nv ? nv : 1) * sizeof *t->height);
     if (!t->fr_block || !t->face_in || !t->pseudo || !angle || !cnt ||
-        !t->fan_a0 || !t->fan_total) {
+        !t->fan_a0 || !t->fan_total || !t->height) {
         free(angle);
         free(cnt);
         mfmm_exact_tables_destroy(t);
@@ -473,6 +478,16 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
     for (size_t v = 0; v < nv; v++)
         if (t->vf_offset[v + 1] > t->vf_offset[v] && isnan(t->fan_total[v]))
             t->pseudo[v] = 1;
+    for (size_t v = 0; v < nv; v++) {
+        double h = INFINITY;
+        for (int32_t j = t->vf_offset[v]; j < t->vf_offset[v + 1]; j++) {
+            int32_t c = ex_corner(t->vf_corner, t->face_in, j);
+            const ex_face *r = t->fr + c / 3;
+            if (!r->skip && r->cy[c % 3] < h)
+                h = r->cy[c % 3];
+        }
+        t->height[v] = h;
+    }
     *out = t;
     return MFMM_OK;
 }
@@ -499,6 +514,7 @@ mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *t, mfmm_exact_w
     ws->pseudo = t->pseudo;
     ws->fan_a0 = t->fan_a0;
     ws->fan_total = t->fan_total;
+    ws->height = t->height;
     ws->inv_w = t->inv_w;
     ws->d = malloc((nv ? nv : 1) * sizeof *ws->d);
     ws->emitted = malloc((nv ? nv : 1) * sizeof *ws->emitted);
@@ -517,6 +533,8 @@ mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *t, mfmm_exact_w
         ws->emitted[v] = INFINITY;
         ws->in_angle[v] = NAN;
     }
+    for (int32_t i = 0; i < EX_NB; i++)
+        ws->bhead[i] = -1;
     /* memory_limit counts the tables too, shared or not */
     ws->fixed_bytes = t->bytes + mfmm_exact_ws_bytes(t->mesh);
     ws->max_d = INFINITY;
@@ -619,7 +637,12 @@ static int ex_grow(mfmm_exact_ws *ws)
  * improves). */
 static int64_t ex_bucket(const mfmm_exact_ws *ws, double key)
 {
-    double b = floor(key * ws->inv_w);
+    double b = key * ws->inv_w;
+    /* keys are distances, >= 0 but for negative source values: truncation
+     * is the floor there and needs no library call or rounding mode */
+    if (b >= 0.0 && b < 1e18)
+        return (int64_t)b;
+    b = floor(b);
     if (!(b > -1e18))
         b = -1e18;
     if (b > 1e18)
@@ -1057,6 +1080,11 @@ static void ex_reset(mfmm_exact_ws *ws)
         ws->in_patch[v] = 0;
     }
     ws->n_touched = 0;
+    /* a run that emptied its queue left every bucket empty: only a failed
+     * one (out of memory) needs them cleared (16 KB, a patch uses ~30) */
+    if (ws->heap_n != 0)
+        for (int32_t i = 0; i < EX_NB; i++)
+            ws->bhead[i] = -1;
     ws->heap_n = 0;
     ws->heap_used = 0;
     ws->qfree = -1;
@@ -1064,8 +1092,6 @@ static void ex_reset(mfmm_exact_ws *ws)
     ws->n_in = 0;
     ws->cur = -((int64_t)1 << 62);
     ws->redist = ws->cur;
-    for (int32_t i = 0; i < EX_NB; i++)
-        ws->bhead[i] = -1;
     ws->failed = 0;
     ws->n_windows = ws->n_propagated = ws->n_pseudo = ws->peak_windows = 0;
     ws->peak_bytes = ex_bytes(ws, ws->heap_cap);
@@ -1257,16 +1283,8 @@ mfmm_status mfmm_exact_patch(mfmm_exact_ws *ws, const mfmm_source *sources, int3
         int32_t v = ws->touched[i];
         double dv = ws->d[v];
         int final = dv <= radius;
-        if (!final && dv < INFINITY) {
-            double h = INFINITY;
-            for (int32_t j = ws->vf_offset[v]; j < ws->vf_offset[v + 1]; j++) {
-                int32_t c = ex_corner(ws->vf_corner, ws->face_in, j);
-                const ex_face *r = ws->fr + c / 3;
-                if (!r->skip && r->cy[c % 3] < h)
-                    h = r->cy[c % 3];
-            }
-            final = dv - h <= radius;
-        }
+        if (!final && dv < INFINITY)
+            final = dv - ws->height[v] <= radius;
         if (final) {
             ws->in_patch[v] = 1;
             ws->touched[i] = ws->touched[n];
