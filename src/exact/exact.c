@@ -31,7 +31,10 @@
  *     end, found by solving one quadratic: the window is trimmed to the
  *     rest (likewise from Q); ICH drops the whole window when its far end
  *     is beaten, this keeps the part that is not;
- *   - for R: dropped when min D > d(R) + max(|R E0|, |R E1|).
+ *   - (ICH's third rule, dropping the window when min D > d(R) + max(|R E0|,
+ *     |R E1|), is not applied: with the trims and the queue's order it
+ *     dropped 0-11 windows of 2,000-4,000 a patch on the test meshes, and
+ *     its test cost 5-9 % of the patch's time.)
  * Dropping or trimming is safe in any order: every point removed has a
  * shorter path through a vertex, so no shortest path crosses it.
  *
@@ -870,8 +873,8 @@ static double ex_gap(double x, double s0, double s1)
 }
 
 /* A window on half-edge h = 3f+k in f's frame (I on f's side: iy >= 0),
- * interval [s0, s1], leaving f: updates the vertices it reaches, checks it
- * against f's vertices, and queues it in the face across, in that face's
+ * interval [s0, s1], leaving f: updates the vertices it reaches, trims it
+ * against the edge's ends, and queues it in the face across, in that face's
  * frame. */
 static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double ix, double iy,
                     double sigma)
@@ -879,7 +882,7 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
     const ex_face *r = ws->fr + h / 3;
     int k = h % 3;
     int k1 = ex_next[k], k2 = ex_prev[k];
-    int32_t va = r->v[k1], vb = r->v[k2], vr = r->v[k];
+    int32_t va = r->v[k1], vb = r->v[k2];
     double L = r->len[k];
     if (s0 < 0.0)
         s0 = 0.0;
@@ -923,12 +926,6 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
         if (key > ws->max_d)
             return;
     }
-    /* key > d(R) + max |R E|, without a square root */
-    double rx = r->cx[k], ry = r->cy[k];
-    double r0 = (rx - s0) * (rx - s0), r1 = (rx - s1) * (rx - s1);
-    double gap = key - ws->d[vr];
-    if (gap > 0.0 && gap * gap > (r0 > r1 ? r0 : r1) + ry * ry)
-        return;
     int32_t wi = ex_new(ws);
     if (wi < 0)
         return;
