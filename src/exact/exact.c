@@ -854,9 +854,10 @@ static double ex_gap(double x, double s0, double s1)
 /* A window on half-edge h = 3f+k in f's frame (I on f's side: iy >= 0),
  * interval [s0, s1], leaving f: updates the vertices it reaches, trims it
  * against the edge's ends, and queues it in the face across, in that face's
- * frame. */
+ * frame. known: its ends at a vertex whose distance through this window
+ * is already set (bit 0: at s = 0, bit 1: at s = L; see ex_propagate). */
 static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double ix, double iy,
-                    double sigma)
+                    double sigma, int known)
 {
     const ex_face *r = ws->fr + h / 3;
     int k = h % 3;
@@ -868,12 +869,12 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
     if (s1 > L)
         s1 = L;
     double iy2 = iy * iy;
-    if (s0 <= EX_POS_TOL * L) {
+    if (s0 <= EX_POS_TOL * L && !(known & 1)) {
         double ra = sqrt(ix * ix + iy2);
         if (ex_update(ws, va, sigma + ra, 0))
             ex_set_in(ws, va, h - k + k1, atan2(iy, ix), ra, L);
     }
-    if (s1 >= L - EX_POS_TOL * L) {
+    if (s1 >= L - EX_POS_TOL * L && !(known & 2)) {
         double rb = sqrt((ix - L) * (ix - L) + iy2);
         if (ex_update(ws, vb, sigma + rb, 0)) {
             int32_t c = h - k + k2;
@@ -969,7 +970,11 @@ static void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
         double s_lo = tc <= b1 ? 0.0 : ex_hit(cx, cy, ux, uy, px, py, b1, lac);
         double qx = px - cx, qy = py - cy;
         double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
-        ex_emit(ws, hl, s_lo, s_hi, ix, iy > 0.0 ? iy : 0.0, sigma);
+        /* its end at C when the window holds C (C updated above), at A
+         * when the window starts at A (A updated where it was emitted):
+         * the same distance again, in another frame */
+        ex_emit(ws, hl, s_lo, s_hi, ix, iy > 0.0 ? iy : 0.0, sigma,
+                (tc <= b1) | (b0 <= 0.0) << 1);
     }
     if (b1 > tc) {
         /* right child: edge B -> C (half-edge 3f+m1), rays through [max(b0, tc), b1] */
@@ -980,7 +985,9 @@ static void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
         double s_hi = tc >= b0 ? lbc : ex_hit(L, 0.0, ux, uy, px, py, b0, lbc);
         double qx = px - L, qy = py;
         double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
-        ex_emit(ws, hr, s_lo, s_hi, ix, iy > 0.0 ? iy : 0.0, sigma);
+        /* (likewise at B and at C) */
+        ex_emit(ws, hr, s_lo, s_hi, ix, iy > 0.0 ? iy : 0.0, sigma,
+                (b1 >= L) | (tc >= b0) << 1);
     }
 }
 
@@ -1009,7 +1016,7 @@ static void ex_start_vertex(mfmm_exact_ws *ws, int32_t v, double dv)
             const ex_face *r = ws->fr + c / 3;
             if (r->skip)
                 continue;
-            ex_emit(ws, c, 0.0, r->len[c % 3], r->cx[c % 3], r->cy[c % 3], dv);
+            ex_emit(ws, c, 0.0, r->len[c % 3], r->cx[c % 3], r->cy[c % 3], dv, 0);
         }
         return;
     }
@@ -1045,7 +1052,7 @@ static void ex_start_vertex(mfmm_exact_ws *ws, int32_t v, double dv)
             double L = r->len[c % 3], cx = r->cx[c % 3], cy = r->cy[c % 3];
             double s0 = p0 <= 0.0 ? 0.0 : ex_ray_x(cx, cy, p0, L);
             double s1 = p1 >= ang ? L : ex_ray_x(cx, cy, p1, L);
-            ex_emit(ws, c, s0, s1, cx, cy, dv);
+            ex_emit(ws, c, s0, s1, cx, cy, dv, 0);
         }
     }
 }
@@ -1061,7 +1068,7 @@ static void ex_start_face(mfmm_exact_ws *ws, int32_t f, const double *w, double 
         const ex_face *r = ws->fr + f;
         double ix = w[(k + 2) % 3] * r->len[k] + w[k] * r->cx[k];
         double iy = w[k] * r->cy[k];
-        ex_emit(ws, h, 0.0, r->len[k], ix, iy, value);
+        ex_emit(ws, h, 0.0, r->len[k], ix, iy, value, 0);
     }
 }
 
