@@ -916,22 +916,7 @@ static void test_saddles_start_once(void **state)
     int32_t nv = fx.g.nv;
     double *sum = calloc((size_t)nv, sizeof *sum);
     assert_non_null(sum);
-    for (int32_t f = 0; f < fx.g.nf; f++) {
-        for (int k = 0; k < 3; k++) {
-            const double *a = fx.g.V + 3 * fx.g.F[3 * f + k];
-            const double *b = fx.g.V + 3 * fx.g.F[3 * f + (k + 1) % 3];
-            const double *c = fx.g.V + 3 * fx.g.F[3 * f + (k + 2) % 3];
-            double u[3], w[3], dot = 0.0, nu = 0.0, nw = 0.0;
-            for (int e = 0; e < 3; e++) {
-                u[e] = b[e] - a[e];
-                w[e] = c[e] - a[e];
-                dot += u[e] * w[e];
-                nu += u[e] * u[e];
-                nw += w[e] * w[e];
-            }
-            sum[fx.g.F[3 * f + k]] += acos(dot / sqrt(nu * nw));
-        }
-    }
+    tm_angle_sums(fx.g.V, fx.g.F, nv, fx.g.nf, sum);
     mfmm_mesh_info mi;
     mfmm_mesh_get_info(fx.mesh, &mi);
     int32_t c = 30 * 61 + 30; /* the centre, among saddles */

@@ -296,21 +296,7 @@ static void test_saddle_corner_continuous(void **state)
     assert_true(angle && d0 && d1);
     /* geometry from the mesh's own arrays (internal vertex ids) */
     const int32_t *IF = mesh->faces;
-    for (int32_t f = 0; f < nf; f++)
-        for (int k = 0; k < 3; k++) {
-            const double *a = mesh->xyz + 3 * (size_t)IF[3 * f + k];
-            const double *b = mesh->xyz + 3 * (size_t)IF[3 * f + (k + 1) % 3];
-            const double *c = mesh->xyz + 3 * (size_t)IF[3 * f + (k + 2) % 3];
-            double u[3], w[3], uu = 0, ww = 0, uw = 0;
-            for (int j = 0; j < 3; j++) {
-                u[j] = b[j] - a[j];
-                w[j] = c[j] - a[j];
-                uu += u[j] * u[j];
-                ww += w[j] * w[j];
-                uw += u[j] * w[j];
-            }
-            angle[IF[3 * f + k]] += acos(fmax(-1.0, fmin(1.0, uw / sqrt(uu * ww))));
-        }
+    tm_angle_sums(mesh->xyz, IF, nv, nf, angle);
     int n_saddles = 0, n_approaches = 0, n_jumps = 0;
     double worst = 0.0;
     for (int32_t v = 0; v < nv && n_saddles < 40; v++) {

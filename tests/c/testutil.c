@@ -192,3 +192,23 @@ double tm_refraction_y(const double *s, const double *p, double f1, double f2)
     }
     return 0.5 * (lo + hi);
 }
+
+void tm_angle_sums(const double *V, const int32_t *F, int32_t nv, int32_t nf, double *sum)
+{
+    for (int32_t v = 0; v < nv; v++)
+        sum[v] = 0.0;
+    for (int32_t f = 0; f < nf; f++)
+        for (int k = 0; k < 3; k++) {
+            const double *a = V + 3 * (size_t)F[3 * f + k];
+            const double *b = V + 3 * (size_t)F[3 * f + (k + 1) % 3];
+            const double *c = V + 3 * (size_t)F[3 * f + (k + 2) % 3];
+            double uu = 0.0, ww = 0.0, uw = 0.0;
+            for (int j = 0; j < 3; j++) {
+                double u = b[j] - a[j], w = c[j] - a[j];
+                uu += u * u;
+                ww += w * w;
+                uw += u * w;
+            }
+            sum[F[3 * f + k]] += acos(fmax(-1.0, fmin(1.0, uw / sqrt(uu * ww))));
+        }
+}

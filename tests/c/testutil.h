@@ -36,6 +36,10 @@ int32_t tm_nearest_vertex(const mfmm_gen_mesh *m, const double p[3]);
 double tm_mean_rel_error(const double *d, const double *exact, int32_t n);
 double tm_max_error(const double *d, const double *exact, int32_t n, double diameter);
 
+/* sum[v] (nv entries, zeroed here) = the angle sum at vertex v of faces F
+ * (nf x 3) over positions V (nv x 3): > 2 pi at a saddle. */
+void tm_angle_sums(const double *V, const int32_t *F, int32_t nv, int32_t nf, double *sum);
+
 /* Least-squares slope of log(err) against log(h): the order of convergence. */
 double tm_fitted_order(const double *h, const double *err, int n);
 
