@@ -16,7 +16,7 @@ typedef struct mfmm_virt_step {
 } mfmm_virt_step;
 
 /* A corner while the mesh is built (mesh.c, unfold.c), by corner id 3f+k;
- * the march gets compact records (mfmm_corner, mfmm_virt) from these. virt:
+ * the march gets records per face (mfmm_face, mfmm_virt) from these. virt:
  * V's id >= 0 (the obtuse corner is split by the virtual edge to V), or one
  * of the MFMM_VIRT_ codes. */
 #define MFMM_VIRT_NONE (-1)       /* not obtuse: the plain stencil */
@@ -44,14 +44,11 @@ struct mfmm_mesh {
     int32_t *component;        /* (nv,) component id, -1 for unreferenced vertices */
     uint8_t *degenerate;       /* (nf,) 1 for zero-area faces */
     mfmm_corner_full *full;    /* (3 nf,) while building only, then NULL */
-    mfmm_corner *corners;      /* (n_slots,) records for the march, grouped by vertex in
-                                  the vertex_face CSR order; an obtuse corner's
-                                  record is followed by its mfmm_virt */
-    void *corners_block;       /* the allocation corners lies in (cache-line aligned) */
-    int32_t n_slots;
-    int32_t *slot_corner;      /* (n_slots,) the corner 3f+k of each slot */
-    int32_t *update_offset;    /* (nv+1,) CSR: corners to recompute when a vertex settles */
-    int32_t *update_corner;    /* pairs (index into corners, its vertex C) */
+    mfmm_face *face_records;   /* (nf,) for the march (local_update.h), 64-byte aligned */
+    void *face_block;          /* the allocation face_records lies in */
+    mfmm_virt *virts;          /* (n_virts,) virtual edges for the march, sorted by V */
+    int32_t n_virts;
+    int32_t *virt_first;       /* (nv+1,) CSR: virts[virt_first[v]..] end at v */
     int32_t *virt_offset;      /* (3 nf + 1,) CSR by corner 3f+k into virt_steps: the
                                   strip of an obtuse corner's virtual edge */
     mfmm_virt_step *virt_steps;
@@ -75,10 +72,11 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
 {
     mfmm_march_mesh m;
     m.nv = mesh->nv;
-    m.update_offset = mesh->update_offset;
-    m.update_corner = mesh->update_corner;
-    m.corners = mesh->corners;
-    m.slot_corner = mesh->slot_corner;
+    m.wedge_offset = mesh->vertex_face_offset;
+    m.wedge = mesh->vertex_face_corner;
+    m.faces = mesh->face_records;
+    m.virts = mesh->virts;
+    m.virt_first = mesh->virt_first;
     m.strip_offset = mesh->virt_offset;
     m.strip = mesh->strip;
     return m;
