@@ -26,17 +26,15 @@ inline void mfmm_row_march(int nv, __global const int *wedge_offset,
                            __global int *heap_pos, __global const int *strip,
                            __global const double *uniform,
                            __global const int *targets, int n_targets,
-                           __global const mfmm_virt *virts, __global const int *strip_offset,
+                           __global const int *virt_first, __global const int *strip_offset,
                            __global const int *seeds, int row,
-                           __global const double *seed_value,
-                           __global const int *virt_first)
+                           __global const double *seed_value)
 {
     mfmm_march_mesh m;
     m.nv = nv;
     m.wedge_offset = wedge_offset;
     m.wedge = wedge;
     m.faces = faces;
-    m.virts = virts;
     m.virt_first = virt_first;
     m.strip_offset = strip_offset;
     m.strip = strip;
@@ -84,11 +82,10 @@ __kernel void fmm_rows_f64(int nv, __global const int *wedge_offset,
                            __global int *vert_ws, __global int *pos_ws, __global double *out,
                            __global const int *strip, __global const double *uniform,
                            __global const int *targets, int n_targets, __global double *T_ws,
-                           __global const int *order, __global const mfmm_virt *virts,
+                           __global const int *order, __global const int *virt_first,
                            __global const int *strip_offset,
                            int n_seeds, __global const int *seeds,
-                           __global const double *seed_value,
-                           __global const int *virt_first)
+                           __global const double *seed_value)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
@@ -98,8 +95,7 @@ __kernel void fmm_rows_f64(int nv, __global const int *wedge_offset,
     mfmm_row_march(nv, wedge_offset, wedge, faces, cost, cost_location,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
                    key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets,
-                   virts, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value,
-                   virt_first);
+                   virt_first, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value);
     if (n_targets > 0) {
         __global double *row = out + (ulong)i * (ulong)n_targets;
         for (int j = 0; j < n_targets; j++)
@@ -123,11 +119,10 @@ __kernel void fmm_rows_f32(int nv, __global const int *wedge_offset,
                            __global double *T_ws, __global float *out,
                            __global const int *strip, __global const double *uniform,
                            __global const int *targets, int n_targets, __global double *unused,
-                           __global const int *order, __global const mfmm_virt *virts,
+                           __global const int *order, __global const int *virt_first,
                            __global const int *strip_offset,
                            int n_seeds, __global const int *seeds,
-                           __global const double *seed_value,
-                           __global const int *virt_first)
+                           __global const double *seed_value)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
@@ -137,8 +132,7 @@ __kernel void fmm_rows_f32(int nv, __global const int *wedge_offset,
     mfmm_row_march(nv, wedge_offset, wedge, faces, cost, cost_location,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
                    key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets,
-                   virts, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value,
-                   virt_first);
+                   virt_first, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value);
     (void)unused;
     if (n_targets > 0) {
         __global float *row = out + (ulong)i * (ulong)n_targets;
