@@ -59,7 +59,7 @@ static int graph_build(const mfmm_mesh *m, graph *g)
                 int32_t w = m->vertex_face_corner[m->vertex_face_offset[x] + j / 2];
                 c = m->faces[3 * (w / 3) + (w % 3 + 1 + j % 2) % 3];
             } else {
-                c = m->virt_first[nv + 1 + 2 * (m->virt_first[x] + j - 2 * nw) + 1];
+                c = m->faces[m->virts[m->virt_first[x] + j - 2 * nw].corner];
             }
             for (int32_t i = g->off[x]; i < k && !dup; i++)
                 dup = g->nbr[i] == c;

@@ -26,15 +26,17 @@ inline void mfmm_row_march(int nv, __global const int *wedge_offset,
                            __global int *heap_pos, __global const int *strip,
                            __global const double *uniform,
                            __global const int *targets, int n_targets,
-                           __global const int *virt_first, __global const int *strip_offset,
+                           __global const mfmm_virt *virts, __global const int *strip_offset,
                            __global const int *seeds, int row,
-                           __global const double *seed_value)
+                           __global const double *seed_value,
+                           __global const int *virt_first)
 {
     mfmm_march_mesh m;
     m.nv = nv;
     m.wedge_offset = wedge_offset;
     m.wedge = wedge;
     m.faces = faces;
+    m.virts = virts;
     m.virt_first = virt_first;
     m.strip_offset = strip_offset;
     m.strip = strip;
@@ -82,10 +84,11 @@ __kernel void fmm_rows_f64(int nv, __global const int *wedge_offset,
                            __global int *vert_ws, __global int *pos_ws, __global double *out,
                            __global const int *strip, __global const double *uniform,
                            __global const int *targets, int n_targets, __global double *T_ws,
-                           __global const int *order, __global const int *virt_first,
+                           __global const int *order, __global const mfmm_virt *virts,
                            __global const int *strip_offset,
                            int n_seeds, __global const int *seeds,
-                           __global const double *seed_value)
+                           __global const double *seed_value,
+                           __global const int *virt_first)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
@@ -95,7 +98,8 @@ __kernel void fmm_rows_f64(int nv, __global const int *wedge_offset,
     mfmm_row_march(nv, wedge_offset, wedge, faces, cost, cost_location,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
                    key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets,
-                   virt_first, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value);
+                   virts, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value,
+                   virt_first);
     if (n_targets > 0) {
         __global double *row = out + (ulong)i * (ulong)n_targets;
         for (int j = 0; j < n_targets; j++)
@@ -119,10 +123,11 @@ __kernel void fmm_rows_f32(int nv, __global const int *wedge_offset,
                            __global double *T_ws, __global float *out,
                            __global const int *strip, __global const double *uniform,
                            __global const int *targets, int n_targets, __global double *unused,
-                           __global const int *order, __global const int *virt_first,
+                           __global const int *order, __global const mfmm_virt *virts,
                            __global const int *strip_offset,
                            int n_seeds, __global const int *seeds,
-                           __global const double *seed_value)
+                           __global const double *seed_value,
+                           __global const int *virt_first)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
@@ -132,7 +137,8 @@ __kernel void fmm_rows_f32(int nv, __global const int *wedge_offset,
     mfmm_row_march(nv, wedge_offset, wedge, faces, cost, cost_location,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
                    key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets,
-                   virt_first, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value);
+                   virts, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value,
+                   virt_first);
     (void)unused;
     if (n_targets > 0) {
         __global float *row = out + (ulong)i * (ulong)n_targets;

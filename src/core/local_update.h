@@ -43,31 +43,39 @@ typedef uint8_t mfmm_u8;
 #define MFMM_OBTUSE_COS (-1e-9)
 
 /* One face as the march reads it: its vertices, the length of the edge
- * opposite each corner (section 4.1; the angles follow by the law of
- * cosines, mfmm_triangle_interior_len), and its obtuse corner's virtual edge
- * (section 4.2), if it has one. When a vertex x settles the march walks x's
- * faces (march.h): in face (x, y, c) every length that updating c from x
- * (and y, and V) needs is in this one record. 64 bytes, one cache line, C
- * and OpenCL C. */
+ * opposite each corner and the cosine of each corner's angle (section 4.1),
+ * and its obtuse corner's virtual edge (section 4.2), if it has one. When a
+ * vertex x settles the march walks x's faces (march.h): in face (x, y, c)
+ * every length and angle that updating c from x (and y) needs is in this
+ * one record. 64 bytes, one cache line, C and OpenCL C. cosv is NaN on a
+ * zero-area face (no triangle update: Eq. 4 then yields +inf, at no cost). */
 typedef struct mfmm_face {
-    /* internal vertex ids, | MFMM_VIRTUAL_CORNER at the obtuse corner with
-     * the virtual edge, | MFMM_ENDS_VIRTUAL where some virtual edge ends
-     * (mask with MFMM_VERTEX_MASK) */
-    mfmm_i32 v[3];
-    mfmm_i32 virt_v;  /* V of the virtual edge; -1 none; MFMM_ZERO_AREA */
-    double len[3];    /* len[k]: the edge opposite corner k */
-    /* the virtual edge C -> V: |CV| in the unfolded plane and the cosines of
-     * the two angles it splits theta into (A-C-V and V-C-B, A and B the
-     * face's vertices after C) */
-    double virt_len, virt_cos_a, virt_cos_b;
+    mfmm_i32 v[3];   /* internal vertex ids, | MFMM_ENDS_VIRTUAL where a
+                        virtual edge ends (mask with MFMM_VERTEX_MASK) */
+    mfmm_i32 virt;   /* its obtuse corner k's mfmm_virt: 4 index + k; 3: none */
+    double len[3];   /* len[k]: the edge opposite corner k */
+    double cosv[3];  /* cos of the angle at corner k (NaN: zero area) */
 } mfmm_face;
 
-/* Flags in mfmm_face.v (vertex ids are below INT32_MAX / 3 < 2^30). */
-#define MFMM_VIRTUAL_CORNER ((mfmm_i32)0x80000000u)
+/* In mfmm_face.v: the vertex is the V of some virtual edge (vertex ids are
+ * below INT32_MAX / 3, so bit 30 is free). */
 #define MFMM_ENDS_VIRTUAL 0x40000000
 #define MFMM_VERTEX_MASK 0x3fffffff
-/* mfmm_face.virt_v of a zero-area face: no triangle update, edges only */
-#define MFMM_ZERO_AREA (-2)
+
+/* The virtual edge C -> V of an obtuse corner (section 4.2): V of the
+ * unfolded patch, the corner 3 f + k it splits, |CV| in the unfolded plane
+ * and the cosines of the two angles it splits theta into (A-C-V and V-C-B,
+ * A and B the face's vertices after C). Stored sorted by V (the march
+ * offers these when V settles). 40 bytes, C and OpenCL C. */
+typedef struct mfmm_virt {
+    mfmm_i32 v;
+    mfmm_i32 corner;
+    mfmm_i32 c;      /* the corner's vertex C */
+    mfmm_i32 unused;
+    double len;   /* |CV| */
+    double cos_a; /* cos of angle A-C-V */
+    double cos_b; /* cos of angle V-C-B */
+} mfmm_virt;
 
 /* Vertex labels of section 2 (Far, Close, Alive), plus a flag for targets. */
 #define MFMM_FAR 0
@@ -132,43 +140,6 @@ MFMM_INLINE double mfmm_triangle_interior(double ta, double tb, double a, double
     /* the test with x = CD = b (t - u) / t of section 4.1, multiplied by t > 0 */
     double xt = b * (t - u);
     if (a * cos_c * t < xt && xt * cos_c < a * t)
-        return ta + t * scale;
-    return MFMM_INF;
-}
-
-/* mfmm_triangle_interior from the three edge lengths: a = |BC|, b = |AC|,
- * c = |AB|, with the angle at C by the law of cosines in units of b: a cos
- * theta = (a^2 + 1 - c^2) / 2, so that Eq. 4 needs no cosine stored and no
- * division but 1 / b (q2 = c^2 exactly). The same equation and acceptance
- * test, the test multiplied by a > 0. */
-MFMM_INLINE double mfmm_triangle_interior_len(double ta, double tb, double a, double b,
-                                              double c, double f)
-{
-    if (ta > tb) {
-        double s = ta; ta = tb; tb = s;
-        s = a; a = b; b = s;
-    }
-    if (!(b > 0.0))
-        return MFMM_INF;
-    double scale = b, inv = 1.0 / b;
-    a *= inv;
-    c *= inv;
-    double u = (tb - ta) * inv;
-    double a2 = a * a;
-    double ac = 0.5 * (a2 + 1.0 - c * c); /* a cos theta */
-    double q2 = c * c;
-    double q1 = 2.0 * u * (ac - 1.0);
-    double q0 = u * u - f * f * (a2 - ac * ac); /* a^2 sin^2 theta */
-    if (!(q2 > 0.0))
-        return MFMM_INF;
-    double disc = q1 * q1 - 4.0 * q2 * q0;
-    disc = disc > 0.0 ? disc : 0.0;
-    double s = sqrt(disc);
-    double t = q1 <= 0.0 ? (s - q1) / (2.0 * q2) : (2.0 * q0) / (-q1 - s);
-    if (!(t > u))
-        return MFMM_INF;
-    double xt = t - u;
-    if (ac * t < xt && xt * ac < a2 * t)
         return ta + t * scale;
     return MFMM_INF;
 }

@@ -19,8 +19,9 @@ typedef struct mfmm_march_mesh {
     MFMM_GLOBAL const mfmm_i32 *wedge_offset;
     MFMM_GLOBAL const mfmm_i32 *wedge;
     MFMM_GLOBAL const mfmm_face *faces; /* (nf,) */
-    /* the virtual edges ending at x: pairs (corner 3 f + k, its vertex C)
-     * at virt_first[nv + 1 + 2 j], j in [virt_first[x], virt_first[x + 1]) */
+    /* the virtual edges, sorted by V: those ending at x are
+     * virts[virt_first[x]] .. virts[virt_first[x + 1] - 1] */
+    MFMM_GLOBAL const mfmm_virt *virts;
     MFMM_GLOBAL const mfmm_i32 *virt_first;
     /* the vertices each virtual edge's strip unfolds up to V (A and B
      * aside): strip[strip_offset[k]] .. strip[strip_offset[k + 1] - 1] for
@@ -236,8 +237,8 @@ MFMM_INLINE void mfmm_march_offer(mfmm_march_state *s, const mfmm_march_mesh *m,
  * (the edge from y when y did, the virtual edge's when V does), so c gets
  * the minimum over the same updates as recomputing the whole corner. */
 MFMM_COLD void mfmm_march_corner(mfmm_march_state *s, const mfmm_march_mesh *m,
-                                 MFMM_GLOBAL const mfmm_face *fr, mfmm_i32 f_id, mfmm_i32 jc,
-                                 mfmm_i32 c, mfmm_u8 lc, mfmm_i32 x, double tx, int alive_y)
+                                   MFMM_GLOBAL const mfmm_face *fr, mfmm_i32 f_id, mfmm_i32 jc,
+                                   mfmm_i32 c, mfmm_u8 lc, mfmm_i32 x, double tx, int alive_y)
 {
     mfmm_i32 ja = jc == 2 ? 0 : jc + 1, jb = ja == 2 ? 0 : ja + 1;
     mfmm_i32 ia = fr->v[ja] & MFMM_VERTEX_MASK, ib = fr->v[jb] & MFMM_VERTEX_MASK;
@@ -247,37 +248,45 @@ MFMM_COLD void mfmm_march_corner(mfmm_march_state *s, const mfmm_march_mesh *m,
         f = mfmm_march_cost(s, f_id, c, ia, ib, &f_a, &f_b, &f_t);
     /* |xc| is the edge opposite the third vertex */
     double best = x_is_a ? tx + fr->len[jb] * f_b : tx + fr->len[ja] * f_a;
-    int virt = (fr->v[jc] & MFMM_VIRTUAL_CORNER) && s->unfolding;
-    if (virt) {
-        mfmm_i32 iv = fr->virt_v;
+    mfmm_i32 vi = fr->virt;
+    MFMM_GLOBAL const mfmm_virt *vr = 0;
+    if ((vi & 3) == jc && s->unfolding)
+        vr = m->virts + (vi >> 2);
+    if (vr) {
+        mfmm_i32 iv = vr->v;
         int v_alive = (s->label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE;
         /* (the footprint matters once V, or both A and B, have settled) */
         if ((v_alive || alive_y) && s->cost_location != 0 &&
             !mfmm_march_virt_ok(s, m, 3 * f_id + jc, ia, ib, f))
-            virt = 0;
+            vr = 0;
         else if (v_alive) {
             double tv = s->T[iv];
             if (x_is_a)
-                best = mfmm_min(best, mfmm_triangle_update(tx, tv, fr->virt_len, fr->len[jb],
-                                                           fr->virt_cos_a, f_t));
+                best = mfmm_min(best, mfmm_triangle_update(tx, tv, vr->len, fr->len[jb],
+                                                           vr->cos_a, f_t));
             else
-                best = mfmm_min(best, mfmm_triangle_update(tv, tx, fr->len[ja], fr->virt_len,
-                                                           fr->virt_cos_b, f_t));
+                best = mfmm_min(best, mfmm_triangle_update(tv, tx, fr->len[ja], vr->len,
+                                                           vr->cos_b, f_t));
         }
     }
-    if (!virt && alive_y && fr->virt_v != MFMM_ZERO_AREA)
-        best = mfmm_min(best, mfmm_triangle_interior_len(s->T[ia], s->T[ib], fr->len[ja],
-                                                         fr->len[jb], fr->len[jc], f_t));
+    if (!vr && alive_y)
+        /* a zero-area face's NaN cosine makes this +inf */
+        best = mfmm_min(best, mfmm_triangle_interior(s->T[ia], s->T[ib], fr->len[ja],
+                                                     fr->len[jb], fr->cosv[jc], f_t));
     mfmm_march_offer(s, m, c, lc, best);
 }
 
-/* x has just settled and is the V of the virtual edge of corner k = 3 f +
- * k' (C = c, neither Alive nor fixed; section 4.2): offers C the virtual
- * edge and the virtual triangles with A and B that have settled. */
-MFMM_COLD void mfmm_march_virtual(mfmm_march_state *s, const mfmm_march_mesh *m, mfmm_i32 k,
-                                  mfmm_i32 c, mfmm_u8 lc, double tx)
+/* x has just settled and is the V of virtual edge vr (section 4.2): offers
+ * its corner C the virtual edge and the virtual triangles with A and B that
+ * have settled. */
+MFMM_COLD void mfmm_march_virtual(mfmm_march_state *s, const mfmm_march_mesh *m,
+                                    MFMM_GLOBAL const mfmm_virt *vr, double tx)
 {
-    mfmm_i32 f_id = k / 3, jc = k - 3 * f_id;
+    mfmm_i32 c = vr->c;
+    mfmm_u8 lc = s->label[c];
+    if ((lc & MFMM_STATE_MASK) == MFMM_ALIVE || (lc & MFMM_FIXED))
+        return;
+    mfmm_i32 k = vr->corner, f_id = k / 3, jc = k - 3 * f_id;
     MFMM_GLOBAL const mfmm_face *fr = m->faces + f_id;
     mfmm_i32 ja = jc == 2 ? 0 : jc + 1, jb = ja == 2 ? 0 : ja + 1;
     mfmm_i32 ia = fr->v[ja] & MFMM_VERTEX_MASK, ib = fr->v[jb] & MFMM_VERTEX_MASK;
@@ -287,13 +296,13 @@ MFMM_COLD void mfmm_march_virtual(mfmm_march_state *s, const mfmm_march_mesh *m,
         if (!mfmm_march_virt_ok(s, m, k, ia, ib, f))
             return;
     }
-    double best = tx + fr->virt_len * f_t;
+    double best = tx + vr->len * f_t;
     if ((s->label[ia] & MFMM_STATE_MASK) == MFMM_ALIVE)
-        best = mfmm_min(best, mfmm_triangle_update(s->T[ia], tx, fr->virt_len, fr->len[jb],
-                                                   fr->virt_cos_a, f_t));
+        best = mfmm_min(best, mfmm_triangle_update(s->T[ia], tx, vr->len, fr->len[jb],
+                                                   vr->cos_a, f_t));
     if ((s->label[ib] & MFMM_STATE_MASK) == MFMM_ALIVE)
-        best = mfmm_min(best, mfmm_triangle_update(tx, s->T[ib], fr->len[ja], fr->virt_len,
-                                                   fr->virt_cos_b, f_t));
+        best = mfmm_min(best, mfmm_triangle_update(tx, s->T[ib], fr->len[ja], vr->len,
+                                                   vr->cos_b, f_t));
     mfmm_march_offer(s, m, c, lc, best);
 }
 
@@ -338,45 +347,44 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
         }
         double tx = s->T[x];
         mfmm_i32 flags = 0;
-        /* a cost, or the face's virtual corner: the general update; else
-         * (most corners) F = 1 and the plain stencil, inline: the edge from
-         * x, |xp| = len[jq], and the inside once the third vertex is Alive
-         * (A, B = the corner's next vertices, as in the general update, so
-         * that both round alike) */
-        mfmm_i32 general = s->cost_location != 0 ? -1 : 0;
-        mfmm_i32 virt_bit = s->unfolding ? MFMM_VIRTUAL_CORNER : 0;
+        int general = s->cost_location != 0;
+        mfmm_i32 no_virt = s->unfolding ? 0 : 3;
         /* section 2's update of x's neighbours, face by face */
         for (mfmm_i32 j = m->wedge_offset[x]; j < end; j++) {
             mfmm_i32 w = m->wedge[j], f_id = w / 3, k = w - 3 * f_id;
             MFMM_GLOBAL const mfmm_face *fr = m->faces + f_id;
             mfmm_i32 jp = k == 2 ? 0 : k + 1, jq = jp == 2 ? 0 : jp + 1;
-            mfmm_i32 vp = fr->v[jp], vq = fr->v[jq];
-            mfmm_i32 p = vp & MFMM_VERTEX_MASK, q = vq & MFMM_VERTEX_MASK;
+            mfmm_i32 p = fr->v[jp] & MFMM_VERTEX_MASK, q = fr->v[jq] & MFMM_VERTEX_MASK;
             flags = fr->v[k];
             mfmm_u8 lp = s->label[p], lq = s->label[q];
             int alive_p = (lp & MFMM_STATE_MASK) == MFMM_ALIVE;
             int alive_q = (lq & MFMM_STATE_MASK) == MFMM_ALIVE;
-            int plain = fr->virt_v != MFMM_ZERO_AREA;
+            /* a cost, or the face's virtual corner: the general update; else
+             * (most corners) F = 1 and the plain stencil, inline: the edge
+             * from x, |xp| = len[jq], and the inside once the third vertex
+             * is Alive (A, B = the corner's next vertices, as in the general
+             * update, so that both round alike) */
+            mfmm_i32 jv = (fr->virt | no_virt) & 3; /* 3: none */
             if (!alive_p && !(lp & MFMM_FIXED)) {
-                if ((vp & virt_bit) | general) {
+                if (general || jv == jp) {
                     mfmm_march_corner(s, m, fr, f_id, jp, p, lp, x, tx, alive_q);
                 } else {
                     double t = tx + fr->len[jq];
-                    if (alive_q && plain)
-                        t = mfmm_min(t, mfmm_triangle_interior_len(s->T[q], tx, fr->len[jq],
-                                                                   fr->len[k], fr->len[jp], 1.0));
+                    if (alive_q)
+                        t = mfmm_min(t, mfmm_triangle_interior(s->T[q], tx, fr->len[jq], fr->len[k],
+                                                               fr->cosv[jp], 1.0));
                     mfmm_march_offer(s, m, p, lp, t);
                 }
             }
             /* (p's update may have changed q's label only if p == q: never) */
             if (!alive_q && !(lq & MFMM_FIXED)) {
-                if ((vq & virt_bit) | general) {
+                if (general || jv == jq) {
                     mfmm_march_corner(s, m, fr, f_id, jq, q, lq, x, tx, alive_p);
                 } else {
                     double t = tx + fr->len[jp];
-                    if (alive_p && plain)
-                        t = mfmm_min(t, mfmm_triangle_interior_len(tx, s->T[p], fr->len[k],
-                                                                   fr->len[jp], fr->len[jq], 1.0));
+                    if (alive_p)
+                        t = mfmm_min(t, mfmm_triangle_interior(tx, s->T[p], fr->len[k], fr->len[jp],
+                                                               fr->cosv[jq], 1.0));
                     mfmm_march_offer(s, m, q, lq, t);
                 }
             }
@@ -384,13 +392,8 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
         /* the virtual edges that end at x (flagged in x's faces, so that
          * other vertices need not read virt_first) */
         if ((flags & MFMM_ENDS_VIRTUAL) && s->unfolding)
-            for (mfmm_i32 j = m->virt_first[x]; j < m->virt_first[x + 1]; j++) {
-                MFMM_GLOBAL const mfmm_i32 *pair = m->virt_first + m->nv + 1 + 2 * j;
-                mfmm_i32 c = pair[1];
-                mfmm_u8 lc = s->label[c];
-                if ((lc & MFMM_STATE_MASK) != MFMM_ALIVE && !(lc & MFMM_FIXED))
-                    mfmm_march_virtual(s, m, pair[0], c, lc, tx);
-            }
+            for (mfmm_i32 j = m->virt_first[x]; j < m->virt_first[x + 1]; j++)
+                mfmm_march_virtual(s, m, m->virts + j, tx);
     }
     /* a list is worth it for a local march; past nv/8 touched vertices a
      * sequential pass is cheaper than scattered ones (measured, bench_scale) */

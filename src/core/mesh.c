@@ -38,6 +38,7 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh->degenerate);
     free(mesh->full);
     free(mesh->face_block);
+    free(mesh->virts);
     free(mesh->virt_first);
     free(mesh->virt_offset);
     free(mesh->virt_steps);
@@ -257,9 +258,10 @@ static void build_corners(mfmm_mesh *m)
 }
 
 /* The march's records from the build's corners: one 64-byte mfmm_face per
- * face (its vertices, the length opposite each corner, its obtuse corner's
- * virtual edge), in face order; per vertex V, the pairs (corner, C) of the
- * virtual edges that end at V (virt_first). The strips' vertices (for the
+ * face (its vertices, the length opposite each corner, each corner's cosine,
+ * NaN on a zero-area face), and one mfmm_virt per obtuse corner whose
+ * virtual edge unfolding found, sorted by V (counting sort, so by corner
+ * within one V), the face pointing at it. The strips' vertices (for the
  * virtual stencils' cost test) parallel to virt_steps. Frees m->full. */
 static mfmm_status build_records(mfmm_mesh *m)
 {
@@ -268,7 +270,7 @@ static mfmm_status build_records(mfmm_mesh *m)
     size_t n_virts = 0;
     for (size_t c = 0; c < nc; c++)
         n_virts += m->full[c].virt >= 0;
-    if (n_virts > (size_t)INT32_MAX / 2 - (size_t)m->nv)
+    if (n_virts > (size_t)INT32_MAX / 4) /* (mfmm_face.virt packs 4 index + k) */
         return MFMM_ERR_BAD_COUNT;
     m->n_virts = (int32_t)n_virts;
     /* on cache-line boundaries: one record, one line */
@@ -276,44 +278,44 @@ static mfmm_status build_records(mfmm_mesh *m)
     if (m->face_block)
         m->face_records = (mfmm_face *)(void *)((char *)m->face_block +
                                                 (64 - (uintptr_t)m->face_block % 64) % 64);
-    /* virt_first, then the (corner, C) pairs it points into */
-    m->virt_first = calloc((size_t)m->nv + 1 + 2 * n_virts, sizeof *m->virt_first);
+    m->virts = malloc((n_virts ? n_virts : 1) * sizeof *m->virts);
+    m->virt_first = calloc((size_t)m->nv + 1, sizeof *m->virt_first);
     m->strip = malloc((n_steps ? n_steps : 1) * sizeof *m->strip);
-    if (!m->face_block || !m->virt_first || !m->strip)
+    if (!m->face_block || !m->virts || !m->virt_first || !m->strip)
         return MFMM_ERR_OUT_OF_MEMORY;
     for (size_t k = 0; k < n_steps; k++)
         m->strip[k] = m->virt_steps[k].far;
-    int32_t *first = m->virt_first, *pairs = first + m->nv + 1;
+    int32_t *first = m->virt_first;
     for (size_t c = 0; c < nc; c++)
         if (m->full[c].virt >= 0)
             first[m->full[c].virt + 1]++;
     for (int32_t v = 0; v < m->nv; v++)
         first[v + 1] += first[v];
-    for (size_t f = 0; f < nf; f++) { /* (first[] holds starts yet) */
-        mfmm_face *r = m->face_records + f;
-        r->virt_v = m->degenerate[f] ? MFMM_ZERO_AREA : -1;
-        r->virt_len = r->virt_cos_a = r->virt_cos_b = 0.0;
+    for (size_t f = 0; f < nf; f++) /* (first[] holds starts yet) */
         for (int k = 0; k < 3; k++) {
-            const mfmm_corner_full *x = m->full + 3 * f + k;
             int32_t v = m->faces[3 * f + k];
-            r->v[k] = v | (first[v + 1] > first[v] ? MFMM_ENDS_VIRTUAL : 0);
-            r->len[(k + 1) % 3] = x->len_a; /* |BC| is opposite A = vertex k + 1 */
+            m->face_records[f].v[k] = v | (first[v + 1] > first[v] ? MFMM_ENDS_VIRTUAL : 0);
         }
-    }
     for (size_t f = 0; f < nf; f++) {
         mfmm_face *r = m->face_records + f;
+        r->virt = 3;
         for (int k = 0; k < 3; k++) {
             const mfmm_corner_full *x = m->full + 3 * f + k;
-            if (x->virt < 0) /* (a face has at most one obtuse corner) */
+            r->len[(k + 1) % 3] = x->len_a; /* |BC| is opposite A = vertex k + 1 */
+            r->cosv[k] = x->virt == MFMM_VIRT_DEGENERATE ? NAN : x->cos_c;
+            if (x->virt < 0)
                 continue;
-            r->v[k] |= MFMM_VIRTUAL_CORNER;
-            r->virt_v = x->virt;
-            r->virt_len = x->virt_len;
-            r->virt_cos_a = x->virt_cos_a;
-            r->virt_cos_b = x->virt_cos_b;
+            /* (a face has at most one obtuse corner) */
             int32_t at = first[x->virt]++;
-            pairs[2 * at] = (int32_t)(3 * f + (size_t)k);
-            pairs[2 * at + 1] = m->faces[3 * f + k];
+            mfmm_virt *vr = m->virts + at;
+            vr->v = x->virt;
+            vr->corner = (int32_t)(3 * f + (size_t)k);
+            vr->c = m->faces[3 * f + k];
+            vr->unused = 0;
+            vr->len = x->virt_len;
+            vr->cos_a = x->virt_cos_a;
+            vr->cos_b = x->virt_cos_b;
+            r->virt = 4 * at + k;
         }
     }
     for (int32_t v = m->nv; v > 0; v--)
@@ -517,7 +519,7 @@ int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, i
         {"degenerate", nf},
         {"to_internal/to_external", 2 * nv * sizeof(int32_t)},
         {"face records", nf * sizeof(mfmm_face)},
-        {"virtual edges (by V)", ((nv + 1) + 2 * (size_t)mesh->n_virts) * sizeof(int32_t)},
+        {"virtual edges", (size_t)mesh->n_virts * sizeof(mfmm_virt) + (nv + 1) * sizeof(int32_t)},
         {"strip", n_steps * sizeof(int32_t)},
         {"virt_offset", (nc + 1) * sizeof(int32_t)},
         {"virt_steps", n_steps * sizeof(mfmm_virt_step)},

@@ -46,8 +46,9 @@ struct mfmm_mesh {
     mfmm_corner_full *full;    /* (3 nf,) while building only, then NULL */
     mfmm_face *face_records;   /* (nf,) for the march (local_update.h), 64-byte aligned */
     void *face_block;          /* the allocation face_records lies in */
-    int32_t n_virts;           /* virtual edges found */
-    int32_t *virt_first;       /* (nv+1 + 2 n_virts,) see mfmm_march_mesh.virt_first */
+    mfmm_virt *virts;          /* (n_virts,) virtual edges for the march, sorted by V */
+    int32_t n_virts;
+    int32_t *virt_first;       /* (nv+1,) CSR: virts[virt_first[v]..] end at v */
     int32_t *virt_offset;      /* (3 nf + 1,) CSR by corner 3f+k into virt_steps: the
                                   strip of an obtuse corner's virtual edge */
     mfmm_virt_step *virt_steps;
@@ -74,6 +75,7 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
     m.wedge_offset = mesh->vertex_face_offset;
     m.wedge = mesh->vertex_face_corner;
     m.faces = mesh->face_records;
+    m.virts = mesh->virts;
     m.virt_first = mesh->virt_first;
     m.strip_offset = mesh->virt_offset;
     m.strip = mesh->strip;

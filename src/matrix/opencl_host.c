@@ -697,7 +697,7 @@ const char *mfmm_opencl_context_device_name(const mfmm_opencl_context *context)
 
 /* ---- rows ---- */
 
-enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_ORDER, MB_VFIRST, MB_STRIPOFF, MB_LABEL, MB_KEY, MB_VERT,
+enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_ORDER, MB_VIRTS, MB_STRIPOFF, MB_VFIRST, MB_LABEL, MB_KEY, MB_VERT,
        MB_POS, MB_T, MB_OUT, MB_COUNT };
 
 /* Bytes per work-item on the device (workspace and output row), and on the
@@ -887,10 +887,13 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     if (e == CL_SUCCESS)
         mem[MB_STRIP] = api->clCreateBuffer(cl.context, ro, (n_strip ? n_strip : 1) * sizeof(int32_t),
                                             mesh->strip, &e);
-    if (e == CL_SUCCESS) /* the virtual edges by V (march.h) */
-        mem[MB_VFIRST] = api->clCreateBuffer(cl.context, ro,
-                                             ((size_t)mesh->nv + 1 + 2 * (size_t)mesh->n_virts) *
-                                                 sizeof(int32_t),
+    if (e == CL_SUCCESS)
+        mem[MB_VIRTS] = api->clCreateBuffer(cl.context, ro,
+                                              (mesh->n_virts ? (size_t)mesh->n_virts : 1) *
+                                                  sizeof(mfmm_virt),
+                                              mesh->virts, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_VFIRST] = api->clCreateBuffer(cl.context, ro, (nv + 1) * sizeof(int32_t),
                                              mesh->virt_first, &e);
     if (e == CL_SUCCESS)
         mem[MB_STRIPOFF] = api->clCreateBuffer(cl.context, ro, (nc + 1) * sizeof(int32_t),
@@ -991,7 +994,7 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         e |= api->clSetKernelArg(cl.kernel, 19, sizeof n_targets, &n_targets);
         e |= api->clSetKernelArg(cl.kernel, 20, sizeof(cl_mem), &t_ws);
         e |= api->clSetKernelArg(cl.kernel, 21, sizeof(cl_mem), &mem[MB_ORDER]);
-        e |= api->clSetKernelArg(cl.kernel, 22, sizeof(cl_mem), &mem[MB_VFIRST]);
+        e |= api->clSetKernelArg(cl.kernel, 22, sizeof(cl_mem), &mem[MB_VIRTS]);
         e |= api->clSetKernelArg(cl.kernel, 23, sizeof(cl_mem), &mem[MB_STRIPOFF]);
     } else {
         e |= api->clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_T]);
@@ -1002,7 +1005,7 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         e |= api->clSetKernelArg(cl.kernel, 20, sizeof n_targets, &n_targets);
         e |= api->clSetKernelArg(cl.kernel, 21, sizeof(cl_mem), &t_ws);
         e |= api->clSetKernelArg(cl.kernel, 22, sizeof(cl_mem), &mem[MB_ORDER]);
-        e |= api->clSetKernelArg(cl.kernel, 23, sizeof(cl_mem), &mem[MB_VFIRST]);
+        e |= api->clSetKernelArg(cl.kernel, 23, sizeof(cl_mem), &mem[MB_VIRTS]);
         e |= api->clSetKernelArg(cl.kernel, 24, sizeof(cl_mem), &mem[MB_STRIPOFF]);
     }
     /* the seeds (set per batch with the exact start; else unused) */
@@ -1011,6 +1014,7 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     e |= api->clSetKernelArg(cl.kernel, seed_arg, sizeof n_seeds, &n_seeds);
     e |= api->clSetKernelArg(cl.kernel, seed_arg + 1, sizeof(cl_mem), &mem[MB_SOURCES]);
     e |= api->clSetKernelArg(cl.kernel, seed_arg + 2, sizeof(cl_mem), &mem[MB_COST]);
+    e |= api->clSetKernelArg(cl.kernel, seed_arg + 3, sizeof(cl_mem), &mem[MB_VFIRST]);
     if (e != CL_SUCCESS) {
         st = runtime_fail(err, "clSetKernelArg", e);
         goto done;
