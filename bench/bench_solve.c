@@ -174,8 +174,7 @@ static void bench(const char *name, const double *V, int32_t nv, const int32_t *
         fprintf(stderr, "out of memory\n");
         exit(1);
     }
-    for (int ui = 0; ui < 2; ui++) {
-        int unfolding = getenv("UNF_FIRST0") ? ui : 1 - ui;
+    for (int unfolding = 1; unfolding >= 0; unfolding--) {
         mfmm_solve_options opt;
         mfmm_solve_options_init(&opt);
         opt.unfolding = unfolding;
