@@ -359,32 +359,60 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
             mfmm_u8 lp = s->label[p], lq = s->label[q];
             int alive_p = (lp & MFMM_STATE_MASK) == MFMM_ALIVE;
             int alive_q = (lq & MFMM_STATE_MASK) == MFMM_ALIVE;
-            /* a cost, or the face's virtual corner: the general update; else
-             * (most corners) F = 1 and the plain stencil, inline: the edge
-             * from x, |xp| = len[jq], and the inside once the third vertex
-             * is Alive (A, B = the corner's next vertices, as in the general
-             * update, so that both round alike) */
+            /* a cost: the general update. Else F = 1, inline: the edge from
+             * x (|xp| = len[jq]) and one triangle through x, the plain one
+             * once the third vertex is Alive or, at the face's obtuse corner
+             * with its virtual edge (section 4.2), the virtual triangle of x
+             * and V once V is Alive, with the virtual edge from V (V's
+             * settling offered it too: equal, so min leaves it). The same
+             * operands as mfmm_march_corner, so that both round alike. */
             mfmm_i32 jv = (fr->virt | no_virt) & 3; /* 3: none */
             if (!alive_p && !(lp & MFMM_FIXED)) {
-                if (general || jv == jp) {
+                if (general) {
                     mfmm_march_corner(s, m, fr, f_id, jp, p, lp, x, tx, alive_q);
                 } else {
-                    double t = tx + fr->len[jq];
-                    if (alive_q)
-                        t = mfmm_min(t, mfmm_triangle_interior(s->T[q], tx, fr->len[jq], fr->len[k],
-                                                               fr->cosv[jp], 1.0));
+                    /* p = C, q = A, x = B */
+                    double t = tx + fr->len[jq], ta = 0.0, b = fr->len[k], cs = fr->cosv[jp];
+                    int go = alive_q;
+                    if (jv == jp) {
+                        MFMM_GLOBAL const mfmm_virt *vr = m->virts + (fr->virt >> 2);
+                        go = (s->label[vr->v] & MFMM_STATE_MASK) == MFMM_ALIVE;
+                        if (go) {
+                            ta = s->T[vr->v];
+                            b = vr->len;
+                            cs = vr->cos_b;
+                            t = mfmm_min(t, ta + b);
+                        }
+                    } else if (go) {
+                        ta = s->T[q];
+                    }
+                    if (go)
+                        t = mfmm_min(t, mfmm_triangle_interior(ta, tx, fr->len[jq], b, cs, 1.0));
                     mfmm_march_offer(s, m, p, lp, t);
                 }
             }
             /* (p's update may have changed q's label only if p == q: never) */
             if (!alive_q && !(lq & MFMM_FIXED)) {
-                if (general || jv == jq) {
+                if (general) {
                     mfmm_march_corner(s, m, fr, f_id, jq, q, lq, x, tx, alive_p);
                 } else {
-                    double t = tx + fr->len[jp];
-                    if (alive_p)
-                        t = mfmm_min(t, mfmm_triangle_interior(tx, s->T[p], fr->len[k], fr->len[jp],
-                                                               fr->cosv[jq], 1.0));
+                    /* q = C, x = A, p = B */
+                    double t = tx + fr->len[jp], tb = 0.0, a = fr->len[k], cs = fr->cosv[jq];
+                    int go = alive_p;
+                    if (jv == jq) {
+                        MFMM_GLOBAL const mfmm_virt *vr = m->virts + (fr->virt >> 2);
+                        go = (s->label[vr->v] & MFMM_STATE_MASK) == MFMM_ALIVE;
+                        if (go) {
+                            tb = s->T[vr->v];
+                            a = vr->len;
+                            cs = vr->cos_a;
+                            t = mfmm_min(t, tb + a);
+                        }
+                    } else if (go) {
+                        tb = s->T[p];
+                    }
+                    if (go)
+                        t = mfmm_min(t, mfmm_triangle_interior(tx, tb, a, fr->len[jp], cs, 1.0));
                     mfmm_march_offer(s, m, q, lq, t);
                 }
             }
