@@ -420,8 +420,35 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
         /* the virtual edges that end at x (flagged in x's faces, so that
          * other vertices need not read virt_first) */
         if ((flags & MFMM_ENDS_VIRTUAL) && s->unfolding)
-            for (mfmm_i32 j = m->virt_first[x]; j < m->virt_first[x + 1]; j++)
-                mfmm_march_virtual(s, m, m->virts + j, tx);
+            for (mfmm_i32 j = m->virt_first[x]; j < m->virt_first[x + 1]; j++) {
+                MFMM_GLOBAL const mfmm_virt *vr = m->virts + j;
+                if (general) {
+                    mfmm_march_virtual(s, m, vr, tx);
+                    continue;
+                }
+                /* F = 1 (as mfmm_march_virtual): the virtual edge, and the
+                 * virtual triangles with A and B that have settled */
+                mfmm_i32 c = vr->c;
+                mfmm_u8 lc = s->label[c];
+                if ((lc & MFMM_STATE_MASK) == MFMM_ALIVE || (lc & MFMM_FIXED))
+                    continue;
+                mfmm_i32 kc = vr->corner, fc = kc / 3, jc = kc - 3 * fc;
+                MFMM_GLOBAL const mfmm_face *fr = m->faces + fc;
+                mfmm_i32 ja = jc == 2 ? 0 : jc + 1, jb = ja == 2 ? 0 : ja + 1;
+                mfmm_i32 ia = fr->v[ja] & MFMM_VERTEX_MASK, ib = fr->v[jb] & MFMM_VERTEX_MASK;
+                double vlen = vr->len, t = tx + vlen;
+                if ((s->label[ia] & MFMM_STATE_MASK) == MFMM_ALIVE) {
+                    double ta = s->T[ia];
+                    t = mfmm_min(t, ta + fr->len[jb]);
+                    t = mfmm_min(t, mfmm_triangle_interior(ta, tx, vlen, fr->len[jb], vr->cos_a, 1.0));
+                }
+                if ((s->label[ib] & MFMM_STATE_MASK) == MFMM_ALIVE) {
+                    double tb = s->T[ib];
+                    t = mfmm_min(t, tb + fr->len[ja]);
+                    t = mfmm_min(t, mfmm_triangle_interior(tx, tb, fr->len[ja], vlen, vr->cos_b, 1.0));
+                }
+                mfmm_march_offer(s, m, c, lc, t);
+            }
     }
     /* a list is worth it for a local march; past nv/8 touched vertices a
      * sequential pass is cheaper than scattered ones (measured, bench_scale) */
