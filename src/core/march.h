@@ -344,6 +344,9 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
             mfmm_i32 y = s->heap_vertex[0];
             for (mfmm_i32 j = m->wedge_offset[y]; j < m->wedge_offset[y + 1]; j++)
                 MFMM_PREFETCH(m->faces + m->wedge[j] / 3);
+            /* and the first virtual edge ending at y (its list is short) */
+            if (s->unfolding)
+                MFMM_PREFETCH(m->virts + m->virt_first[y]);
         }
         double tx = s->T[x];
         int general = s->cost_location != 0;
