@@ -52,7 +52,7 @@ typedef uint8_t mfmm_u8;
 typedef struct mfmm_face {
     mfmm_i32 v[3];   /* internal vertex ids, | MFMM_ENDS_VIRTUAL where a
                         virtual edge ends (mask with MFMM_VERTEX_MASK) */
-    mfmm_i32 virt;   /* its obtuse corner k's mfmm_virt: 4 index + k; 3: none */
+    mfmm_i32 virt;   /* its obtuse corner k's virtual edge: 4 V + k; 3: none */
     double len[3];   /* len[k]: the edge opposite corner k */
     double cosv[3];  /* cos of the angle at corner k (NaN: zero area) */
 } mfmm_face;
@@ -62,16 +62,14 @@ typedef struct mfmm_face {
 #define MFMM_ENDS_VIRTUAL 0x40000000
 #define MFMM_VERTEX_MASK 0x3fffffff
 
-/* The virtual edge C -> V of an obtuse corner (section 4.2): V of the
- * unfolded patch, the corner 3 f + k it splits, |CV| in the unfolded plane
- * and the cosines of the two angles it splits theta into (A-C-V and V-C-B,
- * A and B the face's vertices after C). Stored sorted by V (the march
- * offers these when V settles). 40 bytes, C and OpenCL C. */
+/* The virtual edge C -> V of an obtuse corner (section 4.2): the corner
+ * 3 f + k it splits, its vertex C, |CV| in the unfolded plane and the
+ * cosines of the two angles it splits theta into (A-C-V and V-C-B, A and B
+ * the face's vertices after C). Stored sorted by V (the march offers these
+ * when V settles; the face names V). 32 bytes, C and OpenCL C. */
 typedef struct mfmm_virt {
-    mfmm_i32 v;
     mfmm_i32 corner;
     mfmm_i32 c;      /* the corner's vertex C */
-    mfmm_i32 unused;
     double len;   /* |CV| */
     double cos_a; /* cos of angle A-C-V */
     double cos_b; /* cos of angle V-C-B */

@@ -227,6 +227,18 @@ MFMM_INLINE void mfmm_march_offer(mfmm_march_state *s, const mfmm_march_mesh *m,
     }
 }
 
+/* The virtual edge of corner k = 3 f + k' that ends at V = iv: V's list
+ * (virt_first) holds it. Read only once V is Alive, when V's own settling
+ * has just read that list. */
+MFMM_INLINE MFMM_GLOBAL const mfmm_virt *mfmm_march_virt_of(const mfmm_march_mesh *m,
+                                                            mfmm_i32 iv, mfmm_i32 k)
+{
+    mfmm_i32 j = m->virt_first[iv];
+    while (m->virts[j].corner != k)
+        j++;
+    return m->virts + j;
+}
+
 /* x has just settled (T(x) = tx); c is vertex jc of face fr (id f_id),
  * neither Alive nor fixed, and y the face's third vertex (alive_y: whether
  * it has settled). Offers c what x newly makes possible in this face (section
@@ -249,17 +261,16 @@ MFMM_COLD void mfmm_march_corner(mfmm_march_state *s, const mfmm_march_mesh *m,
     /* |xc| is the edge opposite the third vertex */
     double best = x_is_a ? tx + fr->len[jb] * f_b : tx + fr->len[ja] * f_a;
     mfmm_i32 vi = fr->virt;
-    MFMM_GLOBAL const mfmm_virt *vr = 0;
-    if ((vi & 3) == jc && s->unfolding)
-        vr = m->virts + (vi >> 2);
-    if (vr) {
-        mfmm_i32 iv = vr->v;
+    int virt = (vi & 3) == jc && s->unfolding;
+    if (virt) {
+        mfmm_i32 iv = vi >> 2;
         int v_alive = (s->label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE;
         /* (the footprint matters once V, or both A and B, have settled) */
         if ((v_alive || alive_y) && s->cost_location != 0 &&
             !mfmm_march_virt_ok(s, m, 3 * f_id + jc, ia, ib, f))
-            vr = 0;
+            virt = 0;
         else if (v_alive) {
+            MFMM_GLOBAL const mfmm_virt *vr = mfmm_march_virt_of(m, iv, 3 * f_id + jc);
             double tv = s->T[iv];
             if (x_is_a)
                 best = mfmm_min(best, mfmm_triangle_update(tx, tv, vr->len, fr->len[jb],
@@ -269,7 +280,7 @@ MFMM_COLD void mfmm_march_corner(mfmm_march_state *s, const mfmm_march_mesh *m,
                                                            vr->cos_b, f_t));
         }
     }
-    if (!vr && alive_y)
+    if (!virt && alive_y)
         /* a zero-area face's NaN cosine makes this +inf */
         best = mfmm_min(best, mfmm_triangle_interior(s->T[ia], s->T[ib], fr->len[ja],
                                                      fr->len[jb], fr->cosv[jc], f_t));
@@ -411,10 +422,11 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
                     double t = tx + fr->len[jq], ta = 0.0, b = fr->len[k], cs = fr->cosv[jp];
                     int go = alive_q;
                     if (jv == jp) {
-                        MFMM_GLOBAL const mfmm_virt *vr = m->virts + (fr->virt >> 2);
-                        go = (s->label[vr->v] & MFMM_STATE_MASK) == MFMM_ALIVE;
+                        mfmm_i32 iv = fr->virt >> 2;
+                        go = (s->label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE;
                         if (go) {
-                            ta = s->T[vr->v];
+                            MFMM_GLOBAL const mfmm_virt *vr = mfmm_march_virt_of(m, iv, w - k + jp);
+                            ta = s->T[iv];
                             b = vr->len;
                             cs = vr->cos_b;
                             t = mfmm_min(t, ta + b);
@@ -436,10 +448,11 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
                     double t = tx + fr->len[jp], tb = 0.0, a = fr->len[k], cs = fr->cosv[jq];
                     int go = alive_p;
                     if (jv == jq) {
-                        MFMM_GLOBAL const mfmm_virt *vr = m->virts + (fr->virt >> 2);
-                        go = (s->label[vr->v] & MFMM_STATE_MASK) == MFMM_ALIVE;
+                        mfmm_i32 iv = fr->virt >> 2;
+                        go = (s->label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE;
                         if (go) {
-                            tb = s->T[vr->v];
+                            MFMM_GLOBAL const mfmm_virt *vr = mfmm_march_virt_of(m, iv, w - k + jq);
+                            tb = s->T[iv];
                             a = vr->len;
                             cs = vr->cos_a;
                             t = mfmm_min(t, tb + a);

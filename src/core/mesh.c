@@ -261,7 +261,8 @@ static void build_corners(mfmm_mesh *m)
  * face (its vertices, the length opposite each corner, each corner's cosine,
  * NaN on a zero-area face), and one mfmm_virt per obtuse corner whose
  * virtual edge unfolding found, sorted by V (counting sort, so by corner
- * within one V), the face pointing at it. The strips' vertices (for the
+ * within one V), the face naming V (the march reads the record from V's
+ * list once V is Alive). The strips' vertices (for the
  * virtual stencils' cost test) parallel to virt_steps. Frees m->full. */
 static mfmm_status build_records(mfmm_mesh *m)
 {
@@ -270,7 +271,8 @@ static mfmm_status build_records(mfmm_mesh *m)
     size_t n_virts = 0;
     for (size_t c = 0; c < nc; c++)
         n_virts += m->full[c].virt >= 0;
-    if (n_virts > (size_t)INT32_MAX / 4) /* (mfmm_face.virt packs 4 index + k) */
+    if (n_virts > (size_t)INT32_MAX ||
+        (n_virts > 0 && m->nv > INT32_MAX / 4)) /* (mfmm_face.virt packs 4 V + k) */
         return MFMM_ERR_BAD_COUNT;
     m->n_virts = (int32_t)n_virts;
     /* on cache-line boundaries: one record, one line */
@@ -308,14 +310,12 @@ static mfmm_status build_records(mfmm_mesh *m)
             /* (a face has at most one obtuse corner) */
             int32_t at = first[x->virt]++;
             mfmm_virt *vr = m->virts + at;
-            vr->v = x->virt;
             vr->corner = (int32_t)(3 * f + (size_t)k);
             vr->c = m->faces[3 * f + k];
-            vr->unused = 0;
             vr->len = x->virt_len;
             vr->cos_a = x->virt_cos_a;
             vr->cos_b = x->virt_cos_b;
-            r->virt = 4 * at + k;
+            r->virt = 4 * x->virt + k;
         }
     }
     for (int32_t v = m->nv; v > 0; v--)
