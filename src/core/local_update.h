@@ -50,17 +50,11 @@ typedef uint8_t mfmm_u8;
  * one record. 64 bytes, one cache line, C and OpenCL C. cosv is NaN on a
  * zero-area face (no triangle update: Eq. 4 then yields +inf, at no cost). */
 typedef struct mfmm_face {
-    mfmm_i32 v[3];   /* internal vertex ids, | MFMM_ENDS_VIRTUAL where a
-                        virtual edge ends (mask with MFMM_VERTEX_MASK) */
+    mfmm_i32 v[3];   /* internal vertex ids */
     mfmm_i32 virt;   /* its obtuse corner k's virtual edge: 4 V + k; 3: none */
     double len[3];   /* len[k]: the edge opposite corner k */
     double cosv[3];  /* cos of the angle at corner k (NaN: zero area) */
 } mfmm_face;
-
-/* In mfmm_face.v: the vertex is the V of some virtual edge (vertex ids are
- * below INT32_MAX / 3, so bit 30 is free). */
-#define MFMM_ENDS_VIRTUAL 0x40000000
-#define MFMM_VERTEX_MASK 0x3fffffff
 
 /* The virtual edge C -> V of an obtuse corner (section 4.2): the corner
  * 3 f + k it splits, its vertex C, |CV| in the unfolded plane and the

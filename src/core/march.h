@@ -253,7 +253,7 @@ MFMM_COLD void mfmm_march_corner(mfmm_march_state *s, const mfmm_march_mesh *m,
                                    mfmm_i32 c, mfmm_u8 lc, mfmm_i32 x, double tx, int alive_y)
 {
     mfmm_i32 ja = jc == 2 ? 0 : jc + 1, jb = ja == 2 ? 0 : ja + 1;
-    mfmm_i32 ia = fr->v[ja] & MFMM_VERTEX_MASK, ib = fr->v[jb] & MFMM_VERTEX_MASK;
+    mfmm_i32 ia = fr->v[ja], ib = fr->v[jb];
     int x_is_a = ia == x;
     double f_a = 1.0, f_b = 1.0, f_t = 1.0, f = 1.0;
     if (s->cost_location != 0)
@@ -300,7 +300,7 @@ MFMM_COLD void mfmm_march_virtual(mfmm_march_state *s, const mfmm_march_mesh *m,
     mfmm_i32 k = vr->corner, f_id = k / 3, jc = k - 3 * f_id;
     MFMM_GLOBAL const mfmm_face *fr = m->faces + f_id;
     mfmm_i32 ja = jc == 2 ? 0 : jc + 1, jb = ja == 2 ? 0 : ja + 1;
-    mfmm_i32 ia = fr->v[ja] & MFMM_VERTEX_MASK, ib = fr->v[jb] & MFMM_VERTEX_MASK;
+    mfmm_i32 ia = fr->v[ja], ib = fr->v[jb];
     double f_a = 1.0, f_b = 1.0, f_t = 1.0, f = 1.0;
     if (s->cost_location != 0) {
         f = mfmm_march_cost(s, f_id, c, ia, ib, &f_a, &f_b, &f_t);
@@ -365,8 +365,8 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
         /* the virtual edges that end at x (section 4.2), before x's faces:
          * their records and C's face are loads of their own, which then
          * overlap with the face walk instead of waiting after it (measured:
-         * nefertiti unfolding 1 7.48 -> 7.14 ms; after the walk, behind
-         * x's MFMM_ENDS_VIRTUAL flag, they cost 2.5x main's virtual entries) */
+         * nefertiti unfolding 1 7.48 -> 7.14 ms; after the walk, behind a
+         * flag in x's faces, they cost 2.5x main's virtual entries) */
         if (s->unfolding)
             for (mfmm_i32 j = m->virt_first[x]; j < m->virt_first[x + 1]; j++) {
                 MFMM_GLOBAL const mfmm_virt *vr = m->virts + j;
@@ -383,7 +383,7 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
                 mfmm_i32 kc = vr->corner, fc = kc / 3, jc = kc - 3 * fc;
                 MFMM_GLOBAL const mfmm_face *fr = m->faces + fc;
                 mfmm_i32 ja = jc == 2 ? 0 : jc + 1, jb = ja == 2 ? 0 : ja + 1;
-                mfmm_i32 ia = fr->v[ja] & MFMM_VERTEX_MASK, ib = fr->v[jb] & MFMM_VERTEX_MASK;
+                mfmm_i32 ia = fr->v[ja], ib = fr->v[jb];
                 double vlen = vr->len, t = tx + vlen;
                 if ((s->label[ia] & MFMM_STATE_MASK) == MFMM_ALIVE) {
                     double ta = s->T[ia];
@@ -402,7 +402,7 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
             mfmm_i32 w = m->wedge[j], f_id = w / 3, k = w - 3 * f_id;
             MFMM_GLOBAL const mfmm_face *fr = m->faces + f_id;
             mfmm_i32 jp = k == 2 ? 0 : k + 1, jq = jp == 2 ? 0 : jp + 1;
-            mfmm_i32 p = fr->v[jp] & MFMM_VERTEX_MASK, q = fr->v[jq] & MFMM_VERTEX_MASK;
+            mfmm_i32 p = fr->v[jp], q = fr->v[jq];
             mfmm_u8 lp = s->label[p], lq = s->label[q];
             int alive_p = (lp & MFMM_STATE_MASK) == MFMM_ALIVE;
             int alive_q = (lq & MFMM_STATE_MASK) == MFMM_ALIVE;

@@ -293,11 +293,9 @@ static mfmm_status build_records(mfmm_mesh *m)
             first[m->full[c].virt + 1]++;
     for (int32_t v = 0; v < m->nv; v++)
         first[v + 1] += first[v];
-    for (size_t f = 0; f < nf; f++) /* (first[] holds starts yet) */
-        for (int k = 0; k < 3; k++) {
-            int32_t v = m->faces[3 * f + k];
-            m->face_records[f].v[k] = v | (first[v + 1] > first[v] ? MFMM_ENDS_VIRTUAL : 0);
-        }
+    for (size_t f = 0; f < nf; f++)
+        for (int k = 0; k < 3; k++)
+            m->face_records[f].v[k] = m->faces[3 * f + k];
     for (size_t f = 0; f < nf; f++) {
         mfmm_face *r = m->face_records + f;
         r->virt = 3;
