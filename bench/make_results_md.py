@@ -599,6 +599,7 @@ def exact_start_section():
     radii = [str(r) for r in es["radii"]]
     want = es.get("default_radius") or 6.0
     default = next((r for r in radii if float(r) == float(want)), radii[-1])
+    times = [c["time_ratio"] for c in es["cases"] if "time_ratio" in c] or [float("nan")]
     D = ["## Exact start", "",
          f"**Machine:** {machine_line(es)}.", "",
          "The march starts from the exact distances (mfmm_solve_exact's window propagation) of "
@@ -607,17 +608,16 @@ def exact_start_section():
          f"(`bench/bench_exact_start.py`). The default r = {float(default):g} was chosen on the "
          "*choice* cases (" + ", ".join(es["choice_set"]) + "; the bunny, the one mesh above "
          "0.6x at r = 6, set it): the error falls with r on every case, and r = 7 is the least "
-         "that brings the bunny to 0.6x. Its time per source is 1.05-1.16x the plain start's on "
-         "the meshes of 10k vertices and more but sine 100, which is at the 1.2x limit and over "
-         "it in some runs (1.25x in the table's run; 1.18-1.25x in repeated runs, 1.19-1.21x "
-         "best-of-60 in C; its centre source, among saddles, costs the most). The patch also "
-         "holds the "
+         "that brings the bunny to 0.6x. Its time per source is "
+         f"{min(times):.2f}-{max(times):.2f}x the plain start's on the meshes of 10k vertices "
+         "and more in this run (the goal: at most 1.2x; the most on sine 100, whose centre "
+         "source lies among saddles). The patch also holds the "
          "vertices just beyond r whose distances the propagation made exact anyway (within their "
          "faces' least height of r). The other cases "
          "were not used to choose it (two made for this benchmark: a jittered sine surface and "
          "a random Delaunay mesh). Heat: potpourri3d's robust heat method "
          "(`MeshHeatMethodDistanceSolver(use_robust=True)`). Time: per source, plain and exact "
-         "start in alternating rounds, one run (ratios; the machine was shared). The per-mesh "
+         "start in alternating rounds, one run (ratios). The per-mesh "
          "tables above come from peers.json; where it predates the exact start, their meshfmm "
          "column is the plain start.", ""]
     head = "| case | nv | set | " + " | ".join(f"r = {r}" for r in radii) + \

@@ -129,10 +129,14 @@ typedef struct cli_sources_and_cost {
         {"cost-per-face", no_argument, NULL, OPT_COST_PER_FACE},                             \
         {"plain-start", no_argument, NULL, OPT_PLAIN_START},                                 \
         {"exact-start-radius", required_argument, NULL, OPT_EXACT_START_RADIUS}
+/* A macro's value as a string literal (help texts quote the library's defaults). */
+#define CLI_STR_(x) #x
+#define CLI_STR(x) CLI_STR_(x)
 /* The help lines of the start options (distance, path, allpairs). */
 #define CLI_START_HELP                                                                       \
     "  --exact-start-radius R  start the march from exact distances within R mean\n"        \
-    "                          edge lengths of each source (default 6)\n"                   \
+    "                          edge lengths of each source (default " CLI_STR(             \
+        MFMM_EXACT_START_RADIUS) ")\n"                                                      \
     "  --plain-start           the paper's start (as --exact-start-radius 0)\n"
 /* Parses --exact-start-radius's value: CLI_OK, or CLI_USAGE with the error printed. */
 int cli_parse_start_radius(const char *sub, const char *arg, double *radius);
