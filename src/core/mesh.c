@@ -29,6 +29,8 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
         return;
     free(mesh->to_internal);
     free(mesh->to_external);
+    free(mesh->face_to_internal);
+    free(mesh->face_to_external);
     free(mesh->xyz);
     free(mesh->faces);
     free(mesh->face_neighbor);
@@ -404,7 +406,9 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
     }
-    /* renumbered: coordinates in internal order, face corners' ids mapped */
+    /* renumbered: coordinates in internal order, faces' vertex ids mapped
+     * (face_neighbor holds them in input face order until the faces are
+     * ordered by them) */
     if (mfmm_order_build(vertices, nv, &m->to_internal, &m->to_external) != MFMM_OK) {
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
@@ -412,7 +416,15 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
     for (int32_t v = 0; v < nv; v++)
         memcpy(m->xyz + 3 * (size_t)v, vertices + 3 * (size_t)m->to_external[v], 3 * sizeof *m->xyz);
     for (size_t c = 0; c < nc; c++)
-        m->faces[c] = m->to_internal[faces[c]];
+        m->face_neighbor[c] = m->to_internal[faces[c]];
+    if (mfmm_order_faces(m->face_neighbor, nf, &m->face_to_internal, &m->face_to_external) !=
+        MFMM_OK) {
+        mfmm_mesh_destroy(m);
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
+    }
+    for (int32_t f = 0; f < nf; f++)
+        memcpy(m->faces + 3 * (size_t)f, m->face_neighbor + 3 * (size_t)m->face_to_external[f],
+               3 * sizeof *m->faces);
     m->info.n_vertices = nv;
     m->info.n_faces = nf;
 
@@ -516,6 +528,7 @@ int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, i
         {"component", nv * sizeof(int32_t)},
         {"degenerate", nf},
         {"to_internal/to_external", 2 * nv * sizeof(int32_t)},
+        {"face_to_internal/external", 2 * nf * sizeof(int32_t)},
         {"face records", nf * sizeof(mfmm_face)},
         {"virtual edges", (size_t)mesh->n_virts * sizeof(mfmm_virt) + (nv + 1) * sizeof(int32_t)},
         {"strip", n_steps * sizeof(int32_t)},

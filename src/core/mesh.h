@@ -30,11 +30,14 @@ typedef struct mfmm_corner_full {
 
 struct mfmm_mesh {
     int32_t nv, nf;
-    /* Vertices are numbered internally along a space-filling curve (order.h):
-     * every per-vertex array below, and the vertex ids in faces, are in
-     * that order; faces keep their input ids and corner order. */
+    /* Vertices are numbered internally along a space-filling curve, faces
+     * by their least internal vertex (order.h): every per-vertex and
+     * per-face array below, and the vertex ids in faces, are in that order;
+     * a face keeps its corner order. */
     int32_t *to_internal;      /* (nv,) internal id of each input vertex */
     int32_t *to_external;      /* (nv,) input id of each internal vertex */
+    int32_t *face_to_internal; /* (nf,) internal id of each input face */
+    int32_t *face_to_external; /* (nf,) input id of each internal face */
     double *xyz;               /* (nv, 3) */
     int32_t *faces;            /* (nf, 3) */
     int32_t *face_neighbor;    /* (nf, 3): face across the edge opposite corner k,
