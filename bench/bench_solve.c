@@ -4,7 +4,8 @@
  * update list, each neighbour once, edge lengths precomputed), with the same
  * 8-ary heap, vertex order and per-solve reset. ratio = march time / Dijkstra
  * time. Usage:
- *   bench_solve [--repeats R] [--sources S] MESH...
+ *   bench_solve [--repeats R] [--sources S] [--exact-start R] MESH...
+ * The march starts plain (the paper's start) unless --exact-start R > 0.
  * With no MESH, the larger meshes of tests/data/meshes and generated spheres. */
 #include <math.h>
 #include <stdio.h>
@@ -38,18 +39,28 @@ typedef struct graph {
 
 static int graph_build(const mfmm_mesh *m, graph *g)
 {
-    int32_t nv = m->nv, n_pairs = m->update_offset[nv];
+    int32_t nv = m->nv;
+    /* at most: 2 per face corner, 1 per virtual edge */
+    size_t cap = 2 * (size_t)m->vertex_face_offset[nv] + (size_t)m->n_virts + 1;
     g->nv = nv;
     g->off = malloc(((size_t)nv + 1) * sizeof *g->off);
-    g->nbr = malloc(((size_t)n_pairs + 1) * sizeof *g->nbr);
-    g->len = malloc(((size_t)n_pairs + 1) * sizeof *g->len);
+    g->nbr = malloc(cap * sizeof *g->nbr);
+    g->len = malloc(cap * sizeof *g->len);
     if (!g->off || !g->nbr || !g->len)
         return 0;
     int32_t k = 0;
     for (int32_t x = 0; x < nv; x++) {
         g->off[x] = k;
-        for (int32_t j = m->update_offset[x]; j < m->update_offset[x + 1]; j++) {
-            int32_t c = m->update_corner[2 * j + 1], dup = 0;
+        /* x's face neighbours and the corners whose virtual edge ends at x */
+        int32_t nw = m->vertex_face_offset[x + 1] - m->vertex_face_offset[x];
+        for (int32_t j = 0; j < 2 * nw + m->virt_first[x + 1] - m->virt_first[x]; j++) {
+            int32_t c, dup = 0;
+            if (j < 2 * nw) {
+                int32_t w = m->vertex_face_corner[m->vertex_face_offset[x] + j / 2];
+                c = m->faces[3 * (w / 3) + (w % 3 + 1 + j % 2) % 3];
+            } else {
+                c = m->faces[m->virts[m->virt_first[x] + j - 2 * nw].corner];
+            }
             for (int32_t i = g->off[x]; i < k && !dup; i++)
                 dup = g->nbr[i] == c;
             if (dup || c == x)
@@ -134,6 +145,8 @@ static double ceiling_time(const mfmm_mesh *mesh, int repeats, int n_sources, do
     return med;
 }
 
+static double exact_start = 0.0; /* --exact-start R */
+
 static void bench(const char *name, const double *V, int32_t nv, const int32_t *F, int32_t nf,
                   int repeats, int n_sources)
 {
@@ -165,6 +178,7 @@ static void bench(const char *name, const double *V, int32_t nv, const int32_t *
         mfmm_solve_options opt;
         mfmm_solve_options_init(&opt);
         opt.unfolding = unfolding;
+        opt.exact_start_radius = exact_start; /* 0: the march alone, as the ceiling */
         int k = 0;
         int32_t settled = 0;
         for (int s = 0; s < n_sources; s++) {
@@ -203,8 +217,10 @@ int main(int argc, char **argv)
             repeats = atoi(argv[first + 1]);
         else if (!strcmp(argv[first], "--sources") && first + 1 < argc)
             n_sources = atoi(argv[first + 1]);
+        else if (!strcmp(argv[first], "--exact-start") && first + 1 < argc)
+            exact_start = atof(argv[first + 1]);
         else {
-            fprintf(stderr, "usage: bench_solve [--repeats R] [--sources S] [MESH...]\n");
+            fprintf(stderr, "usage: bench_solve [--repeats R] [--sources S] [--exact-start R] [MESH...]\n");
             return 2;
         }
         first += 2;

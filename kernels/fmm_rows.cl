@@ -17,25 +17,27 @@
 #include "march.h"
 
 /* The march for source sources[first + gid], with T in T_row. */
-inline void mfmm_row_march(int nv, __global const int *update_offset,
-                           __global const int *update_corner,
-                           __global const mfmm_corner *corners, __global const double *cost,
+inline void mfmm_row_march(int nv, __global const int *wedge_offset,
+                           __global const int *wedge,
+                           __global const mfmm_face *faces, __global const double *cost,
                            int cost_location, double max_distance, int unfolding,
                            int source, __global double *T_row, __global uchar *label,
                            __global double *heap_key, __global int *heap_vertex,
                            __global int *heap_pos, __global const int *strip,
                            __global const double *uniform,
                            __global const int *targets, int n_targets,
-                           __global const int *slot_corner, __global const int *strip_offset,
+                           __global const mfmm_virt *virts, __global const int *strip_offset,
                            __global const int *seeds, int row,
-                           __global const double *seed_value)
+                           __global const double *seed_value,
+                           __global const int *virt_first)
 {
     mfmm_march_mesh m;
     m.nv = nv;
-    m.update_offset = update_offset;
-    m.update_corner = update_corner;
-    m.corners = corners;
-    m.slot_corner = slot_corner;
+    m.wedge_offset = wedge_offset;
+    m.wedge = wedge;
+    m.faces = faces;
+    m.virts = virts;
+    m.virt_first = virt_first;
     m.strip_offset = strip_offset;
     m.strip = strip;
     mfmm_march_state s;
@@ -73,29 +75,31 @@ inline void mfmm_row_march(int nv, __global const int *update_offset,
 /* float64 rows: T in a workspace slice, the row gathered from it in the
  * caller's vertex order (order: internal id of each input vertex, as
  * src/core/order.h), or the target columns copied out. */
-__kernel void fmm_rows_f64(int nv, __global const int *update_offset,
-                           __global const int *update_corner,
-                           __global const mfmm_corner *corners, __global const double *cost,
+__kernel void fmm_rows_f64(int nv, __global const int *wedge_offset,
+                           __global const int *wedge,
+                           __global const mfmm_face *faces, __global const double *cost,
                            int cost_location, double max_distance, int unfolding,
                            __global const int *sources, int first, int count,
                            __global uchar *label_ws, __global double *key_ws,
                            __global int *vert_ws, __global int *pos_ws, __global double *out,
                            __global const int *strip, __global const double *uniform,
                            __global const int *targets, int n_targets, __global double *T_ws,
-                           __global const int *order, __global const int *slot_corner,
+                           __global const int *order, __global const mfmm_virt *virts,
                            __global const int *strip_offset,
                            int n_seeds, __global const int *seeds,
-                           __global const double *seed_value)
+                           __global const double *seed_value,
+                           __global const int *virt_first)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
         return;
     ulong o = (ulong)i * (ulong)nv;
     __global double *T = T_ws + o;
-    mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
+    mfmm_row_march(nv, wedge_offset, wedge, faces, cost, cost_location,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
                    key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets,
-                   slot_corner, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value);
+                   virts, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value,
+                   virt_first);
     if (n_targets > 0) {
         __global double *row = out + (ulong)i * (ulong)n_targets;
         for (int j = 0; j < n_targets; j++)
@@ -109,9 +113,9 @@ __kernel void fmm_rows_f64(int nv, __global const int *update_offset,
 
 /* float32 rows: T in a workspace slice, converted (round to nearest) in
  * the caller's vertex order (as float64). */
-__kernel void fmm_rows_f32(int nv, __global const int *update_offset,
-                           __global const int *update_corner,
-                           __global const mfmm_corner *corners, __global const double *cost,
+__kernel void fmm_rows_f32(int nv, __global const int *wedge_offset,
+                           __global const int *wedge,
+                           __global const mfmm_face *faces, __global const double *cost,
                            int cost_location, double max_distance, int unfolding,
                            __global const int *sources, int first, int count,
                            __global uchar *label_ws, __global double *key_ws,
@@ -119,20 +123,22 @@ __kernel void fmm_rows_f32(int nv, __global const int *update_offset,
                            __global double *T_ws, __global float *out,
                            __global const int *strip, __global const double *uniform,
                            __global const int *targets, int n_targets, __global double *unused,
-                           __global const int *order, __global const int *slot_corner,
+                           __global const int *order, __global const mfmm_virt *virts,
                            __global const int *strip_offset,
                            int n_seeds, __global const int *seeds,
-                           __global const double *seed_value)
+                           __global const double *seed_value,
+                           __global const int *virt_first)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
         return;
     ulong o = (ulong)i * (ulong)nv;
     __global double *T = T_ws + o;
-    mfmm_row_march(nv, update_offset, update_corner, corners, cost, cost_location,
+    mfmm_row_march(nv, wedge_offset, wedge, faces, cost, cost_location,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
                    key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets,
-                   slot_corner, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value);
+                   virts, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value,
+                   virt_first);
     (void)unused;
     if (n_targets > 0) {
         __global float *row = out + (ulong)i * (ulong)n_targets;

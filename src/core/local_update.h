@@ -15,6 +15,7 @@
 #pragma OPENCL FP_CONTRACT OFF
 #define MFMM_GLOBAL __global
 #define MFMM_INLINE inline __attribute__((always_inline)) /* PoCL makes calls of plain inline (issue 13.4) */
+#define MFMM_COLD MFMM_INLINE
 #define MFMM_INF ((double)INFINITY)
 typedef int mfmm_i32;
 typedef uchar mfmm_u8;
@@ -22,7 +23,17 @@ typedef uchar mfmm_u8;
 #include <math.h>
 #include <stdint.h>
 #define MFMM_GLOBAL
+#if defined(__GNUC__) || defined(__clang__)
+/* the march's per-face steps are called from two places: GCC left them as
+ * calls (~30 instructions of spills each, callgrind) */
+#define MFMM_INLINE static inline __attribute__((always_inline))
+/* a march step off the common path (a cost, a virtual stencil): kept out
+ * of line so that the common path keeps its values in registers */
+#define MFMM_COLD static __attribute__((noinline))
+#else
 #define MFMM_INLINE static inline
+#define MFMM_COLD static inline
+#endif
 #define MFMM_INF ((double)INFINITY)
 typedef int32_t mfmm_i32;
 typedef uint8_t mfmm_u8;
@@ -31,28 +42,29 @@ typedef uint8_t mfmm_u8;
 /* A corner is obtuse (section 4.2) when cos theta is below this. */
 #define MFMM_OBTUSE_COS (-1e-9)
 
-/* One corner C of a face, with what its update needs: its other vertices A
- * and B (a = |BC|, b = |AC|, angle theta at C). C itself and the face are
- * known from where the record is stored (march.h). cos_c is NaN on a
- * zero-area face (no triangle update: Eq. 4 then yields +inf, at no cost).
- * An obtuse corner's record is followed by an mfmm_virt in the next slot,
- * so that its virtual edge comes in the same fetch, and only obtuse corners
- * pay for one. 32 bytes (was 64 for every corner), C and OpenCL C. */
-typedef struct mfmm_corner {
-    mfmm_i32 a, b;
-    double len_a;      /* |BC| */
-    double len_b;      /* |AC| */
-    double cos_c;      /* cos theta at C (NaN: zero area) */
-} mfmm_corner;
+/* One face as the march reads it: its vertices, the length of the edge
+ * opposite each corner and the cosine of each corner's angle (section 4.1),
+ * and its obtuse corner's virtual edge (section 4.2), if it has one. When a
+ * vertex x settles the march walks x's faces (march.h): in face (x, y, c)
+ * every length and angle that updating c from x (and y) needs is in this
+ * one record. 64 bytes, one cache line, C and OpenCL C. cosv is NaN on a
+ * zero-area face (no triangle update: Eq. 4 then yields +inf, at no cost). */
+typedef struct mfmm_face {
+    mfmm_i32 v[3];   /* internal vertex ids */
+    mfmm_i32 virt;   /* its obtuse corner k's virtual edge: 4 V + k; 3: none */
+    double len[3];   /* len[k]: the edge opposite corner k */
+    double cosv[3];  /* cos of the angle at corner k (NaN: zero area) */
+} mfmm_face;
 
-/* The virtual edge C -> V of an obtuse corner (section 4.2), in the slot
- * after its mfmm_corner: V of the unfolded patch (-1: the walk failed, the
- * plain stencil), |CV| and the cosines of the two angles it splits theta
- * into (A-C-V and V-C-B). 32 bytes, C and OpenCL C. */
+/* The virtual edge C -> V of an obtuse corner (section 4.2): the corner
+ * 3 f + k it splits, its vertex C, |CV| in the unfolded plane and the
+ * cosines of the two angles it splits theta into (A-C-V and V-C-B, A and B
+ * the face's vertices after C). Stored sorted by V (the march offers these
+ * when V settles; the face names V). 32 bytes, C and OpenCL C. */
 typedef struct mfmm_virt {
-    mfmm_i32 v;
-    mfmm_i32 unused;
-    double len;   /* |CV| in the unfolded plane */
+    mfmm_i32 corner;
+    mfmm_i32 c;      /* the corner's vertex C */
+    double len;   /* |CV| */
     double cos_a; /* cos of angle A-C-V */
     double cos_b; /* cos of angle V-C-B */
 } mfmm_virt;
@@ -132,45 +144,6 @@ MFMM_INLINE double mfmm_triangle_update(double ta, double tb, double a, double b
 {
     double edge = mfmm_min(ta + b * f, tb + a * f);
     return mfmm_min(mfmm_triangle_interior(ta, tb, a, b, cos_c, f), edge);
-}
-
-/* The best T(C) that corner `cr` offers from its settled neighbours; +inf if
- * none. Costs: f_b along edge CA, f_a along edge CB, f_t across the
- * triangle and over the virtual stencil vr (which is used only where the
- * cost is the same all around, march.h); vr NULL: the plain stencil. */
-MFMM_INLINE double mfmm_corner_update(MFMM_GLOBAL const mfmm_corner *cr,
-                                      MFMM_GLOBAL const mfmm_virt *vr,
-                                      MFMM_GLOBAL const double *T,
-                                      MFMM_GLOBAL const mfmm_u8 *label,
-                                      double f_a, double f_b, double f_t)
-{
-    mfmm_i32 ia = cr->a, ib = cr->b;
-    int alive_a = (label[ia] & MFMM_STATE_MASK) == MFMM_ALIVE;
-    int alive_b = (label[ib] & MFMM_STATE_MASK) == MFMM_ALIVE;
-    double best = MFMM_INF;
-    if (alive_a) best = mfmm_min(best, T[ia] + cr->len_b * f_b);
-    if (alive_b) best = mfmm_min(best, T[ib] + cr->len_a * f_a);
-    if (vr) {
-        /* section 4.2: the obtuse angle split into two acute virtual
-         * triangles A-C-V and V-C-B */
-        mfmm_i32 iv = vr->v;
-        if ((label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE) {
-            double tv = T[iv];
-            best = mfmm_min(best, tv + vr->len * f_t);
-            if (alive_a)
-                best = mfmm_min(best, mfmm_triangle_update(T[ia], tv, vr->len, cr->len_b,
-                                                       vr->cos_a, f_t));
-            if (alive_b)
-                best = mfmm_min(best, mfmm_triangle_update(tv, T[ib], cr->len_a, vr->len,
-                                                       vr->cos_b, f_t));
-        }
-    } else if (alive_a && alive_b) {
-        /* the edge updates are above, each with its own edge's cost; a
-         * zero-area face's NaN cos_c makes this +inf */
-        best = mfmm_min(best, mfmm_triangle_interior(T[ia], T[ib], cr->len_a, cr->len_b,
-                                                 cr->cos_c, f_t));
-    }
-    return best;
 }
 
 #endif /* MFMM_LOCAL_UPDATE_H */

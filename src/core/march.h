@@ -14,16 +14,15 @@
 /* The arrays of a mesh that a march reads. */
 typedef struct mfmm_march_mesh {
     mfmm_i32 nv;
-    MFMM_GLOBAL const mfmm_i32 *update_offset; /* (nv+1,) CSR into update_corner pairs */
-    /* when a vertex settles: pairs (corner index, its vertex C) to recompute,
-     * 2 * update_offset[nv] entries; C is here so that settled neighbours are
-     * skipped without touching their corner records */
-    MFMM_GLOBAL const mfmm_i32 *update_corner;
-    /* corner records in slots of 32 bytes, grouped by vertex C; an obtuse
-     * corner's record takes two (its mfmm_virt in the second) */
-    MFMM_GLOBAL const mfmm_corner *corners;
-    /* slot r's corner 3 f + k: for the face's cost and the strip only */
-    MFMM_GLOBAL const mfmm_i32 *slot_corner;
+    /* x's faces: corners 3 f + k (x = face f's vertex k) at
+     * wedge[wedge_offset[x]] .. wedge[wedge_offset[x + 1] - 1] */
+    MFMM_GLOBAL const mfmm_i32 *wedge_offset;
+    MFMM_GLOBAL const mfmm_i32 *wedge;
+    MFMM_GLOBAL const mfmm_face *faces; /* (nf,) */
+    /* the virtual edges, sorted by V: those ending at x are
+     * virts[virt_first[x]] .. virts[virt_first[x + 1] - 1] */
+    MFMM_GLOBAL const mfmm_virt *virts;
+    MFMM_GLOBAL const mfmm_i32 *virt_first;
     /* the vertices each virtual edge's strip unfolds up to V (A and B
      * aside): strip[strip_offset[k]] .. strip[strip_offset[k + 1] - 1] for
      * corner k = 3 f + k' */
@@ -158,56 +157,164 @@ MFMM_INLINE void mfmm_march_seed(mfmm_march_state *s, mfmm_i32 v, double value)
     }
 }
 
-/* The costs for updating vertex c through corner cr (mfmm_corner_update):
- * f_a along edge CB, f_b along CA, f_t across the triangle; returns F(C)
- * (per face: the face's F), what the virtual stencil's test compares.
+/* The costs for updating vertex c of face f from its other vertices a, b
+ * (the face's vertices after c, in its order): f_a along edge CB, f_b along
+ * CA, f_t across the triangle; returns F(C) (per face: the face's F), what
+ * the virtual stencil's test compares.
  * Per face, F is constant on the face. Per vertex, F is taken as linear
  * along each path: the mean of its ends' F on an edge (trapezoid), and
  * across the triangle the mean of F(C) and F at the middle of AB, as a
  * characteristic from AB to C has it. (F(C) alone over the whole triangle,
  * the paper's F_ij, made a cheap vertex pull T down through costly
  * neighbours: -96 % against a finer mesh, issue 9.1.) */
-MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, const mfmm_march_mesh *m,
-                                   MFMM_GLOBAL const mfmm_corner *cr, mfmm_i32 r, mfmm_i32 c,
-                                   double *f_a, double *f_b, double *f_t)
+MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, mfmm_i32 f_id, mfmm_i32 c,
+                                   mfmm_i32 a, mfmm_i32 b, double *f_a, double *f_b,
+                                   double *f_t)
 {
     double f = 1.0;
     if (s->cost_location == 1) {
         f = s->cost[c];
-        double fa = s->cost[cr->a], fb = s->cost[cr->b];
+        double fa = s->cost[a], fb = s->cost[b];
         *f_b = 0.5 * (fa + f);
         *f_a = 0.5 * (fb + f);
         *f_t = 0.5 * f + 0.25 * (fa + fb);
         return f;
     }
     if (s->cost_location == 2)
-        f = s->cost[m->slot_corner[r] / 3];
+        f = s->cost[f_id];
     *f_a = f;
     *f_b = f;
     *f_t = f;
     return f;
 }
 
-/* Whether the virtual stencil vr of corner record cr may be used
- * under the march's cost. Its virtual edge and triangles charge the corner's
- * own F over the unfolded strip between C and V and over the virtual
- * triangles A-C-V, V-C-B, which lie over faces other than the corner's: it
- * holds only where F is the same over that footprint, the faces around the
- * strip's vertices A, B and those up to V (per face: their F; per vertex: F
- * at each of their vertices), read from s->uniform. Elsewhere the corner
- * takes the plain stencil, as with unfolding off (issue 9.1: a cost-1 face's
- * virtual edge through cost-100 faces made T 50x too low). */
+/* Whether the virtual stencil of corner k = 3 f + k' (C, with the face's
+ * other vertices a, b) may be used under the march's cost. Its virtual edge
+ * and triangles charge the corner's own F over the unfolded strip between C
+ * and V and over the virtual triangles A-C-V, V-C-B, which lie over faces
+ * other than the corner's: it holds only where F is the same over that
+ * footprint, the faces around the strip's vertices A, B and those up to V
+ * (per face: their F; per vertex: F at each of their vertices), read from
+ * s->uniform. Elsewhere the corner takes the plain stencil, as with
+ * unfolding off (issue 9.1: a cost-1 face's virtual edge through cost-100
+ * faces made T 50x too low). */
 MFMM_INLINE int mfmm_march_virt_ok(const mfmm_march_state *s, const mfmm_march_mesh *m,
-                                   MFMM_GLOBAL const mfmm_corner *cr, mfmm_i32 r, double f)
+                                   mfmm_i32 k, mfmm_i32 a, mfmm_i32 b, double f)
 {
     MFMM_GLOBAL const double *U = s->uniform;
-    if (U[cr->a] != f || U[cr->b] != f)
+    if (U[a] != f || U[b] != f)
         return 0;
-    mfmm_i32 k = m->slot_corner[r];
     for (mfmm_i32 i = m->strip_offset[k]; i < m->strip_offset[k + 1]; i++)
         if (U[m->strip[i]] != f)
             return 0;
     return 1;
+}
+
+/* Offers t to vertex c (label lc): lowers T(c) and its heap key if t is
+ * less. */
+MFMM_INLINE void mfmm_march_offer(mfmm_march_state *s, const mfmm_march_mesh *m, mfmm_i32 c,
+                                  mfmm_u8 lc, double t)
+{
+    if (t < s->T[c]) {
+        mfmm_u8 st = lc & MFMM_STATE_MASK;
+        /* c joins the front: its own faces are read when it settles */
+        if (st == MFMM_FAR)
+            MFMM_PREFETCH(m->wedge + m->wedge_offset[c]);
+        s->T[c] = t;
+        mfmm_heap_push_or_decrease(s, c, t, st == MFMM_CLOSE);
+        mfmm_march_touch(s, c, st);
+        s->label[c] = (mfmm_u8)((lc & MFMM_TARGET) | MFMM_CLOSE);
+    }
+}
+
+/* The virtual edge of corner k = 3 f + k' that ends at V = iv: V's list
+ * (virt_first) holds it. Read only once V is Alive, when V's own settling
+ * has just read that list. */
+MFMM_INLINE MFMM_GLOBAL const mfmm_virt *mfmm_march_virt_of(const mfmm_march_mesh *m,
+                                                            mfmm_i32 iv, mfmm_i32 k)
+{
+    mfmm_i32 j = m->virt_first[iv];
+    while (m->virts[j].corner != k)
+        j++;
+    return m->virts + j;
+}
+
+/* x has just settled (T(x) = tx); c is vertex jc of face fr (id f_id),
+ * neither Alive nor fixed, and y the face's third vertex (alive_y: whether
+ * it has settled). Offers c what x newly makes possible in this face (section
+ * 4.1): the edge update from x and, when y is Alive, the triangle's inside;
+ * at an obtuse corner with a virtual edge (section 4.2), instead of the
+ * inside, the virtual triangle of x and V once V is Alive. Every other
+ * update through this face was offered when its last vertex settled
+ * (the edge from y when y did, the virtual edge's when V does), so c gets
+ * the minimum over the same updates as recomputing the whole corner. */
+MFMM_COLD void mfmm_march_corner(mfmm_march_state *s, const mfmm_march_mesh *m,
+                                   MFMM_GLOBAL const mfmm_face *fr, mfmm_i32 f_id, mfmm_i32 jc,
+                                   mfmm_i32 c, mfmm_u8 lc, mfmm_i32 x, double tx, int alive_y)
+{
+    mfmm_i32 ja = jc == 2 ? 0 : jc + 1, jb = ja == 2 ? 0 : ja + 1;
+    mfmm_i32 ia = fr->v[ja], ib = fr->v[jb];
+    int x_is_a = ia == x;
+    double f_a = 1.0, f_b = 1.0, f_t = 1.0, f = 1.0;
+    if (s->cost_location != 0)
+        f = mfmm_march_cost(s, f_id, c, ia, ib, &f_a, &f_b, &f_t);
+    /* |xc| is the edge opposite the third vertex */
+    double best = x_is_a ? tx + fr->len[jb] * f_b : tx + fr->len[ja] * f_a;
+    mfmm_i32 vi = fr->virt;
+    int virt = (vi & 3) == jc && s->unfolding;
+    if (virt) {
+        mfmm_i32 iv = vi >> 2;
+        int v_alive = (s->label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE;
+        /* (the footprint matters once V, or both A and B, have settled) */
+        if ((v_alive || alive_y) && s->cost_location != 0 &&
+            !mfmm_march_virt_ok(s, m, 3 * f_id + jc, ia, ib, f))
+            virt = 0;
+        else if (v_alive) {
+            MFMM_GLOBAL const mfmm_virt *vr = mfmm_march_virt_of(m, iv, 3 * f_id + jc);
+            double tv = s->T[iv];
+            if (x_is_a)
+                best = mfmm_min(best, mfmm_triangle_update(tx, tv, vr->len, fr->len[jb],
+                                                           vr->cos_a, f_t));
+            else
+                best = mfmm_min(best, mfmm_triangle_update(tv, tx, fr->len[ja], vr->len,
+                                                           vr->cos_b, f_t));
+        }
+    }
+    if (!virt && alive_y)
+        /* a zero-area face's NaN cosine makes this +inf */
+        best = mfmm_min(best, mfmm_triangle_interior(s->T[ia], s->T[ib], fr->len[ja],
+                                                     fr->len[jb], fr->cosv[jc], f_t));
+    mfmm_march_offer(s, m, c, lc, best);
+}
+
+/* x has just settled and is the V of virtual edge vr (section 4.2): offers
+ * its corner C the virtual edge and the virtual triangles with A and B that
+ * have settled. */
+MFMM_COLD void mfmm_march_virtual(mfmm_march_state *s, const mfmm_march_mesh *m,
+                                    MFMM_GLOBAL const mfmm_virt *vr, double tx)
+{
+    mfmm_i32 c = vr->c;
+    mfmm_u8 lc = s->label[c];
+    if ((lc & MFMM_STATE_MASK) == MFMM_ALIVE || (lc & MFMM_FIXED))
+        return;
+    mfmm_i32 k = vr->corner, f_id = k / 3, jc = k - 3 * f_id;
+    MFMM_GLOBAL const mfmm_face *fr = m->faces + f_id;
+    mfmm_i32 ja = jc == 2 ? 0 : jc + 1, jb = ja == 2 ? 0 : ja + 1;
+    mfmm_i32 ia = fr->v[ja], ib = fr->v[jb];
+    double f_a = 1.0, f_b = 1.0, f_t = 1.0, f = 1.0;
+    if (s->cost_location != 0) {
+        f = mfmm_march_cost(s, f_id, c, ia, ib, &f_a, &f_b, &f_t);
+        if (!mfmm_march_virt_ok(s, m, k, ia, ib, f))
+            return;
+    }
+    double best = tx + vr->len * f_t;
+    if ((s->label[ia] & MFMM_STATE_MASK) == MFMM_ALIVE)
+        best = mfmm_min(best, mfmm_triangle_update(s->T[ia], tx, vr->len, fr->len[jb],
+                                                   vr->cos_a, f_t));
+    if ((s->label[ib] & MFMM_STATE_MASK) == MFMM_ALIVE)
+        best = mfmm_min(best, mfmm_triangle_update(tx, s->T[ib], fr->len[ja], vr->len,
+                                                   vr->cos_b, f_t));
+    mfmm_march_offer(s, m, c, lc, best);
 }
 
 /* Seeds v at an exact value (the exact start, src/solve/seed.h): as
@@ -240,46 +347,123 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
         settled++;
         if (stop_at_targets && (lx & MFMM_TARGET) && --s->targets_left == 0)
             break;
-        mfmm_i32 end = m->update_offset[x + 1];
-        /* The march waits on corner records (cache misses). The next vertex
-         * to settle is almost always the new heap top: ask for its records
+        mfmm_i32 end = m->wedge_offset[x + 1];
+        /* The march waits on face records (cache misses). The next vertex
+         * to settle is almost always the new heap top: ask for its faces
          * one iteration ahead (this vertex's were asked for last iteration). */
         if (s->heap_size > 0) {
             mfmm_i32 y = s->heap_vertex[0];
-            for (mfmm_i32 j = m->update_offset[y]; j < m->update_offset[y + 1]; j++)
-                MFMM_PREFETCH(m->corners + m->update_corner[2 * j]);
+            for (mfmm_i32 j = m->wedge_offset[y]; j < m->wedge_offset[y + 1]; j++)
+                MFMM_PREFETCH(m->faces + m->wedge[j] / 3);
+            /* and the first virtual edge ending at y (its list is short) */
+            if (s->unfolding)
+                MFMM_PREFETCH(m->virts + m->virt_first[y]);
         }
-        for (mfmm_i32 j = m->update_offset[x]; j < end; j++) {
-            mfmm_i32 c = m->update_corner[2 * j + 1];
-            mfmm_u8 lc = s->label[c], st = lc & MFMM_STATE_MASK;
-            if (st == MFMM_ALIVE || (lc & MFMM_FIXED))
-                continue;
-            mfmm_i32 r = m->update_corner[2 * j];
-            MFMM_GLOBAL const mfmm_corner *cr = m->corners + r;
-            double f_a, f_b, f_t;
-            double f = mfmm_march_cost(s, m, cr, r, c, &f_a, &f_b, &f_t);
-            /* an obtuse corner's virtual stencil (section 4.2), if it has one */
-            MFMM_GLOBAL const mfmm_virt *vr = 0;
-            if (cr->cos_c < MFMM_OBTUSE_COS && s->unfolding) {
-                vr = (MFMM_GLOBAL const mfmm_virt *)(cr + 1);
-                /* (the footprint matters once V, or both A and B, have settled) */
-                if (vr->v < 0 ||
-                    (s->cost_location != 0 &&
-                     ((s->label[vr->v] & MFMM_STATE_MASK) == MFMM_ALIVE ||
-                      ((s->label[cr->a] & MFMM_STATE_MASK) == MFMM_ALIVE &&
-                       (s->label[cr->b] & MFMM_STATE_MASK) == MFMM_ALIVE)) &&
-                     !mfmm_march_virt_ok(s, m, cr, r, f)))
-                    vr = 0;
+        double tx = s->T[x];
+        int general = s->cost_location != 0;
+        mfmm_i32 no_virt = s->unfolding ? 0 : 3;
+        /* the virtual edges that end at x (section 4.2), before x's faces:
+         * their records and C's face are loads of their own, which then
+         * overlap with the face walk instead of waiting after it (measured:
+         * nefertiti unfolding 1 7.48 -> 7.14 ms; after the walk, behind a
+         * flag in x's faces, they cost 2.5x main's virtual entries) */
+        if (s->unfolding)
+            for (mfmm_i32 j = m->virt_first[x]; j < m->virt_first[x + 1]; j++) {
+                MFMM_GLOBAL const mfmm_virt *vr = m->virts + j;
+                if (general) {
+                    mfmm_march_virtual(s, m, vr, tx);
+                    continue;
+                }
+                /* F = 1 (as mfmm_march_virtual): the virtual edge, and the
+                 * virtual triangles with A and B that have settled */
+                mfmm_i32 c = vr->c;
+                mfmm_u8 lc = s->label[c];
+                if ((lc & MFMM_STATE_MASK) == MFMM_ALIVE || (lc & MFMM_FIXED))
+                    continue;
+                mfmm_i32 kc = vr->corner, fc = kc / 3, jc = kc - 3 * fc;
+                MFMM_GLOBAL const mfmm_face *fr = m->faces + fc;
+                mfmm_i32 ja = jc == 2 ? 0 : jc + 1, jb = ja == 2 ? 0 : ja + 1;
+                mfmm_i32 ia = fr->v[ja], ib = fr->v[jb];
+                double vlen = vr->len, t = tx + vlen;
+                if ((s->label[ia] & MFMM_STATE_MASK) == MFMM_ALIVE) {
+                    double ta = s->T[ia];
+                    t = mfmm_min(t, ta + fr->len[jb]);
+                    t = mfmm_min(t, mfmm_triangle_interior(ta, tx, vlen, fr->len[jb], vr->cos_a, 1.0));
+                }
+                if ((s->label[ib] & MFMM_STATE_MASK) == MFMM_ALIVE) {
+                    double tb = s->T[ib];
+                    t = mfmm_min(t, tb + fr->len[ja]);
+                    t = mfmm_min(t, mfmm_triangle_interior(tx, tb, fr->len[ja], vlen, vr->cos_b, 1.0));
+                }
+                mfmm_march_offer(s, m, c, lc, t);
             }
-            double t = mfmm_corner_update(cr, vr, s->T, s->label, f_a, f_b, f_t);
-            if (t < s->T[c]) {
-                /* c joins the front: its own update list is read when it settles */
-                if (st == MFMM_FAR)
-                    MFMM_PREFETCH(m->update_corner + 2 * m->update_offset[c]);
-                s->T[c] = t;
-                mfmm_heap_push_or_decrease(s, c, t, st == MFMM_CLOSE);
-                mfmm_march_touch(s, c, st);
-                s->label[c] = (mfmm_u8)((s->label[c] & MFMM_TARGET) | MFMM_CLOSE);
+        /* section 2's update of x's neighbours, face by face */
+        for (mfmm_i32 j = m->wedge_offset[x]; j < end; j++) {
+            mfmm_i32 w = m->wedge[j], f_id = w / 3, k = w - 3 * f_id;
+            MFMM_GLOBAL const mfmm_face *fr = m->faces + f_id;
+            mfmm_i32 jp = k == 2 ? 0 : k + 1, jq = jp == 2 ? 0 : jp + 1;
+            mfmm_i32 p = fr->v[jp], q = fr->v[jq];
+            mfmm_u8 lp = s->label[p], lq = s->label[q];
+            int alive_p = (lp & MFMM_STATE_MASK) == MFMM_ALIVE;
+            int alive_q = (lq & MFMM_STATE_MASK) == MFMM_ALIVE;
+            /* a cost: the general update. Else F = 1, inline: the edge from
+             * x (|xp| = len[jq]) and one triangle through x, the plain one
+             * once the third vertex is Alive or, at the face's obtuse corner
+             * with its virtual edge (section 4.2), the virtual triangle of x
+             * and V once V is Alive, with the virtual edge from V (V's
+             * settling offered it too: equal, so min leaves it). The same
+             * operands as mfmm_march_corner, so that both round alike. */
+            mfmm_i32 jv = (fr->virt | no_virt) & 3; /* 3: none */
+            if (!alive_p && !(lp & MFMM_FIXED)) {
+                if (general) {
+                    mfmm_march_corner(s, m, fr, f_id, jp, p, lp, x, tx, alive_q);
+                } else {
+                    /* p = C, q = A, x = B */
+                    double t = tx + fr->len[jq], ta = 0.0, b = fr->len[k], cs = fr->cosv[jp];
+                    int go = alive_q;
+                    if (jv == jp) {
+                        mfmm_i32 iv = fr->virt >> 2;
+                        go = (s->label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE;
+                        if (go) {
+                            MFMM_GLOBAL const mfmm_virt *vr = mfmm_march_virt_of(m, iv, w - k + jp);
+                            ta = s->T[iv];
+                            b = vr->len;
+                            cs = vr->cos_b;
+                            t = mfmm_min(t, ta + b);
+                        }
+                    } else if (go) {
+                        ta = s->T[q];
+                    }
+                    if (go)
+                        t = mfmm_min(t, mfmm_triangle_interior(ta, tx, fr->len[jq], b, cs, 1.0));
+                    mfmm_march_offer(s, m, p, lp, t);
+                }
+            }
+            /* (p's update may have changed q's label only if p == q: never) */
+            if (!alive_q && !(lq & MFMM_FIXED)) {
+                if (general) {
+                    mfmm_march_corner(s, m, fr, f_id, jq, q, lq, x, tx, alive_p);
+                } else {
+                    /* q = C, x = A, p = B */
+                    double t = tx + fr->len[jp], tb = 0.0, a = fr->len[k], cs = fr->cosv[jq];
+                    int go = alive_p;
+                    if (jv == jq) {
+                        mfmm_i32 iv = fr->virt >> 2;
+                        go = (s->label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE;
+                        if (go) {
+                            MFMM_GLOBAL const mfmm_virt *vr = mfmm_march_virt_of(m, iv, w - k + jq);
+                            tb = s->T[iv];
+                            a = vr->len;
+                            cs = vr->cos_a;
+                            t = mfmm_min(t, tb + a);
+                        }
+                    } else if (go) {
+                        tb = s->T[p];
+                    }
+                    if (go)
+                        t = mfmm_min(t, mfmm_triangle_interior(tx, tb, a, fr->len[jp], cs, 1.0));
+                    mfmm_march_offer(s, m, q, lq, t);
+                }
             }
         }
     }

@@ -29,6 +29,8 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
         return;
     free(mesh->to_internal);
     free(mesh->to_external);
+    free(mesh->face_to_internal);
+    free(mesh->face_to_external);
     free(mesh->xyz);
     free(mesh->faces);
     free(mesh->face_neighbor);
@@ -37,10 +39,9 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh->component);
     free(mesh->degenerate);
     free(mesh->full);
-    free(mesh->corners_block);
-    free(mesh->slot_corner);
-    free(mesh->update_offset);
-    free(mesh->update_corner);
+    free(mesh->face_block);
+    free(mesh->virts);
+    free(mesh->virt_first);
     free(mesh->virt_offset);
     free(mesh->virt_steps);
     free(mesh->strip);
@@ -258,107 +259,70 @@ static void build_corners(mfmm_mesh *m)
     m->info.n_obtuse_corners = n_obtuse;
 }
 
-/* The march's records from the build's corners: one 32-byte mfmm_corner per
- * corner, grouped by vertex in the vertex_face CSR order (so a vertex's
- * records are contiguous and in vertex order, as the vertices are numbered
- * along a space-filling curve: the march is bound by misses on them); an
- * obtuse corner's followed by its virtual edge (mfmm_virt) in the next
- * slot; a zero-area face's records get cos_c = NaN. The strips' vertices
- * (for the virtual stencils' cost test) parallel to virt_steps. Then the
- * update lists: when a vertex settles, the pairs (slot, its vertex C) to
- * recompute are the other two corners of each incident face, and each
- * obtuse corner whose virtual edge starts there. Frees m->full. */
+/* The march's records from the build's corners: one 64-byte mfmm_face per
+ * face (its vertices, the length opposite each corner, each corner's cosine,
+ * NaN on a zero-area face), and one mfmm_virt per obtuse corner whose
+ * virtual edge unfolding found, sorted by V (counting sort, so by corner
+ * within one V), the face naming V (the march reads the record from V's
+ * list once V is Alive). The strips' vertices (for the
+ * virtual stencils' cost test) parallel to virt_steps. Frees m->full. */
 static mfmm_status build_records(mfmm_mesh *m)
 {
-    size_t nc = (size_t)m->nf * 3;
+    size_t nf = (size_t)m->nf, nc = 3 * nf;
     size_t n_steps = (size_t)m->virt_offset[nc];
-    size_t n_slots = nc + (size_t)m->info.n_obtuse_corners;
-    if (n_slots > (size_t)INT32_MAX / 2)
+    size_t n_virts = 0;
+    for (size_t c = 0; c < nc; c++)
+        n_virts += m->full[c].virt >= 0;
+    if (n_virts > (size_t)INT32_MAX ||
+        (n_virts > 0 && m->nv > INT32_MAX / 4)) /* (mfmm_face.virt packs 4 V + k) */
         return MFMM_ERR_BAD_COUNT;
-    m->n_slots = (int32_t)n_slots;
-    /* on cache-line boundaries, so that no 32-byte record straddles two
-     * lines (measured with callgrind: 9 % more D1 misses unaligned) */
-    m->corners_block = malloc(n_slots * sizeof *m->corners + 64);
-    if (m->corners_block)
-        m->corners = (mfmm_corner *)(void *)((char *)m->corners_block +
-                                             (64 - (uintptr_t)m->corners_block % 64) % 64);
-    m->slot_corner = malloc(n_slots * sizeof *m->slot_corner);
+    m->n_virts = (int32_t)n_virts;
+    /* on cache-line boundaries: one record, one line */
+    m->face_block = malloc(nf * sizeof *m->face_records + 64);
+    if (m->face_block)
+        m->face_records = (mfmm_face *)(void *)((char *)m->face_block +
+                                                (64 - (uintptr_t)m->face_block % 64) % 64);
+    m->virts = malloc((n_virts ? n_virts : 1) * sizeof *m->virts);
+    m->virt_first = calloc((size_t)m->nv + 1, sizeof *m->virt_first);
     m->strip = malloc((n_steps ? n_steps : 1) * sizeof *m->strip);
-    int32_t *off = calloc((size_t)m->nv + 1, sizeof *off);
-    int32_t *slot_vertex = malloc(n_slots * sizeof *slot_vertex);
-    if (!m->corners || !m->slot_corner || !m->strip || !off || !slot_vertex) {
-        free(off);
-        free(slot_vertex);
+    if (!m->face_block || !m->virts || !m->virt_first || !m->strip)
         return MFMM_ERR_OUT_OF_MEMORY;
-    }
     for (size_t k = 0; k < n_steps; k++)
         m->strip[k] = m->virt_steps[k].far;
-    size_t at = 0;
-    for (int32_t c = 0; c < m->nv; c++)
-        for (int32_t t = m->vertex_face_offset[c]; t < m->vertex_face_offset[c + 1]; t++) {
-            int32_t fc = m->vertex_face_corner[t];
-            const mfmm_corner_full *x = m->full + fc;
-            mfmm_corner *cr = m->corners + at;
-            slot_vertex[at] = c;
-            m->slot_corner[at++] = fc;
-            cr->a = x->a;
-            cr->b = x->b;
-            cr->len_a = x->len_a;
-            cr->len_b = x->len_b;
-            cr->cos_c = x->virt == MFMM_VIRT_DEGENERATE ? NAN : x->cos_c;
-            if (!(cr->cos_c < MFMM_OBTUSE_COS))
+    int32_t *first = m->virt_first;
+    for (size_t c = 0; c < nc; c++)
+        if (m->full[c].virt >= 0)
+            first[m->full[c].virt + 1]++;
+    for (int32_t v = 0; v < m->nv; v++)
+        first[v + 1] += first[v];
+    for (size_t f = 0; f < nf; f++)
+        for (int k = 0; k < 3; k++)
+            m->face_records[f].v[k] = m->faces[3 * f + k];
+    for (size_t f = 0; f < nf; f++) {
+        mfmm_face *r = m->face_records + f;
+        r->virt = 3;
+        for (int k = 0; k < 3; k++) {
+            const mfmm_corner_full *x = m->full + 3 * f + k;
+            r->len[(k + 1) % 3] = x->len_a; /* |BC| is opposite A = vertex k + 1 */
+            r->cosv[k] = x->virt == MFMM_VIRT_DEGENERATE ? NAN : x->cos_c;
+            if (x->virt < 0)
                 continue;
-            mfmm_virt *v = (mfmm_virt *)(void *)(m->corners + at);
-            memset(v, 0, sizeof *v);
-            v->v = x->virt >= 0 ? x->virt : -1;
-            v->len = x->virt_len;
-            v->cos_a = x->virt_cos_a;
-            v->cos_b = x->virt_cos_b;
-            slot_vertex[at] = -1; /* not a record of its own */
-            m->slot_corner[at++] = fc;
+            /* (a face has at most one obtuse corner) */
+            int32_t at = first[x->virt]++;
+            mfmm_virt *vr = m->virts + at;
+            vr->corner = (int32_t)(3 * f + (size_t)k);
+            vr->c = m->faces[3 * f + k];
+            vr->len = x->virt_len;
+            vr->cos_a = x->virt_cos_a;
+            vr->cos_b = x->virt_cos_b;
+            r->virt = 4 * x->virt + k;
         }
+    }
+    for (int32_t v = m->nv; v > 0; v--)
+        first[v] = first[v - 1];
+    first[0] = 0;
     free(m->full);
     m->full = NULL;
-    /* the update lists */
-    size_t total = 0;
-    for (size_t j = 0; j < n_slots; j++) {
-        if (slot_vertex[j] < 0)
-            continue;
-        const mfmm_corner *cr = m->corners + j;
-        off[cr->a + 1]++;
-        off[cr->b + 1]++;
-        total += 2;
-        if (cr->cos_c < MFMM_OBTUSE_COS && ((const mfmm_virt *)(const void *)(cr + 1))->v >= 0) {
-            off[((const mfmm_virt *)(const void *)(cr + 1))->v + 1]++;
-            total++;
-        }
-    }
-    int32_t *list = total <= INT32_MAX / 2 ? malloc(2 * total * sizeof *list) : NULL;
-    if (!list) {
-        free(off);
-        free(slot_vertex);
-        return total <= INT32_MAX / 2 ? MFMM_ERR_OUT_OF_MEMORY : MFMM_ERR_BAD_COUNT;
-    }
-    for (int32_t v = 0; v < m->nv; v++)
-        off[v + 1] += off[v];
-    for (size_t j = 0; j < n_slots; j++) {
-        if (slot_vertex[j] < 0)
-            continue;
-        const mfmm_corner *cr = m->corners + j;
-        int32_t vv = cr->cos_c < MFMM_OBTUSE_COS ? ((const mfmm_virt *)(const void *)(cr + 1))->v : -1;
-        int32_t to[3] = {cr->a, cr->b, vv};
-        for (int t = 0; t < (vv >= 0 ? 3 : 2); t++) {
-            int32_t e = off[to[t]]++;
-            list[2 * e] = (int32_t)j;
-            list[2 * e + 1] = slot_vertex[j];
-        }
-    }
-    free(slot_vertex);
-    for (int32_t v = m->nv; v > 0; v--)
-        off[v] = off[v - 1];
-    off[0] = 0;
-    m->update_offset = off;
-    m->update_corner = list;
     return MFMM_OK;
 }
 
@@ -442,7 +406,9 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
     }
-    /* renumbered: coordinates in internal order, face corners' ids mapped */
+    /* renumbered: coordinates in internal order, faces' vertex ids mapped
+     * (face_neighbor holds them in input face order until the faces are
+     * ordered by them) */
     if (mfmm_order_build(vertices, nv, &m->to_internal, &m->to_external) != MFMM_OK) {
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
@@ -450,7 +416,15 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
     for (int32_t v = 0; v < nv; v++)
         memcpy(m->xyz + 3 * (size_t)v, vertices + 3 * (size_t)m->to_external[v], 3 * sizeof *m->xyz);
     for (size_t c = 0; c < nc; c++)
-        m->faces[c] = m->to_internal[faces[c]];
+        m->face_neighbor[c] = m->to_internal[faces[c]];
+    if (mfmm_order_faces(m->face_neighbor, nf, &m->face_to_internal, &m->face_to_external) !=
+        MFMM_OK) {
+        mfmm_mesh_destroy(m);
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
+    }
+    for (int32_t f = 0; f < nf; f++)
+        memcpy(m->faces + 3 * (size_t)f, m->face_neighbor + 3 * (size_t)m->face_to_external[f],
+               3 * sizeof *m->faces);
     m->info.n_vertices = nv;
     m->info.n_faces = nf;
 
@@ -538,7 +512,6 @@ int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, i
 {
     size_t nv = (size_t)mesh->nv, nf = (size_t)mesh->nf, nc = 3 * nf;
     size_t n_steps = (size_t)mesh->virt_offset[nc];
-    size_t n_upd = (size_t)mesh->update_offset[nv];
     /* the exact tables may be built by another thread meanwhile (mesh.h) */
     pthread_mutex_t *lock = (pthread_mutex_t *)(uintptr_t)&mesh->cache_lock;
     pthread_mutex_lock(lock);
@@ -555,10 +528,10 @@ int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, i
         {"component", nv * sizeof(int32_t)},
         {"degenerate", nf},
         {"to_internal/to_external", 2 * nv * sizeof(int32_t)},
-        {"corners (records)", (size_t)mesh->n_slots * sizeof(mfmm_corner)},
-        {"slot_corner", (size_t)mesh->n_slots * sizeof(int32_t)},
+        {"face_to_internal/external", 2 * nf * sizeof(int32_t)},
+        {"face records", nf * sizeof(mfmm_face)},
+        {"virtual edges", (size_t)mesh->n_virts * sizeof(mfmm_virt) + (nv + 1) * sizeof(int32_t)},
         {"strip", n_steps * sizeof(int32_t)},
-        {"update lists", (nv + 1) * sizeof(int32_t) + 2 * n_upd * sizeof(int32_t)},
         {"virt_offset", (nc + 1) * sizeof(int32_t)},
         {"virt_steps", n_steps * sizeof(mfmm_virt_step)},
         {"mesh struct", sizeof *mesh},

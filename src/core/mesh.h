@@ -16,7 +16,7 @@ typedef struct mfmm_virt_step {
 } mfmm_virt_step;
 
 /* A corner while the mesh is built (mesh.c, unfold.c), by corner id 3f+k;
- * the march gets compact records (mfmm_corner, mfmm_virt) from these. virt:
+ * the march gets records per face (mfmm_face, mfmm_virt) from these. virt:
  * V's id >= 0 (the obtuse corner is split by the virtual edge to V), or one
  * of the MFMM_VIRT_ codes. */
 #define MFMM_VIRT_NONE (-1)       /* not obtuse: the plain stencil */
@@ -30,11 +30,14 @@ typedef struct mfmm_corner_full {
 
 struct mfmm_mesh {
     int32_t nv, nf;
-    /* Vertices are numbered internally along a space-filling curve (order.h):
-     * every per-vertex array below, and the vertex ids in faces, are in
-     * that order; faces keep their input ids and corner order. */
+    /* Vertices are numbered internally along a space-filling curve, faces
+     * by their least internal vertex (order.h): every per-vertex and
+     * per-face array below, and the vertex ids in faces, are in that order;
+     * a face keeps its corner order. */
     int32_t *to_internal;      /* (nv,) internal id of each input vertex */
     int32_t *to_external;      /* (nv,) input id of each internal vertex */
+    int32_t *face_to_internal; /* (nf,) internal id of each input face */
+    int32_t *face_to_external; /* (nf,) input id of each internal face */
     double *xyz;               /* (nv, 3) */
     int32_t *faces;            /* (nf, 3) */
     int32_t *face_neighbor;    /* (nf, 3): face across the edge opposite corner k,
@@ -44,14 +47,11 @@ struct mfmm_mesh {
     int32_t *component;        /* (nv,) component id, -1 for unreferenced vertices */
     uint8_t *degenerate;       /* (nf,) 1 for zero-area faces */
     mfmm_corner_full *full;    /* (3 nf,) while building only, then NULL */
-    mfmm_corner *corners;      /* (n_slots,) records for the march, grouped by vertex in
-                                  the vertex_face CSR order; an obtuse corner's
-                                  record is followed by its mfmm_virt */
-    void *corners_block;       /* the allocation corners lies in (cache-line aligned) */
-    int32_t n_slots;
-    int32_t *slot_corner;      /* (n_slots,) the corner 3f+k of each slot */
-    int32_t *update_offset;    /* (nv+1,) CSR: corners to recompute when a vertex settles */
-    int32_t *update_corner;    /* pairs (index into corners, its vertex C) */
+    mfmm_face *face_records;   /* (nf,) for the march (local_update.h), 64-byte aligned */
+    void *face_block;          /* the allocation face_records lies in */
+    mfmm_virt *virts;          /* (n_virts,) virtual edges for the march, sorted by V */
+    int32_t n_virts;
+    int32_t *virt_first;       /* (nv+1,) CSR: virts[virt_first[v]..] end at v */
     int32_t *virt_offset;      /* (3 nf + 1,) CSR by corner 3f+k into virt_steps: the
                                   strip of an obtuse corner's virtual edge */
     mfmm_virt_step *virt_steps;
@@ -75,10 +75,11 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
 {
     mfmm_march_mesh m;
     m.nv = mesh->nv;
-    m.update_offset = mesh->update_offset;
-    m.update_corner = mesh->update_corner;
-    m.corners = mesh->corners;
-    m.slot_corner = mesh->slot_corner;
+    m.wedge_offset = mesh->vertex_face_offset;
+    m.wedge = mesh->vertex_face_corner;
+    m.faces = mesh->face_records;
+    m.virts = mesh->virts;
+    m.virt_first = mesh->virt_first;
     m.strip_offset = mesh->virt_offset;
     m.strip = mesh->strip;
     return m;

@@ -1,6 +1,6 @@
 /* Vertex renumbering along a space-filling curve over the bounding cube
- * (cells of about 64 vertices in Morton order, rows inside a cell), and the
- * mapping of public arguments and results (order.h). */
+ * (cells of about 64 vertices in Morton order, rows inside a cell), faces
+ * along it, and the mapping of public arguments and results (order.h). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -106,6 +106,65 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_interna
     return MFMM_OK;
 }
 
+typedef struct face_key {
+    int32_t v[3]; /* the face's vertex ids, ascending */
+    int32_t id;
+} face_key;
+
+static int face_key_cmp(const void *pa, const void *pb)
+{
+    const face_key *a = pa, *b = pb;
+    for (int k = 0; k < 3; k++)
+        if (a->v[k] != b->v[k])
+            return a->v[k] < b->v[k] ? -1 : 1;
+    return (a->id > b->id) - (a->id < b->id);
+}
+
+mfmm_status mfmm_order_faces(const int32_t *faces, int32_t nf, int32_t **to_internal,
+                             int32_t **to_external)
+{
+    int32_t *in = malloc((size_t)nf * sizeof *in);
+    int32_t *ex = malloc((size_t)nf * sizeof *ex);
+    face_key *keys = malloc((size_t)nf * sizeof *keys);
+    if (!in || !ex || !keys) {
+        free(in);
+        free(ex);
+        free(keys);
+        return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    for (int32_t f = 0; f < nf; f++) {
+        int32_t a = faces[3 * (size_t)f], b = faces[3 * (size_t)f + 1], c = faces[3 * (size_t)f + 2], t;
+        if (a > b)
+            t = a, a = b, b = t;
+        if (b > c)
+            t = b, b = c, c = t;
+        if (a > b)
+            t = a, a = b, b = t;
+        keys[f] = (face_key){{a, b, c}, f};
+    }
+    qsort(keys, (size_t)nf, sizeof *keys, face_key_cmp);
+    for (int32_t i = 0; i < nf; i++) {
+        ex[i] = keys[i].id;
+        in[keys[i].id] = i;
+    }
+    free(keys);
+    *to_internal = in;
+    *to_external = ex;
+    return MFMM_OK;
+}
+
+void mfmm_order_points_out(const mfmm_mesh *mesh, mfmm_surface_point *points, int32_t n)
+{
+    for (int32_t i = 0; i < n; i++)
+        points[i].face = mesh->face_to_external[points[i].face];
+}
+
+void mfmm_order_face_values_in(const mfmm_mesh *mesh, const double *in, double *out)
+{
+    for (int32_t f = 0; f < mesh->nf; f++)
+        out[f] = in[mesh->face_to_external[f]];
+}
+
 void mfmm_order_ids_in(const mfmm_mesh *mesh, const int32_t *ids, int32_t n, int32_t *out)
 {
     for (int32_t i = 0; i < n; i++)
@@ -138,7 +197,10 @@ mfmm_status mfmm_order_map_args(const mfmm_mesh *mesh, const mfmm_source *source
     size_t nv = (size_t)mesh->nv;
     size_t b_src = sources ? (size_t)n_sources * sizeof(mfmm_source) : 0;
     size_t b_tgt = targets ? align8((size_t)n_targets * sizeof(int32_t)) : 0;
-    size_t b_cost = cost && cost_location == 1 ? nv * sizeof(double) : 0;
+    size_t b_cost = !cost ? 0
+                    : cost_location == 1 ? nv * sizeof(double)
+                    : cost_location == 2 ? (size_t)mesh->nf * sizeof(double)
+                                         : 0;
     size_t b_val = values ? nv * sizeof(double) : 0;
     size_t need = b_src + b_tgt + b_cost + b_val;
     if (need > a->capacity) {
@@ -160,6 +222,8 @@ mfmm_status mfmm_order_map_args(const mfmm_mesh *mesh, const mfmm_source *source
         for (int32_t i = 0; i < n_sources; i++)
             if (s[i].face < 0)
                 s[i].vertex = mesh->to_internal[s[i].vertex];
+            else
+                s[i].face = mesh->face_to_internal[s[i].face];
         a->sources = s;
         at += b_src;
     }
@@ -171,7 +235,10 @@ mfmm_status mfmm_order_map_args(const mfmm_mesh *mesh, const mfmm_source *source
     }
     if (b_cost) {
         double *c = (double *)(void *)at;
-        mfmm_order_values_in(mesh, cost, c);
+        if (cost_location == 1)
+            mfmm_order_values_in(mesh, cost, c);
+        else
+            mfmm_order_face_values_in(mesh, cost, c);
         a->cost = c;
         at += b_cost;
     }

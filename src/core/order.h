@@ -1,10 +1,12 @@
-/* Vertex renumbering (issue 13.1, private to the library). A mesh numbers
- * its vertices internally along a space-filling curve, so that vertices
- * near each other on the surface are near each other in every per-vertex
- * array the march reads. Faces keep their ids and corner order (only the
- * vertex ids inside them are renumbered). Everything below the public entry
- * points works in internal ids; the entry points map vertex ids and
- * per-vertex arrays in and out with these helpers. */
+/* Vertex and face renumbering (issue 13.1, private to the library). A mesh
+ * numbers its vertices internally along a space-filling curve, so that
+ * vertices near each other on the surface are near each other in every
+ * per-vertex array the march reads, and its faces along that order (by
+ * their least internal vertex id), so that the faces of the vertices that
+ * settle together are near each other too. A face keeps its corner order
+ * (barycentric coordinates need no mapping). Everything below the public
+ * entry points works in internal ids; the entry points map vertex and face
+ * ids, per-vertex and per-face arrays in and out with these helpers. */
 #ifndef MFMM_ORDER_H
 #define MFMM_ORDER_H
 
@@ -16,6 +18,34 @@
  * ids only. MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
 mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_internal,
                              int32_t **to_external);
+
+/* The internal order of a mesh's faces, given their corners' internal
+ * vertex ids in input face order, faces (nf, 3): by least vertex id, then
+ * the other two (smaller first), then input id, so that it depends on the
+ * faces only, not on their input order. *to_external (nf,) lists the input
+ * face ids in internal order, *to_internal (nf,) is its inverse (both
+ * malloc'd). MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
+mfmm_status mfmm_order_faces(const int32_t *faces, int32_t nf, int32_t **to_internal,
+                             int32_t **to_external);
+
+/* Internal id of input face f (checked to be in range). */
+static inline int32_t mfmm_face_in(const mfmm_mesh *mesh, int32_t f)
+{
+    return mesh->face_to_internal[f];
+}
+
+/* Input id of internal face f. */
+static inline int32_t mfmm_face_out(const mfmm_mesh *mesh, int32_t f)
+{
+    return mesh->face_to_external[f];
+}
+
+/* The face ids of n surface points (a path) from internal to input ids, in
+ * place. */
+void mfmm_order_points_out(const mfmm_mesh *mesh, mfmm_surface_point *points, int32_t n);
+
+/* Per-face values (nf,) from input order to internal order (out != in). */
+void mfmm_order_face_values_in(const mfmm_mesh *mesh, const double *in, double *out);
 
 /* Internal id of input vertex v (checked to be in range). */
 static inline int32_t mfmm_vertex_in(const mfmm_mesh *mesh, int32_t v)
@@ -39,9 +69,9 @@ void mfmm_order_values_in(const mfmm_mesh *mesh, const double *in, double *out);
 void mfmm_order_values_out(const mfmm_mesh *mesh, const double *in, double *out);
 
 /* The arguments of a public call, in internal order: copies of checked
- * sources (vertex ids mapped), targets, a per-vertex cost and a per-vertex
- * value array (the user's T), each NULL when not given (a per-face cost is
- * passed through: faces keep their ids). The copies live in one block,
+ * sources (vertex and face ids mapped), targets, a per-vertex or per-face
+ * cost and a per-vertex value array (the user's T), each NULL when not
+ * given. The copies live in one block,
  * reused while large enough (a solver keeps it between solves). */
 typedef struct mfmm_mapped_args {
     const mfmm_source *sources;

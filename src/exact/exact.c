@@ -1181,7 +1181,7 @@ static mfmm_status ex_check_sources(const mfmm_exact_ws *ws, const mfmm_source *
         mfmm_status st = mfmm_check_source(ws->mesh, sources + i, i, err);
         if (st != MFMM_OK)
             return st;
-        if (sources[i].face >= 0 && ws->fr[ws->face_in[sources[i].face]].skip)
+        if (sources[i].face >= 0 && ws->fr[ws->face_in[mfmm_face_in(ws->mesh, sources[i].face)]].skip)
             return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, i,
                              "source %ld lies on face %ld, which has zero area", (long)i,
                              (long)sources[i].face);

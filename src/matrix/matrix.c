@@ -537,13 +537,16 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     }
     const double *cost = own_cost ? own_cost : o->cost;
     mfmm_status cst = mfmm_check_cost(mesh, cost, o->cost_location, err);
-    /* ids and per-vertex costs in the mesh's internal order (core/order.h),
-     * after the checks (whose messages name the caller's ids) */
+    /* ids and costs in the mesh's internal order (core/order.h), after the
+     * checks (whose messages name the caller's ids) */
     double *mapped_cost = NULL;
-    if (cst == MFMM_OK && own_cost && o->cost_location == MFMM_COST_PER_VERTEX) {
-        mapped_cost = malloc((size_t)nv * sizeof *mapped_cost);
-        if (mapped_cost)
+    if (cst == MFMM_OK && own_cost) {
+        int per_vertex = o->cost_location == MFMM_COST_PER_VERTEX;
+        mapped_cost = malloc((per_vertex ? (size_t)nv : (size_t)mesh->nf) * sizeof *mapped_cost);
+        if (mapped_cost && per_vertex)
             mfmm_order_values_in(mesh, own_cost, mapped_cost);
+        else if (mapped_cost)
+            mfmm_order_face_values_in(mesh, own_cost, mapped_cost);
         else
             cst = mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the cost");
         free(own_cost);

@@ -697,7 +697,7 @@ const char *mfmm_opencl_context_device_name(const mfmm_opencl_context *context)
 
 /* ---- rows ---- */
 
-enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_ORDER, MB_SLOTCORNER, MB_STRIPOFF, MB_LABEL, MB_KEY, MB_VERT,
+enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_ORDER, MB_VIRTS, MB_STRIPOFF, MB_VFIRST, MB_LABEL, MB_KEY, MB_VERT,
        MB_POS, MB_T, MB_OUT, MB_COUNT };
 
 /* Bytes per work-item on the device (workspace and output row), and on the
@@ -863,16 +863,17 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
 
     /* the mesh, read-only, used in place where the driver allows */
     cl_mem_flags ro = CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR;
-    size_t n_upd = 2 * (size_t)mesh->update_offset[mesh->nv]; /* (corner, vertex) pairs */
+    /* (the march's arrays, march.h: x's faces, face records, virtual edges) */
+    size_t n_wedge = 3 * (size_t)mesh->nf;
     mem[MB_OFFSET] = api->clCreateBuffer(cl.context, ro, (nv + 1) * sizeof(int32_t),
-                                    mesh->update_offset, &e);
+                                    mesh->vertex_face_offset, &e);
     if (e == CL_SUCCESS)
-        mem[MB_CORNER] = api->clCreateBuffer(cl.context, ro, (n_upd ? n_upd : 1) * sizeof(int32_t),
-                                        n_upd ? (void *)mesh->update_corner : (void *)&one, &e);
+        mem[MB_CORNER] = api->clCreateBuffer(cl.context, ro, n_wedge * sizeof(int32_t),
+                                        mesh->vertex_face_corner, &e);
     if (e == CL_SUCCESS)
         mem[MB_CORNERS] = api->clCreateBuffer(cl.context, ro,
-                                         (size_t)mesh->n_slots * sizeof(mfmm_corner),
-                                         mesh->corners, &e);
+                                         (size_t)mesh->nf * sizeof(mfmm_face),
+                                         mesh->face_records, &e);
     if (e == CL_SUCCESS) {
         size_t nc = job->cost_location == 1 ? nv : job->cost_location == 2 ? (size_t)mesh->nf : 1;
         mem[MB_COST] = api->clCreateBuffer(cl.context, ro, nc * sizeof(double),
@@ -887,8 +888,13 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         mem[MB_STRIP] = api->clCreateBuffer(cl.context, ro, (n_strip ? n_strip : 1) * sizeof(int32_t),
                                             mesh->strip, &e);
     if (e == CL_SUCCESS)
-        mem[MB_SLOTCORNER] = api->clCreateBuffer(cl.context, ro, (size_t)mesh->n_slots * sizeof(int32_t),
-                                              mesh->slot_corner, &e);
+        mem[MB_VIRTS] = api->clCreateBuffer(cl.context, ro,
+                                              (mesh->n_virts ? (size_t)mesh->n_virts : 1) *
+                                                  sizeof(mfmm_virt),
+                                              mesh->virts, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_VFIRST] = api->clCreateBuffer(cl.context, ro, (nv + 1) * sizeof(int32_t),
+                                             mesh->virt_first, &e);
     if (e == CL_SUCCESS)
         mem[MB_STRIPOFF] = api->clCreateBuffer(cl.context, ro, (nc + 1) * sizeof(int32_t),
                                            mesh->virt_offset, &e);
@@ -988,7 +994,7 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         e |= api->clSetKernelArg(cl.kernel, 19, sizeof n_targets, &n_targets);
         e |= api->clSetKernelArg(cl.kernel, 20, sizeof(cl_mem), &t_ws);
         e |= api->clSetKernelArg(cl.kernel, 21, sizeof(cl_mem), &mem[MB_ORDER]);
-        e |= api->clSetKernelArg(cl.kernel, 22, sizeof(cl_mem), &mem[MB_SLOTCORNER]);
+        e |= api->clSetKernelArg(cl.kernel, 22, sizeof(cl_mem), &mem[MB_VIRTS]);
         e |= api->clSetKernelArg(cl.kernel, 23, sizeof(cl_mem), &mem[MB_STRIPOFF]);
     } else {
         e |= api->clSetKernelArg(cl.kernel, 15, sizeof(cl_mem), &mem[MB_T]);
@@ -999,7 +1005,7 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         e |= api->clSetKernelArg(cl.kernel, 20, sizeof n_targets, &n_targets);
         e |= api->clSetKernelArg(cl.kernel, 21, sizeof(cl_mem), &t_ws);
         e |= api->clSetKernelArg(cl.kernel, 22, sizeof(cl_mem), &mem[MB_ORDER]);
-        e |= api->clSetKernelArg(cl.kernel, 23, sizeof(cl_mem), &mem[MB_SLOTCORNER]);
+        e |= api->clSetKernelArg(cl.kernel, 23, sizeof(cl_mem), &mem[MB_VIRTS]);
         e |= api->clSetKernelArg(cl.kernel, 24, sizeof(cl_mem), &mem[MB_STRIPOFF]);
     }
     /* the seeds (set per batch with the exact start; else unused) */
@@ -1008,6 +1014,7 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     e |= api->clSetKernelArg(cl.kernel, seed_arg, sizeof n_seeds, &n_seeds);
     e |= api->clSetKernelArg(cl.kernel, seed_arg + 1, sizeof(cl_mem), &mem[MB_SOURCES]);
     e |= api->clSetKernelArg(cl.kernel, seed_arg + 2, sizeof(cl_mem), &mem[MB_COST]);
+    e |= api->clSetKernelArg(cl.kernel, seed_arg + 3, sizeof(cl_mem), &mem[MB_VFIRST]);
     if (e != CL_SUCCESS) {
         st = runtime_fail(err, "clSetKernelArg", e);
         goto done;

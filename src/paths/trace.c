@@ -884,6 +884,8 @@ mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
     mfmm_source target_in = *target;
     if (target_in.face == -1)
         target_in.vertex = mfmm_vertex_in(mesh, target_in.vertex);
+    else
+        target_in.face = mfmm_face_in(mesh, target_in.face);
     if (mfmm_order_map_args(mesh, o->sources, o->n_sources, NULL, 0, o->cost,
                             o->cost ? (int)o->cost_location : 0, distances, &mapped) != MFMM_OK)
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "no memory for the distances");
@@ -977,6 +979,8 @@ mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
         free(sp);
     }
     free(mapped.block);
+    if (points) /* the points' faces in the caller's ids */
+        mfmm_order_points_out(mesh, points, t.n < capacity ? t.n : capacity);
     *n_points = t.n;
     if (length)
         *length = t.len;
@@ -1021,7 +1025,8 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
     }
     if (!(T0 < INFINITY))
         return mfmm_fail(t->err, MFMM_ERR_UNREACHED,
-                         target->face == -1 ? mfmm_vertex_out(m, target->vertex) : target->face,
+                         target->face == -1 ? mfmm_vertex_out(m, target->vertex)
+                                            : mfmm_face_out(m, target->face),
                          "the target's distance is infinite (not reached)");
     if (!emit(t, p.f, p.b))
         return t->st;

@@ -695,6 +695,7 @@ static void test_patch(void **state)
     assert_int_equal(mfmm_exact_patch(fx.solver, &bad, 1, 0.1, 0, &n, &vs, &ds, NULL), MFMM_ERR_BAD_SOURCE);
     /* a point source in a face, with a value: T = value + distance <= radius */
     mfmm_source fs = {0, 1000, {0.2, 0.3, 0.5}, 0.05};
+    fs.face = fx.mesh->face_to_internal[1000]; /* internal, as the vertex ids above */
     double p[3] = {0.0, 0.0, 0.0};
     for (int k = 0; k < 3; k++)
         for (int e = 0; e < 3; e++)

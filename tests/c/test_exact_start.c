@@ -73,10 +73,12 @@ static void test_patch_is_exact(void **state)
             int32_t n = 0;
             const int32_t *pv = NULL;
             const double *pd = NULL;
-            /* the patch API is internal: internal vertex ids (core/order.h) */
+            /* the patch API is internal: internal vertex and face ids (core/order.h) */
             mfmm_source isrc = src;
             if (isrc.face < 0)
                 isrc.vertex = mfmm_vertex_in(mesh, isrc.vertex);
+            else
+                isrc.face = mfmm_face_in(mesh, isrc.face);
             assert_int_equal(mfmm_exact_patch(ws, &isrc, 1, R, 0, &n, &pv, &pd, NULL), MFMM_OK);
             assert_true(n >= 10);
             /* every vertex within R, and a ring beyond it (exact.c) */
@@ -308,7 +310,8 @@ static void test_saddle_corner_continuous(void **state)
         double *e0 = exact_row(mesh, &vs);
         for (int32_t i = mesh->vertex_face_offset[v]; i < mesh->vertex_face_offset[v + 1]; i++) {
             int32_t c = mesh->vertex_face_corner[i];
-            mfmm_source p = {0, c / 3, {1e-9, 1e-9, 1e-9}, 0.0};
+            /* (the public calls take the face's input id) */
+            mfmm_source p = {0, mfmm_face_out(mesh, c / 3), {1e-9, 1e-9, 1e-9}, 0.0};
             p.bary[c % 3] = 1.0 - 2e-9;
             solve_r(solver, &p, MFMM_EXACT_START_RADIUS, d1);
             /* the exact solver itself: within the move (1-Lipschitz); it left
@@ -318,7 +321,7 @@ static void test_saddle_corner_continuous(void **state)
             for (int j = 0; j < 3; j++) {
                 double x = 0.0;
                 for (int q = 0; q < 3; q++)
-                    x += p.bary[q] * mesh->xyz[3 * (size_t)IF[3 * (c / 3) + q] + j];
+                    x += p.bary[q] * mesh->xyz[3 * (size_t)IF[3 * (size_t)(c / 3) + q] + j];
                 move += (x - mesh->xyz[3 * (size_t)v + j]) * (x - mesh->xyz[3 * (size_t)v + j]);
             }
             move = sqrt(move);

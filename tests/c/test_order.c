@@ -1,9 +1,11 @@
-/* Vertex renumbering (issue 13.1): the library numbers vertices internally
- * by position, so a mesh given with its vertices in another order is the same
- * mesh inside. Per input vertex, every public result (distances with and
- * without costs, matrix rows dense / float32 / targets / sparse, paths,
- * exact distances) must then equal the unshuffled mesh's, permuted back, bit
- * for bit; and the renumbering must not depend on anything but the input. */
+/* Vertex and face renumbering (issue 13.1): the library numbers vertices
+ * internally by position, and faces along that order, so a mesh given with
+ * its vertices and faces in another order is the same mesh inside. Per input
+ * vertex, every public result (distances with and without costs, per vertex
+ * and per face, from vertex and face sources, matrix rows dense / float32 /
+ * targets / sparse / per-face cost, paths and their face ids, exact
+ * distances) must then equal the unshuffled mesh's, permuted back, bit for
+ * bit; and the renumbering must not depend on anything but the input. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -18,12 +20,27 @@
 #include "core/mesh.h"
 #include "io/generate.h"
 
-/* g's vertices, plus one unreferenced vertex, in a shuffled order:
- * shuffled vertex i is original vertex perm[i]; inv the inverse. */
+/* g's vertices, plus one unreferenced vertex, and its faces in a shuffled
+ * order (each face's corners kept in order): shuffled vertex i is original
+ * vertex perm[i], shuffled face i original face fperm[i]; inv, finv the
+ * inverses. */
 typedef struct shuffled {
     mfmm_gen_mesh orig, shuf;
-    int32_t *perm, *inv;
+    int32_t *perm, *inv, *fperm, *finv;
 } shuffled;
+
+static void shuffle_ids(int32_t *perm, int32_t n, uint32_t seed)
+{
+    for (int32_t i = 0; i < n; i++)
+        perm[i] = i;
+    for (int32_t i = n - 1; i > 0; i--) { /* Fisher-Yates, a fixed LCG */
+        seed = seed * 1664525u + 1013904223u;
+        int32_t j = (int32_t)((seed >> 8) % (uint32_t)(i + 1));
+        int32_t t = perm[i];
+        perm[i] = perm[j];
+        perm[j] = t;
+    }
+}
 
 static shuffled shuffle(mfmm_gen_mesh g, uint32_t seed)
 {
@@ -39,25 +56,23 @@ static shuffled shuffle(mfmm_gen_mesh g, uint32_t seed)
     s.shuf.F = malloc(3 * (size_t)g.nf * sizeof(int32_t));
     s.perm = malloc((size_t)nv * sizeof(int32_t));
     s.inv = malloc((size_t)nv * sizeof(int32_t));
-    assert_true(s.orig.V && s.shuf.V && s.shuf.F && s.perm && s.inv);
+    s.fperm = malloc((size_t)g.nf * sizeof(int32_t));
+    s.finv = malloc((size_t)g.nf * sizeof(int32_t));
+    assert_true(s.orig.V && s.shuf.V && s.shuf.F && s.perm && s.inv && s.fperm && s.finv);
     memcpy(s.orig.V, g.V, 3 * (size_t)g.nv * sizeof(double));
     s.orig.V[3 * g.nv] = 0.25, s.orig.V[3 * g.nv + 1] = 0.5, s.orig.V[3 * g.nv + 2] = 2.0;
     free(g.V);
-    for (int32_t i = 0; i < nv; i++)
-        s.perm[i] = i;
-    for (int32_t i = nv - 1; i > 0; i--) { /* Fisher-Yates, a fixed LCG */
-        seed = seed * 1664525u + 1013904223u;
-        int32_t j = (int32_t)((seed >> 8) % (uint32_t)(i + 1));
-        int32_t t = s.perm[i];
-        s.perm[i] = s.perm[j];
-        s.perm[j] = t;
-    }
+    shuffle_ids(s.perm, nv, seed);
+    shuffle_ids(s.fperm, g.nf, seed ^ 0x5eedu);
     for (int32_t i = 0; i < nv; i++) {
         s.inv[s.perm[i]] = i;
         memcpy(s.shuf.V + 3 * i, s.orig.V + 3 * s.perm[i], 3 * sizeof(double));
     }
-    for (int32_t c = 0; c < 3 * g.nf; c++)
-        s.shuf.F[c] = s.inv[s.orig.F[c]];
+    for (int32_t f = 0; f < g.nf; f++) {
+        s.finv[s.fperm[f]] = f;
+        for (int k = 0; k < 3; k++)
+            s.shuf.F[3 * f + k] = s.inv[s.orig.F[3 * s.fperm[f] + k]];
+    }
     return s;
 }
 
@@ -67,6 +82,22 @@ static void shuffled_free(shuffled *s)
     mfmm_gen_free(&s->shuf);
     free(s->perm);
     free(s->inv);
+    free(s->fperm);
+    free(s->finv);
+}
+
+/* Path a (original ids) equals path b (shuffled ids): faces mapped, the
+ * rest bit for bit. */
+static void assert_same_path(const shuffled *s, const mfmm_surface_point *a,
+                             const mfmm_surface_point *b, int32_t n)
+{
+    for (int32_t i = 0; i < n; i++) {
+        if (a[i].face != s->fperm[b[i].face])
+            fail_msg("path point %d: face %d, shuffled %d (original %d)", (int)i, (int)a[i].face,
+                     (int)b[i].face, (int)s->fperm[b[i].face]);
+        assert_memory_equal(a[i].bary, b[i].bary, sizeof a[i].bary);
+        assert_memory_equal(a[i].xyz, b[i].xyz, sizeof a[i].xyz);
+    }
 }
 
 /* a[perm[i]] == b[i] bit for bit, n values of `size` bytes */
@@ -89,20 +120,23 @@ static void check_mesh(mfmm_gen_mesh g, uint32_t seed)
     assert_int_equal(mfmm_solver_create(mb, &sb), MFMM_OK);
     double *da = malloc((size_t)nv * sizeof *da), *db = malloc((size_t)nv * sizeof *db);
     double *ca = malloc((size_t)nv * sizeof *ca), *cb = malloc((size_t)nv * sizeof *cb);
-    double *fc = malloc((size_t)nf * sizeof *fc);
-    assert_true(da && db && ca && cb && fc);
+    double *fc = malloc((size_t)nf * sizeof *fc), *fcb = malloc((size_t)nf * sizeof *fcb);
+    assert_true(da && db && ca && cb && fc && fcb);
     for (int32_t v = 0; v < nv; v++)
         ca[v] = 1.0 + 0.5 * sin(3.0 * s.orig.V[3 * v] + 2.0 * s.orig.V[3 * v + 1]);
     for (int32_t i = 0; i < nv; i++)
         cb[i] = ca[s.perm[i]];
     for (int32_t f = 0; f < nf; f++)
         fc[f] = 1.0 + (f % 3);
+    for (int32_t f = 0; f < nf; f++)
+        fcb[f] = fc[s.fperm[f]];
 
     /* single solves: a vertex source with targets, a face source, costs */
     int32_t src = s.orig.F[3 * (nf / 2)], tgt[2] = {s.orig.F[0], s.orig.F[3 * nf - 1]};
     int32_t tgt_b[2] = {s.inv[tgt[0]], s.inv[tgt[1]]};
     mfmm_source va[2] = {tm_vertex_source(src), {0, nf / 3, {0.2, 0.3, 0.5}, 0.1}};
     mfmm_source vb[2] = {tm_vertex_source(s.inv[src]), va[1]};
+    vb[1].face = s.finv[va[1].face];
     for (int variant = 0; variant < 5; variant++) {
         mfmm_solve_options oa, ob;
         mfmm_solve_options_init(&oa);
@@ -117,6 +151,8 @@ static void check_mesh(mfmm_gen_mesh g, uint32_t seed)
         ob = oa;
         if (variant == 1)
             ob.cost = cb;
+        if (variant == 2)
+            ob.cost = fcb;
         if (variant == 3)
             ob.targets = tgt_b;
         assert_int_equal(mfmm_solve(sa, va, 2, &oa, da, NULL), MFMM_OK);
@@ -141,8 +177,21 @@ static void check_mesh(mfmm_gen_mesh g, uint32_t seed)
         assert_int_equal(mfmm_trace_path(ma, da, &ta, &pa, pts_a, 4096, &na, &la, NULL), MFMM_OK);
         assert_int_equal(mfmm_trace_path(mb, db, &tb, &pb, pts_b, 4096, &nb, &lb, NULL), MFMM_OK);
         assert_int_equal(na, nb);
-        assert_memory_equal(pts_a, pts_b, (size_t)na * sizeof *pts_a);
+        assert_same_path(&s, pts_a, pts_b, na);
         assert_memory_equal(&la, &lb, sizeof la);
+
+        /* and to a point inside a face (face ids in and out) */
+        int32_t ft = s.orig.F[3 * (nf - 1)] == t ? nf - 1 : 0;
+        mfmm_source fa = {0, ft, {0.3, 0.3, 0.4}, 0.0}, fb = fa;
+        fb.face = s.finv[ft];
+        mfmm_status sta = mfmm_trace_path(ma, da, &fa, &pa, pts_a, 4096, &na, &la, NULL);
+        mfmm_status stb = mfmm_trace_path(mb, db, &fb, &pb, pts_b, 4096, &nb, &lb, NULL);
+        assert_int_equal(sta, stb);
+        if (sta == MFMM_OK) {
+            assert_int_equal(na, nb);
+            assert_same_path(&s, pts_a, pts_b, na);
+            assert_memory_equal(&la, &lb, sizeof la);
+        }
     }
 
     /* exact distances */
@@ -165,7 +214,7 @@ static void check_mesh(mfmm_gen_mesh g, uint32_t seed)
     }
     double *ra = malloc((size_t)NS * nv * sizeof *ra), *rb = malloc((size_t)NS * nv * sizeof *rb);
     assert_true(ra && rb);
-    for (int kind = 0; kind < 5; kind++) {
+    for (int kind = 0; kind < 6; kind++) {
         mfmm_matrix_options oa, ob;
         mfmm_matrix_options_init(&oa);
         oa.backend = kind == 1 ? MFMM_BACKEND_THREADS : MFMM_BACKEND_SERIAL;
@@ -175,11 +224,15 @@ static void check_mesh(mfmm_gen_mesh g, uint32_t seed)
             oa.targets = tgt, oa.n_targets = 2;
         if (kind == 4)
             oa.cost = ca, oa.cost_location = MFMM_COST_PER_VERTEX;
+        if (kind == 5)
+            oa.cost = fc, oa.cost_location = MFMM_COST_PER_FACE;
         ob = oa;
         if (kind == 3)
             ob.targets = tgt_b;
         if (kind == 4)
             ob.cost = cb;
+        if (kind == 5)
+            ob.cost = fcb;
         oa.out = ra;
         ob.out = rb;
         assert_int_equal(mfmm_distance_matrix(ma, rs_a, NS, &oa, NULL), MFMM_OK);
@@ -207,6 +260,7 @@ static void check_mesh(mfmm_gen_mesh g, uint32_t seed)
     free(ca);
     free(cb);
     free(fc);
+    free(fcb);
     shuffled_free(&s);
 }
 
@@ -295,6 +349,21 @@ static void test_deterministic(void **state)
     for (int32_t v = 0; v < g.nv; v++) {
         assert_int_equal(a->to_external[a->to_internal[v]], v);
         assert_memory_equal(a->xyz + 3 * a->to_internal[v], g.V + 3 * v, 3 * sizeof(double));
+    }
+    /* faces: a permutation along the vertex order, corners kept in order */
+    for (int32_t f = 0; f < g.nf; f++) {
+        int32_t i = a->face_to_internal[f];
+        assert_int_equal(a->face_to_external[i], f);
+        for (int k = 0; k < 3; k++)
+            assert_int_equal(a->faces[3 * i + k], a->to_internal[g.F[3 * f + k]]);
+        if (i > 0) {
+            int32_t lo = a->faces[3 * i], lo_prev = a->faces[3 * (i - 1)];
+            for (int k = 1; k < 3; k++) {
+                lo = a->faces[3 * i + k] < lo ? a->faces[3 * i + k] : lo;
+                lo_prev = a->faces[3 * (i - 1) + k] < lo_prev ? a->faces[3 * (i - 1) + k] : lo_prev;
+            }
+            assert_true(lo_prev <= lo);
+        }
     }
     mfmm_mesh_destroy(a);
     mfmm_mesh_destroy(b);
