@@ -97,6 +97,14 @@ def compact(V: np.ndarray, F: np.ndarray):
     return V[old_of_new].copy(), new_of_old[F].astype(np.int64), old_of_new, new_of_old
 
 
+@functools.lru_cache(maxsize=None)
+def diameter(name: str) -> float:
+    """Bounding-box diagonal of a test mesh's referenced vertices (DESIGN.md's max error scale)."""
+    V, F = load(name)
+    V2 = compact(V, F)[0]
+    return float(np.linalg.norm(V2.max(axis=0) - V2.min(axis=0)))
+
+
 def errors(d: np.ndarray, e: np.ndarray, diameter: float):
     """DESIGN.md metrics: (mean relative error %, max error % of diameter),
     over vertices with a finite exact distance (> 0 for the relative one)."""

@@ -23,6 +23,7 @@ from conftest import (
     MANIFOLD_MESHES,
     OBTUSE_MESHES,
     compact,
+    diameter,
     errors,
     load,
     mesh,
@@ -62,11 +63,6 @@ def gc_distance(name: str, source) -> np.ndarray:
     d = np.full(V.shape[0], np.inf)
     d[old_of_new] = d2
     return d
-
-
-def diameter(name: str) -> float:
-    V2 = compacted(name)[0]
-    return float(np.linalg.norm(V2.max(axis=0) - V2.min(axis=0)))
 
 
 @pytest.mark.parametrize("name", MANIFOLD_MESHES)

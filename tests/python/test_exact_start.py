@@ -13,15 +13,18 @@ import numpy as np
 import pytest
 
 import meshfmm
-from conftest import MANIFOLD_MESHES, compact, errors, load, mesh, need_data, reference
+from conftest import (
+    MANIFOLD_MESHES,
+    compact,
+    diameter,
+    errors,
+    load,
+    mesh,
+    need_data,
+    reference,
+)
 
 TARGET = 0.6  # issue 12: mean relative error at most 0.6x the plain start's
-
-
-def diameter(name):
-    V, F = load(name)
-    V2 = compact(V, F)[0]
-    return float(np.linalg.norm(V2.max(axis=0) - V2.min(axis=0)))
 
 
 @pytest.mark.parametrize("name", MANIFOLD_MESHES)
