@@ -235,20 +235,34 @@ typedef struct mfmm_solve_options {
      * only where the cost is one F over the patch (per vertex: every patch
      * vertex and its neighbours; per face: every face around a patch vertex;
      * then T = value + F * distance); elsewhere that source takes the
-     * straight start. Default MFMM_EXACT_START_RADIUS; 0: the paper's plain
-     * start, as before this option existed. Finite and >= 0, else
+     * straight start. Default MFMM_EXACT_START_AUTO (a radius that grows
+     * with the mesh, below); 0: the paper's plain start, as before this
+     * option existed. MFMM_EXACT_START_AUTO, or finite and >= 0, else
      * MFMM_ERR_BAD_ARGUMENT. */
     double exact_start_radius;
 } mfmm_solve_options;
 
-/* Default exact_start_radius, in mean edge lengths (chosen by measurement:
+/* exact_start_radius's base, in mean edge lengths (chosen by measurement:
  * bench/RESULTS.md, "Exact start"). The patch also holds the vertices just
  * beyond the radius whose exact distances the propagation has found anyway
  * (within a face's height of it). */
 #define MFMM_EXACT_START_RADIUS 7.0
 
+/* exact_start_radius's default: MFMM_EXACT_START_RADIUS mean edge lengths,
+ * times sqrt(nv / MFMM_EXACT_START_AUTO_VERTICES) on larger meshes for a
+ * march without max_distance (17.5 at 250,000 vertices, 35 at a million).
+ * A radius in mean edges covers less of a finer mesh, and the error the
+ * source's singularity creates then dominates again (with 7, the mean error
+ * over the plain start's is 0.33-0.59 on the meshes of 3-35k vertices, 0.62
+ * on igea's 134k, 0.63 on a 251k sine surface); this keeps the patch the same share of the
+ * surface, so about the same share of a full march's time. A march with
+ * max_distance (a local row) keeps the base radius, so that its cost
+ * depends on its reach in mean edges and not on the mesh's size. */
+#define MFMM_EXACT_START_AUTO (-1.0)
+#define MFMM_EXACT_START_AUTO_VERTICES 40000
+
 /* Fills `options` with the defaults: no cost, no limit, no targets, unfolding on,
- * exact start within MFMM_EXACT_START_RADIUS mean edge lengths. */
+ * the exact start with its default radius (MFMM_EXACT_START_AUTO). */
 MFMM_API void mfmm_solve_options_init(mfmm_solve_options *options);
 
 /* Marches from the sources and writes T for every vertex.
@@ -538,7 +552,7 @@ typedef struct mfmm_matrix_options {
     /* as in mfmm_solve_options (appended field): each row's march starts from
      * the exact distances within this many mean edge lengths of its source, on
      * every backend (OpenCL: computed on the host, uploaded with the batch).
-     * Default MFMM_EXACT_START_RADIUS; 0: the plain start */
+     * Default MFMM_EXACT_START_AUTO; 0: the plain start */
     double exact_start_radius;
 } mfmm_matrix_options;
 

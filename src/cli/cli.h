@@ -135,8 +135,11 @@ typedef struct cli_sources_and_cost {
 /* The help lines of the start options (distance, path, allpairs). */
 #define CLI_START_HELP                                                                       \
     "  --exact-start-radius R  start the march from exact distances within R mean\n"        \
-    "                          edge lengths of each source (default " CLI_STR(             \
-        MFMM_EXACT_START_RADIUS) ")\n"                                                      \
+    "                          edge lengths of each source (default auto: " CLI_STR(       \
+        MFMM_EXACT_START_RADIUS) ", times\n"                                                \
+    "                          sqrt(vertices / " CLI_STR(MFMM_EXACT_START_AUTO_VERTICES)    \
+    ") above that size without\n"                                                          \
+    "                          --max-distance)\n"                                          \
     "  --plain-start           the paper's start (as --exact-start-radius 0)\n"
 /* Parses --exact-start-radius's value: CLI_OK, or CLI_USAGE with the error printed. */
 int cli_parse_start_radius(const char *sub, const char *arg, double *radius);

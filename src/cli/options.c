@@ -13,7 +13,7 @@ int cli_sources_and_cost_init(cli_sources_and_cost *o, const char *sub, void (*h
     memset(o, 0, sizeof *o);
     o->sub = sub;
     o->help = help;
-    o->exact_start_radius = MFMM_EXACT_START_RADIUS;
+    o->exact_start_radius = MFMM_EXACT_START_AUTO;
     o->src = malloc((size_t)argc * sizeof *o->src); /* at most one per argument */
     if (!o->src) {
         cli_error("out of memory");
@@ -169,8 +169,13 @@ double *cli_solve_distances(const mfmm_mesh *mesh, const cli_sources_and_cost *o
 
 int cli_parse_start_radius(const char *sub, const char *arg, double *radius)
 {
+    if (strcmp(arg, "auto") == 0) {
+        *radius = MFMM_EXACT_START_AUTO;
+        return CLI_OK;
+    }
     if (!cli_parse_double(arg, radius) || !(*radius >= 0) || !(*radius < INFINITY))
-        return cli_usage_error(sub, "--exact-start-radius needs a finite number >= 0, not '%s'",
+        return cli_usage_error(sub,
+                               "--exact-start-radius needs 'auto' or a finite number >= 0, not '%s'",
                                arg);
     return CLI_OK;
 }

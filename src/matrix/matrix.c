@@ -42,7 +42,7 @@ void mfmm_matrix_options_init(mfmm_matrix_options *options)
     options->user = NULL;
     options->backend_used = MFMM_BACKEND_AUTO;
     options->opencl = NULL;
-    options->exact_start_radius = MFMM_EXACT_START_RADIUS;
+    options->exact_start_radius = MFMM_EXACT_START_AUTO;
 }
 
 /* Rows per block for the CPU engines: the budget less the solvers'
@@ -52,8 +52,8 @@ static int32_t cpu_block_rows(const mfmm_rows_job *job, int n_workers, int ring)
     size_t nv = (size_t)job->mesh->nv;
     size_t row_bytes = job->slot_bytes;
     size_t work = (size_t)n_workers * nv * 32; /* solver + a float64 row */
-    if (job->opt->exact_start_radius > 0.0) /* each solver's exact-start state (the tables
-                                               are the mesh's, not the job's) */
+    /* each solver's exact-start state (the tables are the mesh's, not the job's) */
+    if (mfmm_exact_start_on(job->opt->exact_start_radius))
         work += (size_t)n_workers * mfmm_exact_start_bytes(job->mesh);
     size_t left = job->budget > work ? job->budget - work : 0;
     /* ring 0: rows go straight into the caller's buffer */
@@ -354,7 +354,7 @@ static mfmm_status run_threads(const mfmm_rows_job *job, int32_t start, mfmm_err
     }
     /* the exact start's tables: the mesh's, built now if not yet (exact.h) */
     const mfmm_exact_tables *tables = NULL;
-    if (job->opt->exact_start_radius > 0.0 &&
+    if (mfmm_exact_start_on(job->opt->exact_start_radius) &&
         mfmm_exact_tables_of(job->mesh, &tables) != MFMM_OK) {
         free(p.ring);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the exact start");

@@ -856,7 +856,7 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     double one = 1.0;
     int32_t no_target = 0;
     cl_int n_targets = job->targets ? (cl_int)job->width : 0;
-    int exact = job->opt->exact_start_radius > 0.0;
+    int exact = mfmm_exact_start_on(job->opt->exact_start_radius);
     mfmm_exact_ws *ews = NULL;
     seed_buf sb;
     memset(&sb, 0, sizeof sb);

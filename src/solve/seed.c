@@ -5,11 +5,22 @@
 
 mfmm_status mfmm_check_exact_start(double radius, mfmm_error *err)
 {
-    if (!isfinite(radius) || radius < 0.0)
+    if (radius != MFMM_EXACT_START_AUTO && (!isfinite(radius) || radius < 0.0))
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
-                         "exact_start_radius is %g; it must be finite and >= 0 (0: the plain start)",
+                         "exact_start_radius is %g; it must be finite and >= 0 (0: the plain "
+                         "start) or MFMM_EXACT_START_AUTO (-1, the default)",
                          radius);
     return MFMM_OK;
+}
+
+double mfmm_exact_start_edges(const mfmm_mesh *mesh, double radius, double max_distance)
+{
+    if (radius != MFMM_EXACT_START_AUTO)
+        return radius;
+    double r = MFMM_EXACT_START_RADIUS;
+    if (isinf(max_distance) && mesh->nv > MFMM_EXACT_START_AUTO_VERTICES)
+        r *= sqrt((double)mesh->nv / MFMM_EXACT_START_AUTO_VERTICES);
+    return r;
 }
 
 size_t mfmm_exact_start_bytes(const mfmm_mesh *mesh)
@@ -38,6 +49,7 @@ static mfmm_status exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const 
     *n = 0;
     *patch_radius = 0.0;
     *F = 1.0;
+    radius = mfmm_exact_start_edges(mesh, radius, max_d);
     if (!(radius > 0.0))
         return MFMM_OK;
     /* the patch around the source at value 0; a point at a corner is that

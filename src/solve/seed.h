@@ -11,8 +11,19 @@
 #include "core/start.h"
 #include "exact/exact.h"
 
-/* Validates an exact_start_radius option (finite and >= 0). */
+/* Validates an exact_start_radius option (MFMM_EXACT_START_AUTO, or finite
+ * and >= 0). */
 mfmm_status mfmm_check_exact_start(double radius, mfmm_error *err);
+
+/* Whether a checked exact_start_radius asks for the exact start. */
+static inline int mfmm_exact_start_on(double radius)
+{
+    return radius != 0.0;
+}
+
+/* The radius in mean edge lengths that a checked exact_start_radius gives a
+ * march with this max_distance (MFMM_EXACT_START_AUTO's rule, meshfmm.h). */
+double mfmm_exact_start_edges(const mfmm_mesh *mesh, double radius, double max_distance);
 
 /* The exact start of one checked source: the vertices within `radius` mean
  * edge lengths of it (at least its own faces' corners) and their exact

@@ -89,7 +89,7 @@ void mfmm_solve_options_init(mfmm_solve_options *options)
     options->targets = NULL;
     options->n_targets = 0;
     options->unfolding = 1;
-    options->exact_start_radius = MFMM_EXACT_START_RADIUS;
+    options->exact_start_radius = MFMM_EXACT_START_AUTO;
 }
 
 mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
@@ -206,7 +206,7 @@ static int32_t solver_march(mfmm_solver *solver, const mfmm_source *sources, int
     s.touched = solver->touched;
     s.n_touched = 0;
     s.targets_left = 0;
-    int exact = opt.exact_start_radius > 0.0;
+    int exact = mfmm_exact_start_on(opt.exact_start_radius);
     if (s.cost && (s.unfolding || exact)) {
         if (solver->fixed_cost != s.cost || solver->fixed_location != s.cost_location)
             mfmm_uniform_cost(mesh, s.cost, s.cost_location, solver->uniform);

@@ -403,9 +403,9 @@ def test_exact_start_is_passed_through_and_part_of_the_job(hand, client, tmp_pat
                            dtype="float64", block_rows=8, progress=False, exact_start=3.5)
     assert np.array_equal(Z[:], hand.distance_matrix(src, backend="serial", dtype="float64",
                                                       exact_start=3.5))
-    # the default is recorded as the library's radius, and a radius is checked
+    # the default is recorded as the library's rule, and a radius is checked
     job = md.job_description(hand, src, None, "float64", None, None, None, True)
-    assert job["exact_start_radius"] == 7.0
+    assert job["exact_start_radius"] == "auto"
     with pytest.raises(ValueError):
         md.distance_matrix(hand, str(tmp_path / "bad.zarr"), sources=src, client=client,
                            progress=False, exact_start=-1.0)

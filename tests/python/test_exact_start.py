@@ -101,9 +101,11 @@ def test_exact_start_option_values():
                                                       "meshes", "hand_lowres.obj")))
     d0 = m.distance(21, exact_start=False)
     assert np.array_equal(m.distance(21, exact_start=0), d0)
+    # the default rule gives the base radius on a mesh of <= 40k vertices
     assert np.array_equal(m.distance(21, exact_start=7.0), m.distance(21))
+    assert np.array_equal(m.distance(21, exact_start="auto"), m.distance(21))
     assert not np.array_equal(m.distance(21), d0)
-    for bad in (-1, float("nan"), float("inf"), "5", None):
+    for bad in (-1, float("nan"), float("inf"), "5", "Auto", None):
         with pytest.raises(ValueError):
             m.distance(21, exact_start=bad)
     with pytest.raises(ValueError):

@@ -67,6 +67,9 @@ MFMM_ERR_PARSE = 20
 MFMM_ERR_MEMORY_LIMIT = 21
 MFMM_STATUS_COUNT = 22
 
+# exact_start_radius's default rule (meshfmm.h MFMM_EXACT_START_AUTO)
+EXACT_START_AUTO = -1.0
+
 STATUS_NAMES = (
     "MFMM_OK",
     "MFMM_ERR_NULL_POINTER",

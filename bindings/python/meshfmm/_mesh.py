@@ -237,17 +237,18 @@ def _cost_array(cost: Any, cost_location: Optional[str], nv: int, nf: int) -> Tu
 
 
 def _exact_start(x: Any) -> Optional[float]:
-    """The exact_start option: True (the library's default radius) -> None,
-    False -> 0.0 (the paper's plain start), a number -> that radius in mean
-    edge lengths (finite, >= 0)."""
-    if x is True:
+    """The exact_start option: True or "auto" (the library's default radius,
+    MFMM_EXACT_START_AUTO) -> None, False -> 0.0 (the paper's plain start), a
+    number -> that radius in mean edge lengths (finite, >= 0)."""
+    if x is True or (isinstance(x, str) and x == "auto"):
         return None
     if x is False:
         return 0.0
     if isinstance(x, (bool, np.bool_)):
         return None if x else 0.0
     if isinstance(x, (str, bytes)) or not isinstance(x, (int, float, np.integer, np.floating)):
-        raise ValueError(f"exact_start must be True, False or a radius in mean edge lengths, not {x!r}")
+        raise ValueError(f"exact_start must be True, 'auto', False or a radius in mean edge "
+                         f"lengths, not {x!r}")
     r = float(x)
     if not np.isfinite(r) or r < 0:
         raise ValueError(f"exact_start radius must be finite and >= 0, not {r}")
@@ -512,7 +513,9 @@ class Mesh:
         unfolding: False uses plain stencils at obtuse corners (for comparison).
         exact_start: True (default): the march starts from the exact
             distances of the vertices within 7 mean edge lengths of each
-            source (about half the mean error of the paper's start); a
+            source, times sqrt(n_vertices / 40000) on larger meshes when
+            max_distance is None (MFMM_EXACT_START_AUTO; about half the mean
+            error of the paper's start); a
             number: that radius in mean edge lengths; False (or 0): the
             paper's plain start. With a cost, it applies where the cost is
             uniform around the source (else the plain start).

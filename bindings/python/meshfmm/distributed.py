@@ -27,7 +27,7 @@ import math
 import os
 import sys
 import time
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -104,12 +104,13 @@ def _ids(x: Any, what: str, n: int) -> np.ndarray:
 def job_description(mesh: Mesh, sources: Optional[np.ndarray], targets: Optional[np.ndarray],
                     dtype: str, max_distance: Optional[float], cost: Optional[np.ndarray],
                     cost_location: Optional[str], unfolding: bool,
-                    exact_start_radius: Optional[float] = None) -> Dict[str, Any]:
+                    exact_start_radius: Union[None, float, str] = None) -> Dict[str, Any]:
     """What identifies a job (stored in the array's attributes): hashes of the
     mesh, sources, targets and cost, and the options that change the numbers.
     The backend and block size do not change them and are not part of it.
     exact_start_radius: the radius of the exact start in mean edge lengths
-    (0: the plain start; None: the library's default, recorded as its value)."""
+    (0: the plain start; None or "auto": the library's default, recorded as
+    "auto", its rule MFMM_EXACT_START_AUTO)."""
     V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
     F = np.ascontiguousarray(mesh.faces, dtype=np.int32)
     return {
@@ -130,13 +131,16 @@ def job_description(mesh: Mesh, sources: Optional[np.ndarray], targets: Optional
     }
 
 
-def _start_radius(radius: Optional[float]) -> float:
-    """The exact start's radius a job runs with: None -> the library's default."""
+def _start_radius(radius: Union[None, float, str]) -> Union[float, str]:
+    """The exact start's radius a job runs with: None -> the library's default
+    ("auto" for its rule MFMM_EXACT_START_AUTO, meshfmm.h), "auto" kept."""
+    if radius == "auto":
+        return radius
     if radius is not None:
         return float(radius)
     o = _lib.mfmm_matrix_options()
     _lib.mfmm_matrix_options_init(ctypes.byref(o))
-    return float(o.exact_start_radius)
+    return "auto" if o.exact_start_radius == _lib.EXACT_START_AUTO else float(o.exact_start_radius)
 
 
 def _same_job(stored: Dict[str, Any], job: Dict[str, Any]) -> List[str]:
