@@ -6,9 +6,12 @@ the default radius, and the time per source.
 Cases (3 sources each; references as in compare_peers.py):
   choice set (the radius is chosen on these): hand, spot, fertility, bunny
     (stored igl.exact_geodesic; the bunny set r = 7, the one mesh above 0.6x
-    at 6), sphere 4 (2.5k, great circle), sine 50 (exact);
+    at 6), sphere 4 (2.5k, great circle), sine 50 (exact); for the default's
+    growth on larger meshes (MFMM_EXACT_START_AUTO, column "auto"): igea
+    (134k, 0.62x at r = 7) and sine 500 (251k), both against mfmm_solve_exact;
   held out (not used to choose it): wingnut, decimated-max, camelhead,
-    nefertiti (stored igl), sphere 5 (10k), lattice 50 and 100
+    nefertiti (stored igl), beetle (mfmm_solve_exact: igl.exact_geodesic
+    and gdist crash on it), sphere 5 (10k), lattice 50 and 100
     (Euclidean), sine 100, and two cases made for this benchmark: a jittered
     sine surface (70 x 70, vertices moved by up to 0.3 h) and a random planar
     Delaunay mesh (3000 points in the unit square, Euclidean reference).
@@ -22,7 +25,7 @@ the meshes of 10k vertices and more; ratios from one run.
 
 Writes bench/results/exact_start.json.
 
-    python bench/bench_exact_start.py [--radii 0 3 5 6 7 8 10] [--rounds 5]
+    python bench/bench_exact_start.py [--radii 0 3 5 6 7 8 10 auto] [--rounds 5]
 """
 
 from __future__ import annotations
@@ -42,18 +45,29 @@ import benchlib as bl  # noqa: E402
 import meshfmm  # noqa: E402
 
 CHOICE = ["hand_lowres.obj", "spot.obj", "fertility_FE_10k.off", "sphere 4", "sine 50",
-          "stanford-bunny.obj"]
+          "stanford-bunny.obj", "igea.ply", "sine 500"]
 
 
 def default_radius():
-    """The library's default exact_start radius (MFMM_EXACT_START_RADIUS)."""
+    """The library's default exact_start radius: "auto" (MFMM_EXACT_START_AUTO)
+    or a number."""
     import ctypes
 
     from meshfmm import _lib
 
     o = _lib.mfmm_solve_options()
     _lib.mfmm_solve_options_init(ctypes.byref(o))
-    return float(o.exact_start_radius)
+    r = float(o.exact_start_radius)
+    return "auto" if r == _lib.EXACT_START_AUTO else r
+
+
+def auto_edges(nv):
+    """MFMM_EXACT_START_AUTO's radius in mean edges for a full row (meshfmm.h)."""
+    return 7.0 * max(1.0, (nv / 40000) ** 0.5)
+
+
+def radius_arg(x):
+    return "auto" if x == "auto" else float(x)
 
 
 def nearest(V, pts):
@@ -72,6 +86,11 @@ def cases(workdir):
         V, F = bl.load_data(name)
         src, ref = stored(name)
         yield name, V, F, src, ref, "igl.exact_geodesic (stored)"
+    rng = np.random.default_rng(1)
+    for name in ["igea.ply", "beetle.obj"]:
+        V, F = bl.load_data(name)
+        src = [int(s) for s in rng.choice(len(V), 3, replace=False)]
+        yield name, V, F, src, None, "mfmm_solve_exact"
     for lv in (4, 5):
         V, F = bl.generate("sphere", lv, workdir)
         dirs = np.array([[0.3, 0.5, 0.81], [-0.7, 0.1, -0.2], [0.05, -0.9, 0.4]])
@@ -94,7 +113,7 @@ def cases(workdir):
             e[~inside] = np.nan
             ref.append(e)
         yield f"lattice {n}", V, F, src, ref, "Euclidean"
-    for n in (50, 100):
+    for n in (50, 100, 500):
         V, F = bl.generate("sine", n, workdir)
         src = nearest(V[:, :2], [np.array(p) for p in ([0.5, 0.5], [0.23, 0.31], [0.71, 0.77])])
         yield f"sine {n}", V, F, src, None, "mfmm_solve_exact"
@@ -121,7 +140,7 @@ def cases(workdir):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--radii", type=float, nargs="*", default=[0, 3, 5, 6, 7, 8, 10])
+    ap.add_argument("--radii", type=radius_arg, nargs="*", default=[0, 3, 5, 6, 7, 8, 10, "auto"])
     ap.add_argument("--rounds", type=int, default=5)
     args = ap.parse_args()
     import potpourri3d as pp3d
@@ -137,6 +156,7 @@ def main():
             if ref is None:
                 ref = [m.distance(s, method="exact") for s in src]
             row = {"name": name, "n_vertices": int(m.n_vertices), "reference": ref_kind,
+                   "auto_radius_edges": auto_edges(int(m.n_vertices)),
                    "sources": src, "held_out": name not in CHOICE, "meshfmm": {}}
             for r in args.radii:
                 errs = [bl.errors(m.distance(s, exact_start=r), e, diam) for s, e in zip(src, ref)]
@@ -164,7 +184,7 @@ def main():
                 row["time_ratio"] = row["time_per_source_s"]["exact_start"] / row["time_per_source_s"]["plain"]
             out["cases"].append(row)
             mm = row["meshfmm"]
-            line = " ".join(f"r{r:g} {mm[str(r)]['mre_pct']:.3f}/{mm[str(r)]['max_pct']:.3f}"
+            line = " ".join(f"r{r} {mm[str(r)]['mre_pct']:.3f}/{mm[str(r)]['max_pct']:.3f}"
                             for r in args.radii)
             print(f"{name:22s} {row['n_vertices']:6d} {'held' if row['held_out'] else 'pick'} | {line} | "
                   f"heat {row['heat_robust']['mre_pct']:.3f}/{row['heat_robust']['max_pct']:.3f}"

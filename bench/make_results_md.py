@@ -597,18 +597,21 @@ def exact_start_section():
         return []
     es = json.loads(es_path.read_text())
     radii = [str(r) for r in es["radii"]]
-    want = es.get("default_radius") or 6.0
-    default = next((r for r in radii if float(r) == float(want)), radii[-1])
+    want = str(es.get("default_radius") or 6.0)
+    default = next((r for r in radii if r == want), radii[-1])
     times = [c["time_ratio"] for c in es["cases"] if "time_ratio" in c] or [float("nan")]
     D = ["## Exact start", "",
          f"**Machine:** {machine_line(es)}.", "",
          "The march starts from the exact distances (mfmm_solve_exact's window propagation) of "
          "the vertices within r mean edge lengths of each source, instead of the paper's start "
          "(r = 0). Mean relative error % / max error % of the diagonal over 3 sources per case "
-         f"(`bench/bench_exact_start.py`). The default r = {float(default):g} was chosen on the "
-         "*choice* cases (" + ", ".join(es["choice_set"]) + "; the bunny, the one mesh above "
-         "0.6x at r = 6, set it): the error falls with r on every case, and r = 7 is the least "
-         "that brings the bunny to 0.6x. Its time per source is "
+         f"(`bench/bench_exact_start.py`). The default (r = {default}) was chosen on the "
+         "*choice* cases (" + ", ".join(es["choice_set"]) + "): the error falls with r on every "
+         "case, and r = 7 is the least that brings the bunny to 0.6x (it was 0.63x at r = 6); "
+         "on larger meshes 7 edges cover less of the surface (igea, 134k vertices: 0.62x), so "
+         "the default, MFMM_EXACT_START_AUTO (column auto), takes 7 sqrt(nv / 40,000) mean edges "
+         "above 40,000 vertices for rows without max_distance (column auto r: its value), which "
+         "keeps the patch the same share of the surface. Its time per source is "
          f"{min(times):.2f}-{max(times):.2f}x the plain start's on the meshes of 10k vertices "
          "and more in this run (the goal: at most 1.2x; the most on sine 100, whose centre "
          "source lies among saddles). The patch also holds the "
@@ -620,25 +623,28 @@ def exact_start_section():
          "start in alternating rounds, one run (ratios). The per-mesh "
          "tables above come from peers.json; where it predates the exact start, their meshfmm "
          "column is the plain start.", ""]
-    head = "| case | nv | set | " + " | ".join(f"r = {r}" for r in radii) + \
+    head = "| case | nv | set | auto r | " + " | ".join(f"r = {r}" for r in radii) + \
         f" | r = {default} / r = 0 | heat (robust) | time r = {default} / r = 0 |"
-    D += [head, "|" + "---|" * (6 + len(radii))]
+    D += [head, "|" + "---|" * (7 + len(radii))]
     for c in es["cases"]:
         mm = c["meshfmm"]
         cells = [f"{fnum(mm[r]['mre_pct'])} / {fnum(mm[r]['max_pct'])}" for r in radii]
         ratio = mm[default]["mre_pct"] / mm[radii[0]]["mre_pct"]
         t = f"{c['time_ratio']:.2f}x" if "time_ratio" in c else ""
+        ra = f"{c['auto_radius_edges']:.1f}" if "auto_radius_edges" in c else ""
         D.append(f"| {c['name']} | {c['n_vertices']} | {'held out' if c['held_out'] else 'choice'} | "
-                 + " | ".join(cells) + f" | {ratio:.2f}x | {fnum(c['heat_robust']['mre_pct'])} / "
+                 f"{ra} | " + " | ".join(cells) + f" | {ratio:.2f}x | {fnum(c['heat_robust']['mre_pct'])} / "
                  f"{fnum(c['heat_robust']['max_pct'])} | {t} |")
     D.append("")
     if cv_path.is_file():
         cv = json.loads(cv_path.read_text())
         D += ["### Convergence with and without the exact start", "",
               "Mean relative error % (`bench/convergence_exact_start.py`; the meshes and sources "
-              "of tests/c/test_convergence.c). With r fixed in edge lengths the exact region "
-              "shrinks with h, so the gain is largest on coarse meshes and the fitted order over "
-              "these sizes drops.", ""]
+              "of tests/c/test_convergence.c). Up to 40,000 vertices r is fixed in edge lengths and "
+              "the exact region shrinks with h, so the gain is largest on coarse meshes; above, "
+              "the default radius grows as sqrt(nv) (MFMM_EXACT_START_AUTO: icosphere 7 takes "
+              "14.2 edges), so the exact region keeps its size. The fitted orders over these "
+              "sizes mix both regimes.", ""]
         for fam in cv["families"]:
             keys = [k for k in fam["rows"][0] if k not in ("n", "n_vertices", "h")]
             D += [f"**{fam['family']}**", "",
