@@ -42,9 +42,9 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh->face_block);
     free(mesh->virts);
     free(mesh->virt_first);
-    free(mesh->virt_offset);
-    free(mesh->virt_steps);
+    free(mesh->virt_strip);
     free(mesh->strip);
+    free(mesh->build_steps);
     if (mesh->exact_tables)
         mesh->exact_tables_free(mesh->exact_tables);
     pthread_mutex_destroy(&mesh->cache_lock);
@@ -265,14 +265,21 @@ static void build_corners(mfmm_mesh *m)
  * virtual edge unfolding found, sorted by V (counting sort, so by corner
  * within one V), the face naming V (the march reads the record from V's
  * list once V is Alive). The strips' vertices (for the
- * virtual stencils' cost test) parallel to virt_steps. Frees m->full. */
+ * virtual stencils' cost test) per virtual edge, in virts' order (the
+ * strips' other fields are re-walked when needed, mfmm_strip_next). Frees
+ * m->full and m->build_steps. */
 static mfmm_status build_records(mfmm_mesh *m)
 {
     size_t nf = (size_t)m->nf, nc = 3 * nf;
-    size_t n_steps = (size_t)m->virt_offset[nc];
+    size_t n_steps = 0;
     size_t n_virts = 0;
     for (size_t c = 0; c < nc; c++)
-        n_virts += m->full[c].virt >= 0;
+        if (m->full[c].virt >= 0) {
+            n_virts++;
+            n_steps += (size_t)m->full[c].strip_n;
+        }
+    if (n_steps > (size_t)INT32_MAX)
+        return MFMM_ERR_BAD_COUNT;
     if (n_virts > (size_t)INT32_MAX ||
         (n_virts > 0 && m->nv > INT32_MAX / 4)) /* (mfmm_face.virt packs 4 V + k) */
         return MFMM_ERR_BAD_COUNT;
@@ -284,11 +291,10 @@ static mfmm_status build_records(mfmm_mesh *m)
                                                 (64 - (uintptr_t)m->face_block % 64) % 64);
     m->virts = malloc((n_virts ? n_virts : 1) * sizeof *m->virts);
     m->virt_first = calloc((size_t)m->nv + 1, sizeof *m->virt_first);
+    m->virt_strip = malloc((n_virts + 1) * sizeof *m->virt_strip);
     m->strip = malloc((n_steps ? n_steps : 1) * sizeof *m->strip);
-    if (!m->face_block || !m->virts || !m->virt_first || !m->strip)
+    if (!m->face_block || !m->virts || !m->virt_first || !m->virt_strip || !m->strip)
         return MFMM_ERR_OUT_OF_MEMORY;
-    for (size_t k = 0; k < n_steps; k++)
-        m->strip[k] = m->virt_steps[k].far;
     int32_t *first = m->virt_first;
     for (size_t c = 0; c < nc; c++)
         if (m->full[c].virt >= 0)
@@ -316,13 +322,24 @@ static mfmm_status build_records(mfmm_mesh *m)
             vr->cos_a = x->virt_cos_a;
             vr->cos_b = x->virt_cos_b;
             r->virt = 4 * x->virt + k;
+            m->virt_strip[at + 1] = x->strip_n;
         }
     }
     for (int32_t v = m->nv; v > 0; v--)
         first[v] = first[v - 1];
     first[0] = 0;
+    m->virt_strip[0] = 0;
+    for (size_t j = 0; j < n_virts; j++) {
+        const mfmm_corner_full *x = m->full + m->virts[j].corner;
+        int32_t at = m->virt_strip[j];
+        for (int32_t i = 0; i < x->strip_n; i++)
+            m->strip[at + i] = m->build_steps[x->strip_at + i].far;
+        m->virt_strip[j + 1] += at;
+    }
     free(m->full);
     m->full = NULL;
+    free(m->build_steps);
+    m->build_steps = NULL;
     return MFMM_OK;
 }
 
@@ -511,7 +528,7 @@ void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_locat
 int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, int max)
 {
     size_t nv = (size_t)mesh->nv, nf = (size_t)mesh->nf, nc = 3 * nf;
-    size_t n_steps = (size_t)mesh->virt_offset[nc];
+    size_t n_virts = (size_t)mesh->n_virts, n_steps = (size_t)mesh->virt_strip[n_virts];
     /* the exact tables may be built by another thread meanwhile (mesh.h) */
     pthread_mutex_t *lock = (pthread_mutex_t *)(uintptr_t)&mesh->cache_lock;
     pthread_mutex_lock(lock);
@@ -532,8 +549,7 @@ int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, i
         {"face records", nf * sizeof(mfmm_face)},
         {"virtual edges", (size_t)mesh->n_virts * sizeof(mfmm_virt) + (nv + 1) * sizeof(int32_t)},
         {"strip", n_steps * sizeof(int32_t)},
-        {"virt_offset", (nc + 1) * sizeof(int32_t)},
-        {"virt_steps", n_steps * sizeof(mfmm_virt_step)},
+        {"virt_strip", (n_virts + 1) * sizeof(int32_t)},
         {"mesh struct", sizeof *mesh},
         {"exact tables (once built)", exact_bytes},
     };

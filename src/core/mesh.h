@@ -7,7 +7,8 @@
 #include "meshfmm.h"
 #include "march.h"
 
-/* One face of the strip that a virtual edge C -> V crosses (section 4.2). */
+/* One face of the strip that a virtual edge C -> V crosses (section 4.2).
+ * Not stored: mfmm_strip_next re-walks a strip (unfold.c). */
 typedef struct mfmm_virt_step {
     int32_t face;   /* the face entered */
     int32_t far;    /* its vertex off the edge crossed (the last step's is V) */
@@ -24,6 +25,7 @@ typedef struct mfmm_virt_step {
 #define MFMM_VIRT_DEGENERATE (-3) /* zero-area face: edge updates only */
 typedef struct mfmm_corner_full {
     int32_t face, a, b, virt;
+    int32_t strip_at, strip_n; /* its strip's steps in the build's buffer */
     double len_a, len_b, cos_c;
     double virt_len, virt_cos_a, virt_cos_b;
 } mfmm_corner_full;
@@ -52,11 +54,13 @@ struct mfmm_mesh {
     mfmm_virt *virts;          /* (n_virts,) virtual edges for the march, sorted by V */
     int32_t n_virts;
     int32_t *virt_first;       /* (nv+1,) CSR: virts[virt_first[v]..] end at v */
-    int32_t *virt_offset;      /* (3 nf + 1,) CSR by corner 3f+k into virt_steps: the
-                                  strip of an obtuse corner's virtual edge */
-    mfmm_virt_step *virt_steps;
-    int32_t *strip;            /* virt_steps[].far, for the march (see
-                                  mfmm_march_mesh.strip) */
+    int32_t *virt_strip;       /* (n_virts + 1,) CSR by virtual edge (virts' order)
+                                  into strip */
+    int32_t *strip;            /* each virtual edge's strip: the vertex off the edge
+                                  crossed at each step, the last V (for the march's
+                                  cost test, mfmm_march_mesh.strip; the strip's
+                                  faces and crossings: mfmm_strip_next) */
+    mfmm_virt_step *build_steps; /* while building only (corner order), then NULL */
     mfmm_mesh_info info;
     /* The exact solver's read-only tables (exact/exact.h: face frames, fans),
      * built on the first exact solve or exact start and then shared by every
@@ -80,18 +84,49 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
     m.faces = mesh->face_records;
     m.virts = mesh->virts;
     m.virt_first = mesh->virt_first;
-    m.strip_offset = mesh->virt_offset;
+    m.strip_offset = mesh->virt_strip;
     m.strip = mesh->strip;
     return m;
 }
 
 /* Finds the virtual edge of every obtuse corner by unfolding (section 4.2);
- * fills full[].virt, virt_len, virt_cos_a, virt_cos_b, the strips
- * (virt_offset, virt_steps) and the counts.
+ * fills full[].virt, virt_len, virt_cos_a, virt_cos_b, strip_at, strip_n, the
+ * strips' steps (build_steps, corner order) and the counts.
  * Needs faces, xyz, face_neighbor, corners' lengths and cosines, with the
  * corners still in face order (corner 3f+k), as mesh creation has them then.
  * MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
 mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *mesh, int32_t max_steps);
+
+/* The index in virts of corner 3 f + k's virtual edge, or -1 if it has none. */
+static inline int32_t mfmm_mesh_virt_index(const mfmm_mesh *mesh, int32_t corner)
+{
+    const mfmm_face *fr = mesh->face_records + corner / 3;
+    if ((fr->virt & 3) != corner % 3)
+        return -1;
+    int32_t j = mesh->virt_first[fr->virt >> 2];
+    while (mesh->virts[j].corner != corner)
+        j++;
+    return j;
+}
+
+/* A walk along a virtual edge's strip, rebuilding its steps as the build
+ * found them (bit for bit): mfmm_strip_begin, then mfmm_strip_next per step.
+ * The fields are the walk's. */
+typedef struct mfmm_vec2 {
+    double x, y;
+} mfmm_vec2;
+typedef struct mfmm_strip_walk {
+    const mfmm_mesh *m;
+    int32_t corner, a, b, n, i;
+    int32_t e1, e2, face, opposite, k1, k2;
+    mfmm_vec2 pa, pb, p1, p2, away, pv;
+} mfmm_strip_walk;
+
+/* Starts the walk of virtual edge j's strip (j: index in virts). */
+void mfmm_strip_begin(mfmm_strip_walk *w, const mfmm_mesh *mesh, int32_t j);
+
+/* The walk's next step into *step: 1, or 0 past the last (whose far is V). */
+int mfmm_strip_next(mfmm_strip_walk *w, mfmm_virt_step *step);
 
 /* For the march's virtual stencils under a cost (march.h): uniform[v] = the
  * cost every face around v has (per face), or that v and every neighbour

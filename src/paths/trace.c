@@ -438,7 +438,7 @@ static void edge_bary(const mfmm_mesh *m, int32_t f, int32_t u, int32_t w, doubl
     }
 }
 
-/* Where corner c's virtual edge crosses the edge of its strip's step k. */
+/* Where a virtual edge crosses the edge of its strip's step st. */
 static void virt_crossing(const mfmm_mesh *m, const mfmm_virt_step *st, double x[3])
 {
     const double *x1 = m->xyz + 3 * (size_t)st->e1, *x2 = m->xyz + 3 * (size_t)st->e2;
@@ -446,18 +446,22 @@ static void virt_crossing(const mfmm_mesh *m, const mfmm_virt_step *st, double x
         x[d] = (1.0 - st->t) * x1[d] + st->t * x2[d];
 }
 
-/* Length on the surface of corner c's virtual edge C -> V (section 4.2): its
- * pieces between the edges it crosses, each inside one face of the strip. */
-static double virt_length(const mfmm_mesh *m, int32_t c)
+/* Length on the surface of virtual edge j, C -> V (section 4.2): its pieces
+ * between the edges it crosses, each inside one face of the strip. */
+static double virt_length(const mfmm_mesh *m, int32_t j)
 {
     double prev[3], x[3], len = 0.0;
-    memcpy(prev, m->xyz + 3 * (size_t)m->faces[c], sizeof prev);
-    for (int32_t k = m->virt_offset[c]; k < m->virt_offset[c + 1]; k++) {
-        virt_crossing(m, m->virt_steps + k, x);
+    memcpy(prev, m->xyz + 3 * (size_t)m->virts[j].c, sizeof prev);
+    mfmm_strip_walk w;
+    mfmm_virt_step st;
+    int32_t V = -1;
+    mfmm_strip_begin(&w, m, j);
+    while (mfmm_strip_next(&w, &st)) {
+        virt_crossing(m, &st, x);
         len += mfmm_dist3(prev, x);
         memcpy(prev, x, sizeof x);
+        V = st.far;
     }
-    int32_t V = m->virt_steps[m->virt_offset[c + 1] - 1].far;
     return len + mfmm_dist3(prev, m->xyz + 3 * (size_t)V);
 }
 
@@ -471,12 +475,13 @@ static int32_t virt_descent(const tracer *t, int32_t v)
     int32_t bc = -1;
     for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
         int32_t c = m->vertex_face_corner[i];
-        if (m->virt_offset[c] == m->virt_offset[c + 1])
+        const mfmm_face *fr = m->face_records + c / 3;
+        if ((fr->virt & 3) != c % 3)
             continue;
-        double TV = t->T[m->virt_steps[m->virt_offset[c + 1] - 1].far];
+        double TV = t->T[fr->virt >> 2];
         if (!(TV < Tv))
             continue;
-        double L = virt_length(m, c), slope = L > 0.0 ? (Tv - TV) / L : INFINITY;
+        double L = virt_length(m, mfmm_mesh_virt_index(m, c)), slope = L > 0.0 ? (Tv - TV) / L : INFINITY;
         if (bc < 0 || slope > best) {
             best = slope;
             bc = c;
@@ -700,16 +705,19 @@ static int slide(tracer *t, pos *p, const frame *fr, int k, const double d[2], d
 static int follow_virt(tracer *t, pos *p, int32_t c)
 {
     const mfmm_mesh *m = t->m;
-    int32_t f = c / 3;
-    for (int32_t k = m->virt_offset[c]; k < m->virt_offset[c + 1]; k++) {
-        const mfmm_virt_step *st = m->virt_steps + k;
+    int32_t f = c / 3, V = -1;
+    mfmm_strip_walk w;
+    mfmm_virt_step st;
+    mfmm_strip_begin(&w, m, mfmm_mesh_virt_index(m, c));
+    while (mfmm_strip_next(&w, &st)) {
         double b[3];
-        edge_bary(m, f, st->e1, st->e2, st->t, b);
+        edge_bary(m, f, st.e1, st.e2, st.t, b);
         if (!emit(t, f, b)) /* the piece to it ran through f */
             return -1;
-        f = st->face;
+        f = st.face;
+        V = st.far;
     }
-    set_vertex(p, m, f, m->virt_steps[m->virt_offset[c + 1] - 1].far);
+    set_vertex(p, m, f, V);
     return emit(t, f, p->b) ? 1 : -1;
 }
 
