@@ -32,7 +32,6 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh->face_to_internal);
     free(mesh->face_to_external);
     free(mesh->xyz);
-    free(mesh->faces);
     free(mesh->face_neighbor);
     free(mesh->vertex_face_offset);
     free(mesh->vertex_face_corner);
@@ -76,7 +75,7 @@ static mfmm_status build_edges(mfmm_mesh *m)
         return MFMM_ERR_OUT_OF_MEMORY;
     for (size_t c = 0; c < nc; c++) {
         size_t f = c / 3, k = c % 3;
-        int32_t u = m->faces[3 * f + (k + 1) % 3], v = m->faces[3 * f + (k + 2) % 3];
+        int32_t u = m->face_records[f].v[(k + 1) % 3], v = m->face_records[f].v[(k + 2) % 3];
         he[c].lo = u < v ? u : v;
         he[c].hi = u < v ? v : u;
         he[c].corner = (int32_t)c;
@@ -131,11 +130,11 @@ static mfmm_status build_vertex_faces(mfmm_mesh *m)
         return MFMM_ERR_OUT_OF_MEMORY;
     }
     for (size_t c = 0; c < nc; c++)
-        off[m->faces[c] + 1]++;
+        off[mfmm_mesh_corner_vertex(m, (int32_t)c) + 1]++;
     for (int32_t v = 0; v < m->nv; v++)
         off[v + 1] += off[v];
     for (size_t c = 0; c < nc; c++) {
-        int32_t v = m->faces[c];
+        int32_t v = mfmm_mesh_corner_vertex(m, (int32_t)c);
         list[off[v]++] = (int32_t)c;
     }
     for (int32_t v = m->nv; v > 0; v--)
@@ -164,9 +163,9 @@ static mfmm_status build_components(mfmm_mesh *m)
     for (int32_t v = 0; v < m->nv; v++)
         parent[v] = v;
     for (int32_t f = 0; f < m->nf; f++) {
-        int32_t r0 = uf_find(parent, m->faces[3 * f]);
+        int32_t r0 = uf_find(parent, m->face_records[f].v[0]);
         for (int k = 1; k < 3; k++) {
-            int32_t r = uf_find(parent, m->faces[3 * f + k]);
+            int32_t r = uf_find(parent, m->face_records[f].v[k]);
             if (r != r0)
                 parent[r] = r0;
         }
@@ -207,7 +206,7 @@ static void build_corners(mfmm_mesh *m)
 {
     int32_t n_degenerate = 0, n_obtuse = 0;
     for (int32_t f = 0; f < m->nf; f++) {
-        const int32_t *fv = m->faces + 3 * (size_t)f;
+        const int32_t *fv = m->face_records[f].v;
         double e[3][3], len[3]; /* e[k]: edge opposite corner k, from k+1 to k+2 */
         for (int k = 0; k < 3; k++) {
             sub3(e[k], m->xyz + 3 * (size_t)fv[(k + 2) % 3], m->xyz + 3 * (size_t)fv[(k + 1) % 3]);
@@ -284,16 +283,11 @@ static mfmm_status build_records(mfmm_mesh *m)
         (n_virts > 0 && m->nv > INT32_MAX / 4)) /* (mfmm_face.virt packs 4 V + k) */
         return MFMM_ERR_BAD_COUNT;
     m->n_virts = (int32_t)n_virts;
-    /* on cache-line boundaries: one record, one line */
-    m->face_block = malloc(nf * sizeof *m->face_records + 64);
-    if (m->face_block)
-        m->face_records = (mfmm_face *)(void *)((char *)m->face_block +
-                                                (64 - (uintptr_t)m->face_block % 64) % 64);
     m->virts = malloc((n_virts ? n_virts : 1) * sizeof *m->virts);
     m->virt_first = calloc((size_t)m->nv + 1, sizeof *m->virt_first);
     m->virt_strip = malloc((n_virts + 1) * sizeof *m->virt_strip);
     m->strip = malloc((n_steps ? n_steps : 1) * sizeof *m->strip);
-    if (!m->face_block || !m->virts || !m->virt_first || !m->virt_strip || !m->strip)
+    if (!m->virts || !m->virt_first || !m->virt_strip || !m->strip)
         return MFMM_ERR_OUT_OF_MEMORY;
     int32_t *first = m->virt_first;
     for (size_t c = 0; c < nc; c++)
@@ -301,9 +295,6 @@ static mfmm_status build_records(mfmm_mesh *m)
             first[m->full[c].virt + 1]++;
     for (int32_t v = 0; v < m->nv; v++)
         first[v + 1] += first[v];
-    for (size_t f = 0; f < nf; f++)
-        for (int k = 0; k < 3; k++)
-            m->face_records[f].v[k] = m->faces[3 * f + k];
     for (size_t f = 0; f < nf; f++) {
         mfmm_face *r = m->face_records + f;
         r->virt = 3;
@@ -317,7 +308,7 @@ static mfmm_status build_records(mfmm_mesh *m)
             int32_t at = first[x->virt]++;
             mfmm_virt *vr = m->virts + at;
             vr->corner = (int32_t)(3 * f + (size_t)k);
-            vr->c = m->faces[3 * f + k];
+            vr->c = m->face_records[f].v[k];
             vr->len = x->virt_len;
             vr->cos_a = x->virt_cos_a;
             vr->cos_b = x->virt_cos_b;
@@ -413,12 +404,17 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
     m->nf = nf;
     size_t nc = (size_t)nf * 3;
     m->xyz = malloc((size_t)nv * 3 * sizeof *m->xyz);
-    m->faces = malloc(nc * sizeof *m->faces);
+    /* the face records, on cache-line boundaries (one record, one line):
+     * their vertices now, the rest once the corners are known */
+    m->face_block = malloc((size_t)nf * sizeof *m->face_records + 64);
+    if (m->face_block)
+        m->face_records = (mfmm_face *)(void *)((char *)m->face_block +
+                                                (64 - (uintptr_t)m->face_block % 64) % 64);
     m->face_neighbor = malloc(nc * sizeof *m->face_neighbor);
     m->component = malloc((size_t)nv * sizeof *m->component);
     m->degenerate = malloc((size_t)nf * sizeof *m->degenerate);
     m->full = malloc(nc * sizeof *m->full);
-    if (!m->xyz || !m->faces || !m->face_neighbor || !m->component || !m->degenerate ||
+    if (!m->xyz || !m->face_block || !m->face_neighbor || !m->component || !m->degenerate ||
         !m->full) {
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
@@ -440,8 +436,8 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
     }
     for (int32_t f = 0; f < nf; f++)
-        memcpy(m->faces + 3 * (size_t)f, m->face_neighbor + 3 * (size_t)m->face_to_external[f],
-               3 * sizeof *m->faces);
+        memcpy(m->face_records[f].v, m->face_neighbor + 3 * (size_t)m->face_to_external[f],
+               sizeof m->face_records[f].v);
     m->info.n_vertices = nv;
     m->info.n_faces = nf;
 
@@ -509,7 +505,7 @@ void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_locat
     for (int32_t v = 0; v < mesh->nv; v++)
         uniform[v] = 0.0;
     for (int32_t f = 0; f < mesh->nf; f++) {
-        const int32_t *fv = mesh->faces + 3 * (size_t)f;
+        const int32_t *fv = mesh->face_records[f].v;
         double x;
         if (cost_location == 2) {
             x = cost[f];
@@ -539,7 +535,6 @@ int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, i
         size_t bytes;
     } a[] = {
         {"xyz", nv * 3 * sizeof(double)},
-        {"faces", nc * sizeof(int32_t)},
         {"face_neighbor", nc * sizeof(int32_t)},
         {"vertex_face (CSR)", (nv + 1 + nc) * sizeof(int32_t)},
         {"component", nv * sizeof(int32_t)},

@@ -41,7 +41,6 @@ struct mfmm_mesh {
     int32_t *face_to_internal; /* (nf,) internal id of each input face */
     int32_t *face_to_external; /* (nf,) input id of each internal face */
     double *xyz;               /* (nv, 3) */
-    int32_t *faces;            /* (nf, 3) */
     int32_t *face_neighbor;    /* (nf, 3): face across the edge opposite corner k,
                                   -1 at a boundary or non-manifold edge */
     int32_t *vertex_face_offset; /* (nv+1,) CSR: corners (3f+k) at each vertex */
@@ -49,7 +48,9 @@ struct mfmm_mesh {
     int32_t *component;        /* (nv,) component id, -1 for unreferenced vertices */
     uint8_t *degenerate;       /* (nf,) 1 for zero-area faces */
     mfmm_corner_full *full;    /* (3 nf,) while building only, then NULL */
-    mfmm_face *face_records;   /* (nf,) for the march (local_update.h), 64-byte aligned */
+    mfmm_face *face_records;   /* (nf,) for the march (local_update.h), 64-byte aligned;
+                                  face f's vertices: face_records[f].v (the
+                                  mesh's only copy of the faces) */
     void *face_block;          /* the allocation face_records lies in */
     mfmm_virt *virts;          /* (n_virts,) virtual edges for the march, sorted by V */
     int32_t n_virts;
@@ -96,6 +97,12 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
  * corners still in face order (corner 3f+k), as mesh creation has them then.
  * MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
 mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *mesh, int32_t max_steps);
+
+/* The vertex at corner c = 3 f + k: face f's vertex k. */
+static inline int32_t mfmm_mesh_corner_vertex(const mfmm_mesh *mesh, int32_t c)
+{
+    return mesh->face_records[c / 3].v[c % 3];
+}
 
 /* The index in virts of corner 3 f + k's virtual edge, or -1 if it has none. */
 static inline int32_t mfmm_mesh_virt_index(const mfmm_mesh *mesh, int32_t corner)

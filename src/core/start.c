@@ -38,7 +38,7 @@ static double norm2(v2 a)
 
 void mfmm_source_locate(const mfmm_mesh *mesh, const mfmm_source *src, mfmm_source_loc *loc)
 {
-    const int32_t *fv = mesh->faces + 3 * (size_t)src->face;
+    const int32_t *fv = mesh->face_records[src->face].v;
     int n_zero = 0, zero = -1, top = 0;
     for (int k = 0; k < 3; k++) {
         if (src->bary[k] <= 0.0) {
@@ -143,7 +143,7 @@ static void enter(walk *w, int depth, int32_t g, int32_t ia, int32_t ib, v2 pa, 
     const mfmm_mesh *m = w->m;
     if (w->stop || g < 0 || m->degenerate[g] || depth > MFMM_START_DEPTH)
         return;
-    const int32_t *gv = m->faces + 3 * (size_t)g;
+    const int32_t *gv = m->face_records[g].v;
     int kq = -1;
     for (int k = 0; k < 3; k++)
         if (gv[k] != ia && gv[k] != ib)
@@ -203,7 +203,7 @@ static void enter(walk *w, int depth, int32_t g, int32_t ia, int32_t ib, v2 pa, 
 static void start_face(walk *w, int32_t f, const double *p)
 {
     const mfmm_mesh *m = w->m;
-    const int32_t *fv = m->faces + 3 * (size_t)f;
+    const int32_t *fv = m->face_records[f].v;
     const double *X[3];
     double r[3];
     int far = 0;
@@ -282,7 +282,7 @@ void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double
     w.radius = fmax(MFMM_START_RADIUS * mesh->info.mean_edge_length, mesh->info.max_edge_length);
     w.fn = fn;
     w.user = user;
-    const int32_t *fv = mesh->faces + 3 * (size_t)src->face;
+    const int32_t *fv = mesh->face_records[src->face].v;
     mfmm_source_loc at;
     mfmm_source_locate(mesh, src, &at);
     const double *p = at.p;

@@ -41,7 +41,7 @@ static vec2 unfold_point(vec2 p1, vec2 p2, double r1, double r2, vec2 away)
 static int local_index(const mfmm_mesh *m, int32_t g, int32_t v)
 {
     for (int k = 0; k < 3; k++)
-        if (m->faces[3 * (size_t)g + k] == v)
+        if (m->face_records[g].v[k] == v)
             return k;
     return -1;
 }
@@ -82,8 +82,8 @@ static int walk_cross(mfmm_strip_walk *w, int32_t *g_out, int32_t *q_out, vec2 *
     if (k1 < 0 || k2 < 0)
         return 0;
     int kq = 3 - k1 - k2;
-    int32_t q = m->faces[3 * (size_t)g + kq];
-    if (q == m->faces[w->corner] || q == w->a || q == w->b)
+    int32_t q = m->face_records[g].v[kq];
+    if (q == mfmm_mesh_corner_vertex(m, w->corner) || q == w->a || q == w->b)
         return 0;
     const double *xq = m->xyz + 3 * (size_t)q;
     *pq = unfold_point(w->p1, w->p2, dist3(m->xyz + 3 * (size_t)w->e1, xq),

@@ -105,7 +105,7 @@ static int cost_at(tracer *t, int32_t f, const double b[3], double *out)
     double s = 0.0;
     for (int k = 0; k < 3; k++) {
         double c;
-        if (!read_cost(t, t->m->faces[3 * f + k], &c))
+        if (!read_cost(t, t->m->face_records[f].v[k], &c))
             return 0;
         s += b[k] * c;
     }
@@ -185,7 +185,7 @@ static int frame_build(tracer *t, int32_t f, frame *fr)
     memset(fr, 0, sizeof *fr);
     fr->f = f;
     for (int k = 0; k < 3; k++) {
-        fr->v[k] = m->faces[3 * f + k];
+        fr->v[k] = m->face_records[f].v[k];
         if (!read_T(t, fr->v[k], &fr->T[k]))
             return 0;
     }
@@ -240,7 +240,7 @@ static int frame_build(tracer *t, int32_t f, frame *fr)
             return 1; /* boundary or degenerate neighbour: linear */
         int32_t a1 = fr->v[(k + 1) % 3], a2 = fr->v[(k + 2) % 3], far = -1;
         for (int j = 0; j < 3; j++) {
-            int32_t x = m->faces[3 * g + j];
+            int32_t x = m->face_records[g].v[j];
             if (x != a1 && x != a2)
                 far = x;
         }
@@ -433,7 +433,7 @@ static int32_t face_source(tracer *t, const frame *fr, const double b[3], double
 static void edge_bary(const mfmm_mesh *m, int32_t f, int32_t u, int32_t w, double s, double b[3])
 {
     for (int k = 0; k < 3; k++) {
-        int32_t x = m->faces[3 * (size_t)f + k];
+        int32_t x = m->face_records[f].v[k];
         b[k] = x == u ? 1.0 - s : x == w ? s : 0.0;
     }
 }
@@ -497,7 +497,7 @@ static int local_min(const tracer *t, int32_t v)
     double Tv = t->T[v];
     for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
         int32_t c = m->vertex_face_corner[i], f = c / 3, k = c % 3;
-        if (t->T[m->faces[3 * f + (k + 1) % 3]] < Tv || t->T[m->faces[3 * f + (k + 2) % 3]] < Tv)
+        if (t->T[m->face_records[f].v[(k + 1) % 3]] < Tv || t->T[m->face_records[f].v[(k + 2) % 3]] < Tv)
             return 0;
     }
     return virt_descent(t, v) < 0;
@@ -576,7 +576,7 @@ static void map_bary(const mfmm_mesh *m, const frame *fr, const double b[3], int
 {
     for (int j = 0; j < 3; j++) {
         bg[j] = 0.0;
-        int32_t x = m->faces[3 * g + j];
+        int32_t x = m->face_records[g].v[j];
         for (int k = 0; k < 3; k++)
             if (fr->v[k] == x)
                 bg[j] = b[k];
@@ -596,7 +596,7 @@ static void set_vertex(pos *p, const mfmm_mesh *m, int32_t f, int32_t v)
     p->vertex = v;
     p->from = -1;
     for (int k = 0; k < 3; k++)
-        p->b[k] = m->faces[3 * f + k] == v ? 1.0 : 0.0;
+        p->b[k] = m->face_records[f].v[k] == v ? 1.0 : 0.0;
 }
 
 /* At vertex v: steepest descent among the incident faces (a face whose
@@ -782,10 +782,10 @@ static int finish_straight(tracer *t, int32_t v)
     int32_t f0 = best.face[0];
     double b[3];
     for (int k = 0; k < 3; k++) {
-        int32_t x = m->faces[3 * (size_t)f0 + k];
+        int32_t x = m->face_records[f0].v[k];
         b[k] = 0.0;
         for (int j = 0; j < 3; j++)
-            if (m->faces[3 * (size_t)s->face + j] == x)
+            if (m->face_records[s->face].v[j] == x)
                 b[k] = s->bary[j] > 0.0 ? s->bary[j] : 0.0;
     }
     double sum = b[0] + b[1] + b[2];
