@@ -35,8 +35,6 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh->face_neighbor);
     free(mesh->vertex_face_offset);
     free(mesh->vertex_face_corner);
-    free(mesh->component);
-    free(mesh->degenerate);
     free(mesh->full);
     free(mesh->face_block);
     free(mesh->virts);
@@ -154,12 +152,17 @@ static int32_t uf_find(int32_t *parent, int32_t x)
     return x;
 }
 
-/* Connected components (through faces) of referenced vertices. */
+/* Connected components (through faces) of referenced vertices: their count
+ * (the ids are not kept). */
 static mfmm_status build_components(mfmm_mesh *m)
 {
     int32_t *parent = malloc((size_t)m->nv * sizeof *parent);
-    if (!parent)
+    int32_t *component = malloc((size_t)m->nv * sizeof *component);
+    if (!parent || !component) {
+        free(parent);
+        free(component);
         return MFMM_ERR_OUT_OF_MEMORY;
+    }
     for (int32_t v = 0; v < m->nv; v++)
         parent[v] = v;
     for (int32_t f = 0; f < m->nf; f++) {
@@ -172,18 +175,19 @@ static mfmm_status build_components(mfmm_mesh *m)
     }
     int32_t n_comp = 0, n_unref = 0;
     for (int32_t v = 0; v < m->nv; v++)
-        m->component[v] = -1;
+        component[v] = -1;
     for (int32_t v = 0; v < m->nv; v++) {
         if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1]) {
             n_unref++;
             continue;
         }
         int32_t r = uf_find(parent, v);
-        if (m->component[r] < 0)
-            m->component[r] = n_comp++;
-        m->component[v] = m->component[r];
+        if (component[r] < 0)
+            component[r] = n_comp++;
+        component[v] = component[r];
     }
     free(parent);
+    free(component);
     m->info.n_components = n_comp;
     m->info.n_unreferenced_vertices = n_unref;
     return MFMM_OK;
@@ -201,7 +205,8 @@ static double dot3(const double *a, const double *b)
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/* Corner lengths and angles; degenerate faces; obtuse corners. */
+/* Corner lengths and angles; degenerate faces; obtuse corners; the face
+ * records' lengths and cosines. */
 static void build_corners(mfmm_mesh *m)
 {
     int32_t n_degenerate = 0, n_obtuse = 0;
@@ -228,7 +233,6 @@ static void build_corners(mfmm_mesh *m)
             double sine = sqrt(dot3(cr, cr));
             degenerate = !(sine > 64.0 * DBL_EPSILON * (lmax / len[0]) * (lmax / len[1]));
         }
-        m->degenerate[f] = (uint8_t)degenerate;
         n_degenerate += degenerate;
         for (int k = 0; k < 3; k++) {
             mfmm_corner_full *c = m->full + 3 * (size_t)f + k;
@@ -253,14 +257,21 @@ static void build_corners(mfmm_mesh *m)
                 n_obtuse++;
             }
         }
+        /* the march's record (NaN cosines: zero area, mfmm_mesh_degenerate),
+         * which unfolding reads already */
+        mfmm_face *r = m->face_records + f;
+        for (int k = 0; k < 3; k++) {
+            r->len[k] = len[k];
+            r->cosv[k] = degenerate ? NAN : m->full[3 * (size_t)f + k].cos_c;
+        }
     }
     m->info.n_degenerate_faces = n_degenerate;
     m->info.n_obtuse_corners = n_obtuse;
 }
 
-/* The march's records from the build's corners: one 64-byte mfmm_face per
- * face (its vertices, the length opposite each corner, each corner's cosine,
- * NaN on a zero-area face), and one mfmm_virt per obtuse corner whose
+/* The march's records from the build's corners: each face record's obtuse
+ * corner (its vertices, lengths and cosines are in place: mesh creation,
+ * build_corners), and one mfmm_virt per obtuse corner whose
  * virtual edge unfolding found, sorted by V (counting sort, so by corner
  * within one V), the face naming V (the march reads the record from V's
  * list once V is Alive). The strips' vertices (for the
@@ -300,8 +311,6 @@ static mfmm_status build_records(mfmm_mesh *m)
         r->virt = 3;
         for (int k = 0; k < 3; k++) {
             const mfmm_corner_full *x = m->full + 3 * f + k;
-            r->len[(k + 1) % 3] = x->len_a; /* |BC| is opposite A = vertex k + 1 */
-            r->cosv[k] = x->virt == MFMM_VIRT_DEGENERATE ? NAN : x->cos_c;
             if (x->virt < 0)
                 continue;
             /* (a face has at most one obtuse corner) */
@@ -411,10 +420,8 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
         m->face_records = (mfmm_face *)(void *)((char *)m->face_block +
                                                 (64 - (uintptr_t)m->face_block % 64) % 64);
     m->face_neighbor = malloc(nc * sizeof *m->face_neighbor);
-    m->component = malloc((size_t)nv * sizeof *m->component);
-    m->degenerate = malloc((size_t)nf * sizeof *m->degenerate);
     m->full = malloc(nc * sizeof *m->full);
-    if (!m->xyz || !m->face_block || !m->face_neighbor || !m->component || !m->degenerate ||
+    if (!m->xyz || !m->face_block || !m->face_neighbor ||
         !m->full) {
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
@@ -458,8 +465,8 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
     }
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int32_t v = 0; v < nv; v++) {
-        if (m->component[v] < 0)
-            continue;
+        if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1])
+            continue; /* unreferenced */
         for (int k = 0; k < 3; k++) {
             lo[k] = fmin(lo[k], m->xyz[3 * (size_t)v + k]);
             hi[k] = fmax(hi[k], m->xyz[3 * (size_t)v + k]);
@@ -537,8 +544,6 @@ int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, i
         {"xyz", nv * 3 * sizeof(double)},
         {"face_neighbor", nc * sizeof(int32_t)},
         {"vertex_face (CSR)", (nv + 1 + nc) * sizeof(int32_t)},
-        {"component", nv * sizeof(int32_t)},
-        {"degenerate", nf},
         {"to_internal/to_external", 2 * nv * sizeof(int32_t)},
         {"face_to_internal/external", 2 * nf * sizeof(int32_t)},
         {"face records", nf * sizeof(mfmm_face)},

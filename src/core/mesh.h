@@ -2,6 +2,7 @@
 #ifndef MFMM_MESH_H
 #define MFMM_MESH_H
 
+#include <math.h>
 #include <pthread.h>
 
 #include "meshfmm.h"
@@ -45,8 +46,6 @@ struct mfmm_mesh {
                                   -1 at a boundary or non-manifold edge */
     int32_t *vertex_face_offset; /* (nv+1,) CSR: corners (3f+k) at each vertex */
     int32_t *vertex_face_corner;
-    int32_t *component;        /* (nv,) component id, -1 for unreferenced vertices */
-    uint8_t *degenerate;       /* (nf,) 1 for zero-area faces */
     mfmm_corner_full *full;    /* (3 nf,) while building only, then NULL */
     mfmm_face *face_records;   /* (nf,) for the march (local_update.h), 64-byte aligned;
                                   face f's vertices: face_records[f].v (the
@@ -97,6 +96,12 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
  * corners still in face order (corner 3f+k), as mesh creation has them then.
  * MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
 mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *mesh, int32_t max_steps);
+
+/* 1 when face f has zero area (its record's cosines are NaN), else 0. */
+static inline int mfmm_mesh_degenerate(const mfmm_mesh *mesh, int32_t f)
+{
+    return isnan(mesh->face_records[f].cosv[0]);
+}
 
 /* The vertex at corner c = 3 f + k: face f's vertex k. */
 static inline int32_t mfmm_mesh_corner_vertex(const mfmm_mesh *mesh, int32_t c)

@@ -141,7 +141,7 @@ static int in_cone(v2 d, v2 R, v2 L)
 static void enter(walk *w, int depth, int32_t g, int32_t ia, int32_t ib, v2 pa, v2 pb, v2 R, v2 L)
 {
     const mfmm_mesh *m = w->m;
-    if (w->stop || g < 0 || m->degenerate[g] || depth > MFMM_START_DEPTH)
+    if (w->stop || g < 0 || mfmm_mesh_degenerate(m, g) || depth > MFMM_START_DEPTH)
         return;
     const int32_t *gv = m->face_records[g].v;
     int kq = -1;
@@ -292,7 +292,7 @@ void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double
             w.fp = cost[v];
         for (int32_t i = mesh->vertex_face_offset[v]; i < mesh->vertex_face_offset[v + 1] && !w.stop; i++) {
             int32_t f = mesh->vertex_face_corner[i] / 3;
-            if (!mesh->degenerate[f])
+            if (!mfmm_mesh_degenerate(mesh, f))
                 start_face(&w, f, p);
         }
         return;
@@ -301,7 +301,7 @@ void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double
         for (int k = 0; k < 3; k++)
             w.fp += (src->bary[k] > 0.0 ? src->bary[k] : 0.0) * cost[fv[k]];
     int32_t g = at.across;
-    if (g >= 0 && mesh->degenerate[g])
+    if (g >= 0 && mfmm_mesh_degenerate(mesh, g))
         g = -1;
     /* on an edge: both faces, in the same order whichever names the point */
     int32_t first = g >= 0 && g < src->face ? g : src->face;

@@ -76,7 +76,7 @@ static int walk_cross(mfmm_strip_walk *w, int32_t *g_out, int32_t *q_out, vec2 *
 {
     const mfmm_mesh *m = w->m;
     int32_t g = m->face_neighbor[3 * (size_t)w->face + w->opposite];
-    if (g < 0 || m->degenerate[g])
+    if (g < 0 || mfmm_mesh_degenerate(m, g))
         return 0;
     int k1 = local_index(m, g, w->e1), k2 = local_index(m, g, w->e2);
     if (k1 < 0 || k2 < 0)

@@ -391,7 +391,7 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
     free(cnt);
     for (size_t f = 0; f < nf; f++) {
         const int32_t *fv = F[f].v;
-        int bad = mesh->degenerate[f] != 0;
+        int bad = mfmm_mesh_degenerate(mesh, (int32_t)f);
         ex_face *r = t->fr + t->face_in[f];
         memset(r, 0, sizeof *r);
         for (int k = 0; k < 3; k++) {

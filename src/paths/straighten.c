@@ -99,7 +99,7 @@ static int unfold_strip(const mfmm_mesh *m, const int32_t *faces, int32_t nf, do
     for (int32_t j = 0; j < nf; j++) {
         int32_t f = faces[j];
         const int32_t *v = m->face_records[f].v;
-        if (m->degenerate[f])
+        if (mfmm_mesh_degenerate(m, f))
             return 0;
         int ka, kb, kc;
         double A[2], B[2], away[2];

@@ -200,7 +200,7 @@ static int frame_build(tracer *t, int32_t f, frame *fr)
     fr->max_edge = fmax(L, fmax(sqrt(mfmm_dot3(w, w)), mfmm_dist3(B, C)));
     double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
     double n2 = sqrt(mfmm_dot3(n, n));
-    if (m->degenerate[f] || !(L > 0.0) || !(n2 > 1e-14 * fr->max_edge * fr->max_edge)) {
+    if (mfmm_mesh_degenerate(m, f) || !(L > 0.0) || !(n2 > 1e-14 * fr->max_edge * fr->max_edge)) {
         fr->degenerate = 1;
         return 1;
     }
@@ -236,7 +236,7 @@ static int frame_build(tracer *t, int32_t f, frame *fr)
     double Fmin = fr->F, Fmax = fr->F;
     for (int k = 0; k < 3; k++) {
         int32_t g = m->face_neighbor[3 * f + k];
-        if (g < 0 || m->degenerate[g])
+        if (g < 0 || mfmm_mesh_degenerate(m, g))
             return 1; /* boundary or degenerate neighbour: linear */
         int32_t a1 = fr->v[(k + 1) % 3], a2 = fr->v[(k + 2) % 3], far = -1;
         for (int j = 0; j < 3; j++) {

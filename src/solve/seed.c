@@ -55,7 +55,7 @@ static mfmm_status exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const 
         if (at.kind == MFMM_AT_VERTEX) {
             s.face = -1;
             s.vertex = center;
-        } else if (g >= 0 && g < s.face && !mesh->degenerate[g]) {
+        } else if (g >= 0 && g < s.face && !mfmm_mesh_degenerate(mesh, g)) {
             /* on an edge: named by the lower of its two faces, so that the
              * patch does not depend on which face names the point */
             const int32_t *gv = mesh->face_records[g].v;
