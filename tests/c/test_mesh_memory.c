@@ -1,6 +1,8 @@
-/* A built mesh's memory (issue 13.3): the virtual edges' strips, which the
- * mesh keeps only as their vertices (mesh.h), re-walked (mfmm_strip_next)
- * to the same virtual edge the build found. */
+/* A built mesh's memory (issue 13.3): at most 300 bytes per vertex on every
+ * shared mesh and on generated sine and sphere meshes, counted array by
+ * array (mfmm_mesh_memory); and the virtual edges' strips, which the mesh
+ * keeps only as their vertices (mesh.h), re-walked (mfmm_strip_next) to the
+ * same virtual edge the build found. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -14,6 +16,55 @@
 #include "testutil.h"
 #include "core/mesh.h"
 #include "io/generate.h"
+
+static double bytes_per_vertex(const mfmm_mesh *mesh)
+{
+    const char *names[32];
+    size_t bytes[32];
+    int n = mfmm_mesh_memory(mesh, names, bytes, 32);
+    assert_true(n <= 32);
+    size_t total = 0;
+    for (int i = 0; i < n; i++)
+        total += bytes[i];
+    return (double)total / mesh->nv;
+}
+
+static void check_budget(const mfmm_mesh *mesh, const char *what)
+{
+    double b = bytes_per_vertex(mesh);
+    if (!(b <= 300.0))
+        fail_msg("%s: %.1f bytes per vertex > 300", what, b);
+}
+
+static void test_shared_meshes_within_budget(void **state)
+{
+    (void)state;
+    static const char *files[] = {
+        "meshes/beetle.obj",           "meshes/camelhead.off",     "meshes/decimated-max.obj",
+        "meshes/fertility_FE_10k.off", "meshes/hand_lowres.obj",   "meshes/igea.ply",
+        "meshes/nefertiti-lowres.obj", "meshes/spot.obj",          "meshes/stanford-bunny.obj",
+        "meshes/wingnut.obj",
+    };
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+        mfmm_mesh *mesh = tm_load_data(files[i], NULL, NULL, NULL);
+        check_budget(mesh, files[i]);
+        mfmm_mesh_destroy(mesh);
+    }
+}
+
+static void test_generated_meshes_within_budget(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh g[] = {mfmm_gen_sine(30), mfmm_gen_sine(100), mfmm_gen_sine(200),
+                         mfmm_gen_icosphere(3), mfmm_gen_icosphere(5)};
+    const char *what[] = {"sine 30", "sine 100", "sine 200", "sphere 3", "sphere 5"};
+    for (size_t i = 0; i < sizeof g / sizeof g[0]; i++) {
+        mfmm_mesh *mesh = tm_make(&g[i]);
+        check_budget(mesh, what[i]);
+        mfmm_mesh_destroy(mesh);
+        mfmm_gen_free(&g[i]);
+    }
+}
 
 static int face_has(const mfmm_mesh *m, int32_t f, int32_t v)
 {
@@ -92,6 +143,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_strips_rewalk),
+        cmocka_unit_test(test_shared_meshes_within_budget),
+        cmocka_unit_test(test_generated_meshes_within_budget),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
