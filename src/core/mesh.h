@@ -35,7 +35,7 @@ struct mfmm_mesh {
     int32_t nv, nf;
     /* Vertices are numbered internally along a space-filling curve, faces
      * by their least internal vertex (order.h): every per-vertex and
-     * per-face array below, and the vertex ids in faces, are in that order;
+     * per-face array below, and the vertex ids in the face records, are in that order;
      * a face keeps its corner order. */
     int32_t *to_internal;      /* (nv,) internal id of each input vertex */
     int32_t *to_external;      /* (nv,) input id of each internal vertex */
@@ -92,8 +92,8 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
 /* Finds the virtual edge of every obtuse corner by unfolding (section 4.2);
  * fills full[].virt, virt_len, virt_cos_a, virt_cos_b, strip_at, strip_n, the
  * strips' steps (build_steps, corner order) and the counts.
- * Needs faces, xyz, face_neighbor, corners' lengths and cosines, with the
- * corners still in face order (corner 3f+k), as mesh creation has them then.
+ * Needs the face records' vertices, lengths and cosines, xyz, face_neighbor
+ * and the corners (full, corner 3f+k), as mesh creation has them then.
  * MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
 mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *mesh, int32_t max_steps);
 
