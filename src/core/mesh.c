@@ -275,7 +275,7 @@ static void build_corners(mfmm_mesh *m)
  * virtual edge unfolding found, sorted by V (counting sort, so by corner
  * within one V), the face naming V (the march reads the record from V's
  * list once V is Alive). The strips' vertices (for the
- * virtual stencils' cost test) per virtual edge, in virts' order (the
+ * virtual stencils' cost test) per virtual edge but V, in virts' order (the
  * strips' other fields are re-walked when needed, mfmm_strip_next). Frees
  * m->full and m->build_steps. */
 static mfmm_status build_records(mfmm_mesh *m)
@@ -286,7 +286,7 @@ static mfmm_status build_records(mfmm_mesh *m)
     for (size_t c = 0; c < nc; c++)
         if (m->full[c].virt >= 0) {
             n_virts++;
-            n_steps += (size_t)m->full[c].strip_n;
+            n_steps += (size_t)m->full[c].strip_n - 1; /* (V aside) */
         }
     if (n_steps > (size_t)INT32_MAX)
         return MFMM_ERR_BAD_COUNT;
@@ -322,7 +322,7 @@ static mfmm_status build_records(mfmm_mesh *m)
             vr->cos_a = x->virt_cos_a;
             vr->cos_b = x->virt_cos_b;
             r->virt = 4 * x->virt + k;
-            m->virt_strip[at + 1] = x->strip_n;
+            m->virt_strip[at + 1] = x->strip_n - 1;
         }
     }
     for (int32_t v = m->nv; v > 0; v--)
@@ -332,7 +332,7 @@ static mfmm_status build_records(mfmm_mesh *m)
     for (size_t j = 0; j < n_virts; j++) {
         const mfmm_corner_full *x = m->full + m->virts[j].corner;
         int32_t at = m->virt_strip[j];
-        for (int32_t i = 0; i < x->strip_n; i++)
+        for (int32_t i = 0; i < x->strip_n - 1; i++)
             m->strip[at + i] = m->build_steps[x->strip_at + i].far;
         m->virt_strip[j + 1] += at;
     }

@@ -57,9 +57,9 @@ struct mfmm_mesh {
     int32_t *virt_strip;       /* (n_virts + 1,) CSR by virtual edge (virts' order)
                                   into strip */
     int32_t *strip;            /* each virtual edge's strip: the vertex off the edge
-                                  crossed at each step, the last V (for the march's
-                                  cost test, mfmm_march_mesh.strip; the strip's
-                                  faces and crossings: mfmm_strip_next) */
+                                  crossed at each step but the last (whose is V),
+                                  for the march's cost test (mfmm_march_mesh.strip;
+                                  the strip's faces and crossings: mfmm_strip_next) */
     mfmm_virt_step *build_steps; /* while building only (corner order), then NULL */
     mfmm_mesh_info info;
     /* The exact solver's read-only tables (exact/exact.h: face frames, fans),

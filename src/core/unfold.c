@@ -210,7 +210,7 @@ void mfmm_strip_begin(mfmm_strip_walk *w, const mfmm_mesh *mesh, int32_t j)
 {
     w->m = mesh;
     w->corner = mesh->virts[j].corner;
-    w->n = mesh->virt_strip[j + 1] - mesh->virt_strip[j];
+    w->n = mesh->virt_strip[j + 1] - mesh->virt_strip[j] + 1; /* (and V's step) */
     /* once to V, for the crossings' t; then from the start again */
     strip_init(w);
     for (int32_t i = 0; i < w->n; i++) {
