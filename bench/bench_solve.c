@@ -57,9 +57,9 @@ static int graph_build(const mfmm_mesh *m, graph *g)
             int32_t c, dup = 0;
             if (j < 2 * nw) {
                 int32_t w = m->vertex_face_corner[m->vertex_face_offset[x] + j / 2];
-                c = m->faces[3 * (w / 3) + (w % 3 + 1 + j % 2) % 3];
+                c = m->face_records[w / 3].v[(w % 3 + 1 + j % 2) % 3];
             } else {
-                c = m->faces[m->virts[m->virt_first[x] + j - 2 * nw].corner];
+                c = m->virts[m->virt_first[x] + j - 2 * nw].c;
             }
             for (int32_t i = g->off[x]; i < k && !dup; i++)
                 dup = g->nbr[i] == c;

@@ -36,7 +36,7 @@ mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int
     if (src->face >= mesh->nf)
         return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, i, "source %ld: face %ld is outside [0, %ld)",
                          (long)i, (long)src->face, (long)mesh->nf);
-    if (mesh->degenerate[mfmm_face_in(mesh, src->face)])
+    if (mfmm_mesh_degenerate(mesh, mfmm_face_in(mesh, src->face)))
         return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, i,
                          "source %ld lies on face %ld, which has zero area", (long)i,
                          (long)src->face);

@@ -23,9 +23,9 @@ typedef struct mfmm_march_mesh {
      * virts[virt_first[x]] .. virts[virt_first[x + 1] - 1] */
     MFMM_GLOBAL const mfmm_virt *virts;
     MFMM_GLOBAL const mfmm_i32 *virt_first;
-    /* the vertices each virtual edge's strip unfolds up to V (A and B
-     * aside): strip[strip_offset[k]] .. strip[strip_offset[k + 1] - 1] for
-     * corner k = 3 f + k' */
+    /* the vertices each virtual edge's strip unfolds before V (A and B
+     * aside): strip[strip_offset[j]] .. strip[strip_offset[j + 1] - 1] for
+     * virts[j] */
     MFMM_GLOBAL const mfmm_i32 *strip_offset;
     MFMM_GLOBAL const mfmm_i32 *strip;
 } mfmm_march_mesh;
@@ -188,8 +188,9 @@ MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, mfmm_i32 f_id, mfm
     return f;
 }
 
-/* Whether the virtual stencil of corner k = 3 f + k' (C, with the face's
- * other vertices a, b) may be used under the march's cost. Its virtual edge
+/* Whether the virtual stencil of virtual edge vr (its corner C, with the
+ * face's other vertices a, b, and its V = iv) may be used under the march's
+ * cost. Its virtual edge
  * and triangles charge the corner's own F over the unfolded strip between C
  * and V and over the virtual triangles A-C-V, V-C-B, which lie over faces
  * other than the corner's: it holds only where F is the same over that
@@ -199,12 +200,14 @@ MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, mfmm_i32 f_id, mfm
  * unfolding off (issue 9.1: a cost-1 face's virtual edge through cost-100
  * faces made T 50x too low). */
 MFMM_INLINE int mfmm_march_virt_ok(const mfmm_march_state *s, const mfmm_march_mesh *m,
-                                   mfmm_i32 k, mfmm_i32 a, mfmm_i32 b, double f)
+                                   MFMM_GLOBAL const mfmm_virt *vr, mfmm_i32 a, mfmm_i32 b,
+                                   mfmm_i32 iv, double f)
 {
     MFMM_GLOBAL const double *U = s->uniform;
-    if (U[a] != f || U[b] != f)
+    if (U[a] != f || U[b] != f || U[iv] != f)
         return 0;
-    for (mfmm_i32 i = m->strip_offset[k]; i < m->strip_offset[k + 1]; i++)
+    mfmm_i32 j = (mfmm_i32)(vr - m->virts);
+    for (mfmm_i32 i = m->strip_offset[j]; i < m->strip_offset[j + 1]; i++)
         if (U[m->strip[i]] != f)
             return 0;
     return 1;
@@ -228,8 +231,8 @@ MFMM_INLINE void mfmm_march_offer(mfmm_march_state *s, const mfmm_march_mesh *m,
 }
 
 /* The virtual edge of corner k = 3 f + k' that ends at V = iv: V's list
- * (virt_first) holds it. Read only once V is Alive, when V's own settling
- * has just read that list. */
+ * (virt_first) holds it. Read once V is Alive, when V's own settling has
+ * just read that list (and under a cost for the footprint's test). */
 MFMM_INLINE MFMM_GLOBAL const mfmm_virt *mfmm_march_virt_of(const mfmm_march_mesh *m,
                                                             mfmm_i32 iv, mfmm_i32 k)
 {
@@ -267,7 +270,7 @@ MFMM_COLD void mfmm_march_corner(mfmm_march_state *s, const mfmm_march_mesh *m,
         int v_alive = (s->label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE;
         /* (the footprint matters once V, or both A and B, have settled) */
         if ((v_alive || alive_y) && s->cost_location != 0 &&
-            !mfmm_march_virt_ok(s, m, 3 * f_id + jc, ia, ib, f))
+            !mfmm_march_virt_ok(s, m, mfmm_march_virt_of(m, iv, 3 * f_id + jc), ia, ib, iv, f))
             virt = 0;
         else if (v_alive) {
             MFMM_GLOBAL const mfmm_virt *vr = mfmm_march_virt_of(m, iv, 3 * f_id + jc);
@@ -304,7 +307,7 @@ MFMM_COLD void mfmm_march_virtual(mfmm_march_state *s, const mfmm_march_mesh *m,
     double f_a = 1.0, f_b = 1.0, f_t = 1.0, f = 1.0;
     if (s->cost_location != 0) {
         f = mfmm_march_cost(s, f_id, c, ia, ib, &f_a, &f_b, &f_t);
-        if (!mfmm_march_virt_ok(s, m, k, ia, ib, f))
+        if (!mfmm_march_virt_ok(s, m, vr, ia, ib, fr->virt >> 2, f))
             return;
     }
     double best = tx + vr->len * f_t;

@@ -32,19 +32,16 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh->face_to_internal);
     free(mesh->face_to_external);
     free(mesh->xyz);
-    free(mesh->faces);
     free(mesh->face_neighbor);
     free(mesh->vertex_face_offset);
     free(mesh->vertex_face_corner);
-    free(mesh->component);
-    free(mesh->degenerate);
     free(mesh->full);
     free(mesh->face_block);
     free(mesh->virts);
     free(mesh->virt_first);
-    free(mesh->virt_offset);
-    free(mesh->virt_steps);
+    free(mesh->virt_strip);
     free(mesh->strip);
+    free(mesh->build_steps);
     if (mesh->exact_tables)
         mesh->exact_tables_free(mesh->exact_tables);
     pthread_mutex_destroy(&mesh->cache_lock);
@@ -76,7 +73,7 @@ static mfmm_status build_edges(mfmm_mesh *m)
         return MFMM_ERR_OUT_OF_MEMORY;
     for (size_t c = 0; c < nc; c++) {
         size_t f = c / 3, k = c % 3;
-        int32_t u = m->faces[3 * f + (k + 1) % 3], v = m->faces[3 * f + (k + 2) % 3];
+        int32_t u = m->face_records[f].v[(k + 1) % 3], v = m->face_records[f].v[(k + 2) % 3];
         he[c].lo = u < v ? u : v;
         he[c].hi = u < v ? v : u;
         he[c].corner = (int32_t)c;
@@ -131,11 +128,11 @@ static mfmm_status build_vertex_faces(mfmm_mesh *m)
         return MFMM_ERR_OUT_OF_MEMORY;
     }
     for (size_t c = 0; c < nc; c++)
-        off[m->faces[c] + 1]++;
+        off[mfmm_mesh_corner_vertex(m, (int32_t)c) + 1]++;
     for (int32_t v = 0; v < m->nv; v++)
         off[v + 1] += off[v];
     for (size_t c = 0; c < nc; c++) {
-        int32_t v = m->faces[c];
+        int32_t v = mfmm_mesh_corner_vertex(m, (int32_t)c);
         list[off[v]++] = (int32_t)c;
     }
     for (int32_t v = m->nv; v > 0; v--)
@@ -155,36 +152,42 @@ static int32_t uf_find(int32_t *parent, int32_t x)
     return x;
 }
 
-/* Connected components (through faces) of referenced vertices. */
+/* Connected components (through faces) of referenced vertices: their count
+ * (the ids are not kept). */
 static mfmm_status build_components(mfmm_mesh *m)
 {
     int32_t *parent = malloc((size_t)m->nv * sizeof *parent);
-    if (!parent)
+    int32_t *component = malloc((size_t)m->nv * sizeof *component);
+    if (!parent || !component) {
+        free(parent);
+        free(component);
         return MFMM_ERR_OUT_OF_MEMORY;
+    }
     for (int32_t v = 0; v < m->nv; v++)
         parent[v] = v;
     for (int32_t f = 0; f < m->nf; f++) {
-        int32_t r0 = uf_find(parent, m->faces[3 * f]);
+        int32_t r0 = uf_find(parent, m->face_records[f].v[0]);
         for (int k = 1; k < 3; k++) {
-            int32_t r = uf_find(parent, m->faces[3 * f + k]);
+            int32_t r = uf_find(parent, m->face_records[f].v[k]);
             if (r != r0)
                 parent[r] = r0;
         }
     }
     int32_t n_comp = 0, n_unref = 0;
     for (int32_t v = 0; v < m->nv; v++)
-        m->component[v] = -1;
+        component[v] = -1;
     for (int32_t v = 0; v < m->nv; v++) {
         if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1]) {
             n_unref++;
             continue;
         }
         int32_t r = uf_find(parent, v);
-        if (m->component[r] < 0)
-            m->component[r] = n_comp++;
-        m->component[v] = m->component[r];
+        if (component[r] < 0)
+            component[r] = n_comp++;
+        component[v] = component[r];
     }
     free(parent);
+    free(component);
     m->info.n_components = n_comp;
     m->info.n_unreferenced_vertices = n_unref;
     return MFMM_OK;
@@ -202,12 +205,13 @@ static double dot3(const double *a, const double *b)
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/* Corner lengths and angles; degenerate faces; obtuse corners. */
+/* Corner lengths and angles; degenerate faces; obtuse corners; the face
+ * records' lengths and cosines. */
 static void build_corners(mfmm_mesh *m)
 {
     int32_t n_degenerate = 0, n_obtuse = 0;
     for (int32_t f = 0; f < m->nf; f++) {
-        const int32_t *fv = m->faces + 3 * (size_t)f;
+        const int32_t *fv = m->face_records[f].v;
         double e[3][3], len[3]; /* e[k]: edge opposite corner k, from k+1 to k+2 */
         for (int k = 0; k < 3; k++) {
             sub3(e[k], m->xyz + 3 * (size_t)fv[(k + 2) % 3], m->xyz + 3 * (size_t)fv[(k + 1) % 3]);
@@ -229,7 +233,6 @@ static void build_corners(mfmm_mesh *m)
             double sine = sqrt(dot3(cr, cr));
             degenerate = !(sine > 64.0 * DBL_EPSILON * (lmax / len[0]) * (lmax / len[1]));
         }
-        m->degenerate[f] = (uint8_t)degenerate;
         n_degenerate += degenerate;
         for (int k = 0; k < 3; k++) {
             mfmm_corner_full *c = m->full + 3 * (size_t)f + k;
@@ -254,75 +257,89 @@ static void build_corners(mfmm_mesh *m)
                 n_obtuse++;
             }
         }
+        /* the march's record (NaN cosines: zero area, mfmm_mesh_degenerate),
+         * which unfolding reads already */
+        mfmm_face *r = m->face_records + f;
+        for (int k = 0; k < 3; k++) {
+            r->len[k] = len[k];
+            r->cosv[k] = degenerate ? NAN : m->full[3 * (size_t)f + k].cos_c;
+        }
     }
     m->info.n_degenerate_faces = n_degenerate;
     m->info.n_obtuse_corners = n_obtuse;
 }
 
-/* The march's records from the build's corners: one 64-byte mfmm_face per
- * face (its vertices, the length opposite each corner, each corner's cosine,
- * NaN on a zero-area face), and one mfmm_virt per obtuse corner whose
+/* The march's records from the build's corners: each face record's obtuse
+ * corner (its vertices, lengths and cosines are in place: mesh creation,
+ * build_corners), and one mfmm_virt per obtuse corner whose
  * virtual edge unfolding found, sorted by V (counting sort, so by corner
  * within one V), the face naming V (the march reads the record from V's
  * list once V is Alive). The strips' vertices (for the
- * virtual stencils' cost test) parallel to virt_steps. Frees m->full. */
+ * virtual stencils' cost test) per virtual edge but V, in virts' order (the
+ * strips' other fields are re-walked when needed, mfmm_strip_next). Frees
+ * m->full and m->build_steps. */
 static mfmm_status build_records(mfmm_mesh *m)
 {
     size_t nf = (size_t)m->nf, nc = 3 * nf;
-    size_t n_steps = (size_t)m->virt_offset[nc];
+    size_t n_steps = 0;
     size_t n_virts = 0;
     for (size_t c = 0; c < nc; c++)
-        n_virts += m->full[c].virt >= 0;
+        if (m->full[c].virt >= 0) {
+            n_virts++;
+            n_steps += (size_t)m->full[c].strip_n - 1; /* (V aside) */
+        }
+    if (n_steps > (size_t)INT32_MAX)
+        return MFMM_ERR_BAD_COUNT;
     if (n_virts > (size_t)INT32_MAX ||
         (n_virts > 0 && m->nv > INT32_MAX / 4)) /* (mfmm_face.virt packs 4 V + k) */
         return MFMM_ERR_BAD_COUNT;
     m->n_virts = (int32_t)n_virts;
-    /* on cache-line boundaries: one record, one line */
-    m->face_block = malloc(nf * sizeof *m->face_records + 64);
-    if (m->face_block)
-        m->face_records = (mfmm_face *)(void *)((char *)m->face_block +
-                                                (64 - (uintptr_t)m->face_block % 64) % 64);
     m->virts = malloc((n_virts ? n_virts : 1) * sizeof *m->virts);
     m->virt_first = calloc((size_t)m->nv + 1, sizeof *m->virt_first);
+    m->virt_strip = malloc((n_virts + 1) * sizeof *m->virt_strip);
     m->strip = malloc((n_steps ? n_steps : 1) * sizeof *m->strip);
-    if (!m->face_block || !m->virts || !m->virt_first || !m->strip)
+    if (!m->virts || !m->virt_first || !m->virt_strip || !m->strip)
         return MFMM_ERR_OUT_OF_MEMORY;
-    for (size_t k = 0; k < n_steps; k++)
-        m->strip[k] = m->virt_steps[k].far;
     int32_t *first = m->virt_first;
     for (size_t c = 0; c < nc; c++)
         if (m->full[c].virt >= 0)
             first[m->full[c].virt + 1]++;
     for (int32_t v = 0; v < m->nv; v++)
         first[v + 1] += first[v];
-    for (size_t f = 0; f < nf; f++)
-        for (int k = 0; k < 3; k++)
-            m->face_records[f].v[k] = m->faces[3 * f + k];
     for (size_t f = 0; f < nf; f++) {
         mfmm_face *r = m->face_records + f;
         r->virt = 3;
         for (int k = 0; k < 3; k++) {
             const mfmm_corner_full *x = m->full + 3 * f + k;
-            r->len[(k + 1) % 3] = x->len_a; /* |BC| is opposite A = vertex k + 1 */
-            r->cosv[k] = x->virt == MFMM_VIRT_DEGENERATE ? NAN : x->cos_c;
             if (x->virt < 0)
                 continue;
             /* (a face has at most one obtuse corner) */
             int32_t at = first[x->virt]++;
             mfmm_virt *vr = m->virts + at;
             vr->corner = (int32_t)(3 * f + (size_t)k);
-            vr->c = m->faces[3 * f + k];
+            vr->c = m->face_records[f].v[k];
             vr->len = x->virt_len;
             vr->cos_a = x->virt_cos_a;
             vr->cos_b = x->virt_cos_b;
             r->virt = 4 * x->virt + k;
+            m->virt_strip[at + 1] = x->strip_n - 1;
         }
     }
     for (int32_t v = m->nv; v > 0; v--)
         first[v] = first[v - 1];
     first[0] = 0;
+    m->virt_strip[0] = 0;
+    for (size_t j = 0; j < n_virts; j++) {
+        const mfmm_corner_full *x = m->full + m->virts[j].corner;
+        int32_t at = m->virt_strip[j];
+        for (int32_t i = 0; i < x->strip_n - 1; i++)
+            m->strip[at + i] = m->build_steps[x->strip_at + i].far;
+        m->virt_strip[j + 1] += at;
+    }
     free(m->full);
     m->full = NULL;
+    free(m->build_steps);
+    m->build_steps = NULL;
     return MFMM_OK;
 }
 
@@ -396,12 +413,15 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
     m->nf = nf;
     size_t nc = (size_t)nf * 3;
     m->xyz = malloc((size_t)nv * 3 * sizeof *m->xyz);
-    m->faces = malloc(nc * sizeof *m->faces);
+    /* the face records, on cache-line boundaries (one record, one line):
+     * their vertices now, the rest once the corners are known */
+    m->face_block = malloc((size_t)nf * sizeof *m->face_records + 64);
+    if (m->face_block)
+        m->face_records = (mfmm_face *)(void *)((char *)m->face_block +
+                                                (64 - (uintptr_t)m->face_block % 64) % 64);
     m->face_neighbor = malloc(nc * sizeof *m->face_neighbor);
-    m->component = malloc((size_t)nv * sizeof *m->component);
-    m->degenerate = malloc((size_t)nf * sizeof *m->degenerate);
     m->full = malloc(nc * sizeof *m->full);
-    if (!m->xyz || !m->faces || !m->face_neighbor || !m->component || !m->degenerate ||
+    if (!m->xyz || !m->face_block || !m->face_neighbor ||
         !m->full) {
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
@@ -423,8 +443,8 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
     }
     for (int32_t f = 0; f < nf; f++)
-        memcpy(m->faces + 3 * (size_t)f, m->face_neighbor + 3 * (size_t)m->face_to_external[f],
-               3 * sizeof *m->faces);
+        memcpy(m->face_records[f].v, m->face_neighbor + 3 * (size_t)m->face_to_external[f],
+               sizeof m->face_records[f].v);
     m->info.n_vertices = nv;
     m->info.n_faces = nf;
 
@@ -445,8 +465,8 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
     }
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int32_t v = 0; v < nv; v++) {
-        if (m->component[v] < 0)
-            continue;
+        if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1])
+            continue; /* unreferenced */
         for (int k = 0; k < 3; k++) {
             lo[k] = fmin(lo[k], m->xyz[3 * (size_t)v + k]);
             hi[k] = fmax(hi[k], m->xyz[3 * (size_t)v + k]);
@@ -492,7 +512,7 @@ void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_locat
     for (int32_t v = 0; v < mesh->nv; v++)
         uniform[v] = 0.0;
     for (int32_t f = 0; f < mesh->nf; f++) {
-        const int32_t *fv = mesh->faces + 3 * (size_t)f;
+        const int32_t *fv = mesh->face_records[f].v;
         double x;
         if (cost_location == 2) {
             x = cost[f];
@@ -511,7 +531,7 @@ void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_locat
 int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, int max)
 {
     size_t nv = (size_t)mesh->nv, nf = (size_t)mesh->nf, nc = 3 * nf;
-    size_t n_steps = (size_t)mesh->virt_offset[nc];
+    size_t n_virts = (size_t)mesh->n_virts, n_steps = (size_t)mesh->virt_strip[n_virts];
     /* the exact tables may be built by another thread meanwhile (mesh.h) */
     pthread_mutex_t *lock = (pthread_mutex_t *)(uintptr_t)&mesh->cache_lock;
     pthread_mutex_lock(lock);
@@ -522,18 +542,14 @@ int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, i
         size_t bytes;
     } a[] = {
         {"xyz", nv * 3 * sizeof(double)},
-        {"faces", nc * sizeof(int32_t)},
         {"face_neighbor", nc * sizeof(int32_t)},
         {"vertex_face (CSR)", (nv + 1 + nc) * sizeof(int32_t)},
-        {"component", nv * sizeof(int32_t)},
-        {"degenerate", nf},
         {"to_internal/to_external", 2 * nv * sizeof(int32_t)},
         {"face_to_internal/external", 2 * nf * sizeof(int32_t)},
         {"face records", nf * sizeof(mfmm_face)},
         {"virtual edges", (size_t)mesh->n_virts * sizeof(mfmm_virt) + (nv + 1) * sizeof(int32_t)},
         {"strip", n_steps * sizeof(int32_t)},
-        {"virt_offset", (nc + 1) * sizeof(int32_t)},
-        {"virt_steps", n_steps * sizeof(mfmm_virt_step)},
+        {"virt_strip", (n_virts + 1) * sizeof(int32_t)},
         {"mesh struct", sizeof *mesh},
         {"exact tables (once built)", exact_bytes},
     };

@@ -2,12 +2,14 @@
 #ifndef MFMM_MESH_H
 #define MFMM_MESH_H
 
+#include <math.h>
 #include <pthread.h>
 
 #include "meshfmm.h"
 #include "march.h"
 
-/* One face of the strip that a virtual edge C -> V crosses (section 4.2). */
+/* One face of the strip that a virtual edge C -> V crosses (section 4.2).
+ * Not stored: mfmm_strip_next re-walks a strip (unfold.c). */
 typedef struct mfmm_virt_step {
     int32_t face;   /* the face entered */
     int32_t far;    /* its vertex off the edge crossed (the last step's is V) */
@@ -24,6 +26,7 @@ typedef struct mfmm_virt_step {
 #define MFMM_VIRT_DEGENERATE (-3) /* zero-area face: edge updates only */
 typedef struct mfmm_corner_full {
     int32_t face, a, b, virt;
+    int32_t strip_at, strip_n; /* its strip's steps in the build's buffer */
     double len_a, len_b, cos_c;
     double virt_len, virt_cos_a, virt_cos_b;
 } mfmm_corner_full;
@@ -32,31 +35,32 @@ struct mfmm_mesh {
     int32_t nv, nf;
     /* Vertices are numbered internally along a space-filling curve, faces
      * by their least internal vertex (order.h): every per-vertex and
-     * per-face array below, and the vertex ids in faces, are in that order;
+     * per-face array below, and the vertex ids in the face records, are in that order;
      * a face keeps its corner order. */
     int32_t *to_internal;      /* (nv,) internal id of each input vertex */
     int32_t *to_external;      /* (nv,) input id of each internal vertex */
     int32_t *face_to_internal; /* (nf,) internal id of each input face */
     int32_t *face_to_external; /* (nf,) input id of each internal face */
     double *xyz;               /* (nv, 3) */
-    int32_t *faces;            /* (nf, 3) */
     int32_t *face_neighbor;    /* (nf, 3): face across the edge opposite corner k,
                                   -1 at a boundary or non-manifold edge */
     int32_t *vertex_face_offset; /* (nv+1,) CSR: corners (3f+k) at each vertex */
     int32_t *vertex_face_corner;
-    int32_t *component;        /* (nv,) component id, -1 for unreferenced vertices */
-    uint8_t *degenerate;       /* (nf,) 1 for zero-area faces */
     mfmm_corner_full *full;    /* (3 nf,) while building only, then NULL */
-    mfmm_face *face_records;   /* (nf,) for the march (local_update.h), 64-byte aligned */
+    mfmm_face *face_records;   /* (nf,) for the march (local_update.h), 64-byte aligned;
+                                  face f's vertices: face_records[f].v (the
+                                  mesh's only copy of the faces) */
     void *face_block;          /* the allocation face_records lies in */
     mfmm_virt *virts;          /* (n_virts,) virtual edges for the march, sorted by V */
     int32_t n_virts;
     int32_t *virt_first;       /* (nv+1,) CSR: virts[virt_first[v]..] end at v */
-    int32_t *virt_offset;      /* (3 nf + 1,) CSR by corner 3f+k into virt_steps: the
-                                  strip of an obtuse corner's virtual edge */
-    mfmm_virt_step *virt_steps;
-    int32_t *strip;            /* virt_steps[].far, for the march (see
-                                  mfmm_march_mesh.strip) */
+    int32_t *virt_strip;       /* (n_virts + 1,) CSR by virtual edge (virts' order)
+                                  into strip */
+    int32_t *strip;            /* each virtual edge's strip: the vertex off the edge
+                                  crossed at each step but the last (whose is V),
+                                  for the march's cost test (mfmm_march_mesh.strip;
+                                  the strip's faces and crossings: mfmm_strip_next) */
+    mfmm_virt_step *build_steps; /* while building only (corner order), then NULL */
     mfmm_mesh_info info;
     /* The exact solver's read-only tables (exact/exact.h: face frames, fans),
      * built on the first exact solve or exact start and then shared by every
@@ -80,18 +84,61 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
     m.faces = mesh->face_records;
     m.virts = mesh->virts;
     m.virt_first = mesh->virt_first;
-    m.strip_offset = mesh->virt_offset;
+    m.strip_offset = mesh->virt_strip;
     m.strip = mesh->strip;
     return m;
 }
 
 /* Finds the virtual edge of every obtuse corner by unfolding (section 4.2);
- * fills full[].virt, virt_len, virt_cos_a, virt_cos_b, the strips
- * (virt_offset, virt_steps) and the counts.
- * Needs faces, xyz, face_neighbor, corners' lengths and cosines, with the
- * corners still in face order (corner 3f+k), as mesh creation has them then.
+ * fills full[].virt, virt_len, virt_cos_a, virt_cos_b, strip_at, strip_n, the
+ * strips' steps (build_steps, corner order) and the counts.
+ * Needs the face records' vertices, lengths and cosines, xyz, face_neighbor
+ * and the corners (full, corner 3f+k), as mesh creation has them then.
  * MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
 mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *mesh, int32_t max_steps);
+
+/* 1 when face f has zero area (its record's cosines are NaN), else 0. */
+static inline int mfmm_mesh_degenerate(const mfmm_mesh *mesh, int32_t f)
+{
+    return isnan(mesh->face_records[f].cosv[0]);
+}
+
+/* The vertex at corner c = 3 f + k: face f's vertex k. */
+static inline int32_t mfmm_mesh_corner_vertex(const mfmm_mesh *mesh, int32_t c)
+{
+    return mesh->face_records[c / 3].v[c % 3];
+}
+
+/* The index in virts of corner 3 f + k's virtual edge, or -1 if it has none. */
+static inline int32_t mfmm_mesh_virt_index(const mfmm_mesh *mesh, int32_t corner)
+{
+    const mfmm_face *fr = mesh->face_records + corner / 3;
+    if ((fr->virt & 3) != corner % 3)
+        return -1;
+    int32_t j = mesh->virt_first[fr->virt >> 2];
+    while (mesh->virts[j].corner != corner)
+        j++;
+    return j;
+}
+
+/* A walk along a virtual edge's strip, rebuilding its steps as the build
+ * found them (bit for bit): mfmm_strip_begin, then mfmm_strip_next per step.
+ * The fields are the walk's. */
+typedef struct mfmm_vec2 {
+    double x, y;
+} mfmm_vec2;
+typedef struct mfmm_strip_walk {
+    const mfmm_mesh *m;
+    int32_t corner, a, b, n, i;
+    int32_t e1, e2, face, opposite, k1, k2;
+    mfmm_vec2 pa, pb, p1, p2, away, pv;
+} mfmm_strip_walk;
+
+/* Starts the walk of virtual edge j's strip (j: index in virts). */
+void mfmm_strip_begin(mfmm_strip_walk *w, const mfmm_mesh *mesh, int32_t j);
+
+/* The walk's next step into *step: 1, or 0 past the last (whose far is V). */
+int mfmm_strip_next(mfmm_strip_walk *w, mfmm_virt_step *step);
 
 /* For the march's virtual stencils under a cost (march.h): uniform[v] = the
  * cost every face around v has (per face), or that v and every neighbour

@@ -38,7 +38,7 @@ static double norm2(v2 a)
 
 void mfmm_source_locate(const mfmm_mesh *mesh, const mfmm_source *src, mfmm_source_loc *loc)
 {
-    const int32_t *fv = mesh->faces + 3 * (size_t)src->face;
+    const int32_t *fv = mesh->face_records[src->face].v;
     int n_zero = 0, zero = -1, top = 0;
     for (int k = 0; k < 3; k++) {
         if (src->bary[k] <= 0.0) {
@@ -141,9 +141,9 @@ static int in_cone(v2 d, v2 R, v2 L)
 static void enter(walk *w, int depth, int32_t g, int32_t ia, int32_t ib, v2 pa, v2 pb, v2 R, v2 L)
 {
     const mfmm_mesh *m = w->m;
-    if (w->stop || g < 0 || m->degenerate[g] || depth > MFMM_START_DEPTH)
+    if (w->stop || g < 0 || mfmm_mesh_degenerate(m, g) || depth > MFMM_START_DEPTH)
         return;
-    const int32_t *gv = m->faces + 3 * (size_t)g;
+    const int32_t *gv = m->face_records[g].v;
     int kq = -1;
     for (int k = 0; k < 3; k++)
         if (gv[k] != ia && gv[k] != ib)
@@ -203,7 +203,7 @@ static void enter(walk *w, int depth, int32_t g, int32_t ia, int32_t ib, v2 pa, 
 static void start_face(walk *w, int32_t f, const double *p)
 {
     const mfmm_mesh *m = w->m;
-    const int32_t *fv = m->faces + 3 * (size_t)f;
+    const int32_t *fv = m->face_records[f].v;
     const double *X[3];
     double r[3];
     int far = 0;
@@ -282,7 +282,7 @@ void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double
     w.radius = fmax(MFMM_START_RADIUS * mesh->info.mean_edge_length, mesh->info.max_edge_length);
     w.fn = fn;
     w.user = user;
-    const int32_t *fv = mesh->faces + 3 * (size_t)src->face;
+    const int32_t *fv = mesh->face_records[src->face].v;
     mfmm_source_loc at;
     mfmm_source_locate(mesh, src, &at);
     const double *p = at.p;
@@ -292,7 +292,7 @@ void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double
             w.fp = cost[v];
         for (int32_t i = mesh->vertex_face_offset[v]; i < mesh->vertex_face_offset[v + 1] && !w.stop; i++) {
             int32_t f = mesh->vertex_face_corner[i] / 3;
-            if (!mesh->degenerate[f])
+            if (!mfmm_mesh_degenerate(mesh, f))
                 start_face(&w, f, p);
         }
         return;
@@ -301,7 +301,7 @@ void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double
         for (int k = 0; k < 3; k++)
             w.fp += (src->bary[k] > 0.0 ? src->bary[k] : 0.0) * cost[fv[k]];
     int32_t g = at.across;
-    if (g >= 0 && mesh->degenerate[g])
+    if (g >= 0 && mfmm_mesh_degenerate(mesh, g))
         g = -1;
     /* on an edge: both faces, in the same order whichever names the point */
     int32_t first = g >= 0 && g < src->face ? g : src->face;

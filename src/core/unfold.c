@@ -7,9 +7,7 @@
 
 #include "mesh.h"
 
-typedef struct vec2 {
-    double x, y;
-} vec2;
+typedef mfmm_vec2 vec2;
 
 static double dot2(vec2 a, vec2 b)
 {
@@ -43,9 +41,85 @@ static vec2 unfold_point(vec2 p1, vec2 p2, double r1, double r2, vec2 away)
 static int local_index(const mfmm_mesh *m, int32_t g, int32_t v)
 {
     for (int k = 0; k < 3; k++)
-        if (m->faces[3 * (size_t)g + k] == v)
+        if (m->face_records[g].v[k] == v)
             return k;
     return -1;
+}
+
+/* One walk from an obtuse corner C across the edge AB opposite it, face by
+ * face (section 4.2), in C's plane: C at the origin, A on the x axis, B
+ * above it. The build walks until a vertex lands in the section; a re-walk
+ * (mfmm_strip_next) repeats the same steps with the same arithmetic. */
+static void walk_init(mfmm_strip_walk *w, const mfmm_mesh *m, int32_t corner, int32_t a,
+                      int32_t b, double len_a, double len_b, double cos_c)
+{
+    double sin_c = sqrt((1.0 - cos_c) * (1.0 + cos_c));
+    w->m = m;
+    w->corner = corner;
+    w->a = a;
+    w->b = b;
+    w->pa = (vec2){len_b, 0.0};
+    w->pb = (vec2){len_a * cos_c, len_a * sin_c};
+    w->p1 = w->pa;
+    w->p2 = w->pb;
+    w->away = (vec2){0.0, 0.0};
+    w->e1 = a;
+    w->e2 = b;
+    w->face = corner / 3;
+    w->opposite = corner % 3;
+}
+
+/* The face g beyond the edge (e1, e2) and its third vertex q, unfolded to
+ * *pq; 0 when the walk cannot go on (boundary, non-manifold edge, zero-area
+ * face, or back at C, A or B). */
+static int walk_cross(mfmm_strip_walk *w, int32_t *g_out, int32_t *q_out, vec2 *pq)
+{
+    const mfmm_mesh *m = w->m;
+    int32_t g = m->face_neighbor[3 * (size_t)w->face + w->opposite];
+    if (g < 0 || mfmm_mesh_degenerate(m, g))
+        return 0;
+    int k1 = local_index(m, g, w->e1), k2 = local_index(m, g, w->e2);
+    if (k1 < 0 || k2 < 0)
+        return 0;
+    int kq = 3 - k1 - k2;
+    int32_t q = m->face_records[g].v[kq];
+    if (q == mfmm_mesh_corner_vertex(m, w->corner) || q == w->a || q == w->b)
+        return 0;
+    const double *xq = m->xyz + 3 * (size_t)q;
+    *pq = unfold_point(w->p1, w->p2, dist3(m->xyz + 3 * (size_t)w->e1, xq),
+                       dist3(m->xyz + 3 * (size_t)w->e2, xq), w->away);
+    w->k1 = k1;
+    w->k2 = k2;
+    *g_out = g;
+    *q_out = q;
+    return 1;
+}
+
+/* Goes on into face g beyond its vertex q (at pq), which lies on A's side
+ * of the section (qb < 0: across (q, e2)) or on B's (across (e1, q)). */
+static void walk_advance(mfmm_strip_walk *w, int32_t g, int32_t q, vec2 pq, double qb)
+{
+    if (qb < 0.0) {
+        w->away = w->p1;
+        w->p1 = pq;
+        w->e1 = q;
+        w->opposite = w->k1;
+    } else {
+        w->away = w->p2;
+        w->p2 = pq;
+        w->e2 = q;
+        w->opposite = w->k2;
+    }
+    w->face = g;
+}
+
+/* Where C -> pv crosses the edge from u to v, as a fraction of it, in [0, 1]:
+ * every edge walked straddles the section, so CV crosses them all, in order. */
+static double crossing_t(vec2 pv, vec2 u, vec2 v)
+{
+    double den = pv.x * (v.y - u.y) - pv.y * (v.x - u.x);
+    double t = den != 0.0 ? -(pv.x * u.y - pv.y * u.x) / den : 0.5;
+    return t > 0.0 ? (t < 1.0 ? t : 1.0) : 0.0;
 }
 
 /* The strip of one walk: a step per face entered, and the unfolded ends of
@@ -87,66 +161,86 @@ static int unfold_corner(mfmm_mesh *m, int32_t corner, int32_t max_steps, strip_
 {
     int32_t first = sb->n;
     mfmm_corner_full *cr = m->full + corner;
-    /* C at the origin, A on the x axis, B above it */
-    double cos_c = cr->cos_c, sin_c = sqrt((1.0 - cos_c) * (1.0 + cos_c));
-    vec2 pa = {cr->len_b, 0.0}, pb = {cr->len_a * cos_c, cr->len_a * sin_c};
-    vec2 p1 = pa, p2 = pb, away = {0.0, 0.0};
-    int32_t e1 = cr->a, e2 = cr->b;
-    int32_t face = corner / 3, opposite = corner % 3;
+    mfmm_strip_walk w;
+    walk_init(&w, m, corner, cr->a, cr->b, cr->len_a, cr->len_b, cr->cos_c);
     for (int32_t step = 0; step < max_steps; step++) {
-        int32_t g = m->face_neighbor[3 * (size_t)face + opposite];
-        if (g < 0 || m->degenerate[g])
+        int32_t g, q;
+        vec2 pq;
+        if (!walk_cross(&w, &g, &q, &pq))
             break;
-        int k1 = local_index(m, g, e1), k2 = local_index(m, g, e2);
-        if (k1 < 0 || k2 < 0)
-            break;
-        int kq = 3 - k1 - k2;
-        int32_t q = m->faces[3 * (size_t)g + kq];
-        if (q == m->faces[corner] || q == cr->a || q == cr->b)
-            break;
-        const double *xq = m->xyz + 3 * (size_t)q;
-        vec2 pq = unfold_point(p1, p2, dist3(m->xyz + 3 * (size_t)e1, xq),
-                               dist3(m->xyz + 3 * (size_t)e2, xq), away);
-        mfmm_virt_step rec = {g, q, e1, e2, 0.0};
-        if (!strip_push(sb, rec, p1, p2))
+        mfmm_virt_step rec = {g, q, w.e1, w.e2, 0.0};
+        if (!strip_push(sb, rec, w.p1, w.p2))
             return -1;
-        double qa = dot2(pq, pa), qb = dot2(pq, pb);
+        double qa = dot2(pq, w.pa), qb = dot2(pq, w.pb);
         if (qa >= 0.0 && qb >= 0.0) {
             /* in the section: both virtual angles are acute */
             double l = sqrt(dot2(pq, pq));
             if (!(l > 0.0))
                 break;
-            /* where CV crosses each edge of the strip: every edge walked
-             * straddles the section, so CV crosses them all, in order */
-            for (int32_t i = first; i < sb->n; i++) {
-                vec2 u = sb->end[2 * i], w = sb->end[2 * i + 1];
-                double den = pq.x * (w.y - u.y) - pq.y * (w.x - u.x);
-                double t = den != 0.0 ? -(pq.x * u.y - pq.y * u.x) / den : 0.5;
-                sb->step[i].t = t > 0.0 ? (t < 1.0 ? t : 1.0) : 0.0;
-            }
+            for (int32_t i = first; i < sb->n; i++)
+                sb->step[i].t = crossing_t(pq, sb->end[2 * i], sb->end[2 * i + 1]);
             cr->virt = q;
             cr->virt_len = l;
             cr->virt_cos_a = fmin(1.0, qa / (l * cr->len_b));
             cr->virt_cos_b = fmin(1.0, qb / (l * cr->len_a));
+            cr->strip_at = first;
+            cr->strip_n = sb->n - first;
             return 1;
         }
         if (qa < 0.0 && qb < 0.0)
             break;
-        if (qb < 0.0) { /* on A's side of the section: go on across (q, e2) */
-            away = p1;
-            p1 = pq;
-            e1 = q;
-            opposite = k1;
-        } else { /* on B's side: go on across (e1, q) */
-            away = p2;
-            p2 = pq;
-            e2 = q;
-            opposite = k2;
-        }
-        face = g;
+        walk_advance(&w, g, q, pq, qb);
     }
     sb->n = first;
     return 0;
+}
+
+/* (A strip is re-walked from the face record, which holds the lengths and
+ * the cosine the build walked with.) */
+static void strip_init(mfmm_strip_walk *w)
+{
+    const mfmm_mesh *m = w->m;
+    int32_t corner = w->corner, k = corner % 3;
+    const mfmm_face *fr = m->face_records + corner / 3;
+    int ka = (k + 1) % 3, kb = (k + 2) % 3;
+    walk_init(w, m, corner, fr->v[ka], fr->v[kb], fr->len[ka], fr->len[kb], fr->cosv[k]);
+}
+
+void mfmm_strip_begin(mfmm_strip_walk *w, const mfmm_mesh *mesh, int32_t j)
+{
+    w->m = mesh;
+    w->corner = mesh->virts[j].corner;
+    w->n = mesh->virt_strip[j + 1] - mesh->virt_strip[j] + 1; /* (and V's step) */
+    /* once to V, for the crossings' t; then from the start again */
+    strip_init(w);
+    for (int32_t i = 0; i < w->n; i++) {
+        int32_t g = -1, q = -1;
+        vec2 pq = {0.0, 0.0};
+        walk_cross(w, &g, &q, &pq); /* (the build's walk went on here) */
+        if (i == w->n - 1)
+            w->pv = pq;
+        else
+            walk_advance(w, g, q, pq, dot2(pq, w->pb));
+    }
+    strip_init(w);
+    w->i = 0;
+}
+
+int mfmm_strip_next(mfmm_strip_walk *w, mfmm_virt_step *step)
+{
+    if (w->i >= w->n)
+        return 0;
+    int32_t g = -1, q = -1;
+    vec2 pq = {0.0, 0.0};
+    walk_cross(w, &g, &q, &pq);
+    step->face = g;
+    step->far = q;
+    step->e1 = w->e1;
+    step->e2 = w->e2;
+    step->t = crossing_t(w->pv, w->p1, w->p2);
+    if (++w->i < w->n)
+        walk_advance(w, g, q, pq, dot2(pq, w->pb));
+    return 1;
 }
 
 mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *m, int32_t max_steps)
@@ -154,11 +248,9 @@ mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *m, int32_t max_steps)
     int32_t made = 0, failed = 0;
     size_t nc = 3 * (size_t)m->nf;
     strip_buf sb = {NULL, NULL, 0, 0};
-    m->virt_offset = malloc((nc + 1) * sizeof *m->virt_offset);
-    if (!m->virt_offset)
-        return MFMM_ERR_OUT_OF_MEMORY;
     for (size_t c = 0; c < nc; c++) {
-        m->virt_offset[c] = sb.n;
+        m->full[c].strip_at = sb.n;
+        m->full[c].strip_n = 0;
         if (m->full[c].virt != MFMM_VIRT_FAILED)
             continue;
         int r = unfold_corner(m, (int32_t)c, max_steps, &sb);
@@ -172,20 +264,14 @@ mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *m, int32_t max_steps)
         else
             failed++;
     }
-    m->virt_offset[nc] = sb.n;
     free(sb.end);
     /* never a NULL array, so that readers need no special case */
-    if (sb.n == 0) {
-        free(sb.step);
+    if (!sb.step) {
         sb.step = malloc(sizeof *sb.step);
         if (!sb.step)
             return MFMM_ERR_OUT_OF_MEMORY;
-    } else {
-        mfmm_virt_step *fit = realloc(sb.step, (size_t)sb.n * sizeof *sb.step);
-        if (fit)
-            sb.step = fit;
     }
-    m->virt_steps = sb.step;
+    m->build_steps = sb.step;
     m->info.n_virtual_edges = made;
     m->info.n_unfold_failures = failed;
     return MFMM_OK;

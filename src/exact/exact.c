@@ -375,23 +375,23 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
     }
     t->bytes = mfmm_exact_tables_bytes(mesh);
     const double *X = mesh->xyz;
-    const int32_t *F = mesh->faces;
+    const mfmm_face *F = mesh->face_records;
     for (size_t f = 0; f < nf; f++) {
-        const int32_t *fv = F + 3 * f;
+        const int32_t *fv = F[f].v;
         int32_t lo = fv[0] < fv[1] ? fv[0] : fv[1];
         cnt[(lo < fv[2] ? lo : fv[2]) + 1]++;
     }
     for (size_t v = 0; v < nv; v++)
         cnt[v + 1] += cnt[v];
     for (size_t f = 0; f < nf; f++) {
-        const int32_t *fv = F + 3 * f;
+        const int32_t *fv = F[f].v;
         int32_t lo = fv[0] < fv[1] ? fv[0] : fv[1];
         t->face_in[f] = cnt[lo < fv[2] ? lo : fv[2]]++;
     }
     free(cnt);
     for (size_t f = 0; f < nf; f++) {
-        const int32_t *fv = F + 3 * f;
-        int bad = mesh->degenerate[f] != 0;
+        const int32_t *fv = F[f].v;
+        int bad = mfmm_mesh_degenerate(mesh, (int32_t)f);
         ex_face *r = t->fr + t->face_in[f];
         memset(r, 0, sizeof *r);
         for (int k = 0; k < 3; k++) {
@@ -421,7 +421,7 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
         r->skip = (uint8_t)bad;
     }
     for (size_t f = 0; f < nf; f++) {
-        const int32_t *fv = F + 3 * f;
+        const int32_t *fv = F[f].v;
         ex_face *r = t->fr + t->face_in[f];
         for (int k = 0; k < 3; k++) {
             int32_t g = mesh->face_neighbor[3 * f + k];
@@ -430,7 +430,7 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
             if (g < 0 || r->skip || t->fr[t->face_in[g]].skip)
                 continue;
             int32_t a = fv[(k + 1) % 3], b = fv[(k + 2) % 3];
-            const int32_t *gv = F + 3 * (size_t)g;
+            const int32_t *gv = F[g].v;
             for (int m = 0; m < 3; m++) {
                 if (gv[m] != a && gv[m] != b) {
                     r->across[k] = 3 * t->face_in[g] + m;
@@ -1122,7 +1122,7 @@ static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t
             ex_update(ws, s->vertex, s->value, 1);
             continue;
         }
-        const int32_t *fv = ws->mesh->faces + 3 * (size_t)s->face;
+        const int32_t *fv = ws->mesh->face_records[s->face].v;
         double w[3], sum = 0.0;
         for (int k = 0; k < 3; k++) {
             w[k] = s->bary[k] > 0.0 ? s->bary[k] : 0.0;

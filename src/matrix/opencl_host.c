@@ -883,7 +883,7 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         mem[MB_SOURCES] = api->clCreateBuffer(cl.context, ro, (size_t)job->n_sources * sizeof(int32_t),
                                          (void *)job->sources, &e);
     /* each slot's corner, virtual edges' strips (march.h) */
-    size_t nc = (size_t)mesh->nf * 3, n_strip = (size_t)mesh->virt_offset[nc];
+    size_t n_strip = (size_t)mesh->virt_strip[mesh->n_virts];
     if (e == CL_SUCCESS)
         mem[MB_STRIP] = api->clCreateBuffer(cl.context, ro, (n_strip ? n_strip : 1) * sizeof(int32_t),
                                             mesh->strip, &e);
@@ -896,8 +896,9 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         mem[MB_VFIRST] = api->clCreateBuffer(cl.context, ro, (nv + 1) * sizeof(int32_t),
                                              mesh->virt_first, &e);
     if (e == CL_SUCCESS)
-        mem[MB_STRIPOFF] = api->clCreateBuffer(cl.context, ro, (nc + 1) * sizeof(int32_t),
-                                           mesh->virt_offset, &e);
+        mem[MB_STRIPOFF] = api->clCreateBuffer(cl.context, ro,
+                                               ((size_t)mesh->n_virts + 1) * sizeof(int32_t),
+                                               mesh->virt_strip, &e);
     /* with a cost: the cost around each vertex, for the virtual stencils
      * (march.h), once for the job */
     if (e == CL_SUCCESS && job->cost && (job->opt->unfolding || exact)) {

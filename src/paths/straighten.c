@@ -58,7 +58,7 @@ static int sv2_eq(sv2 a, sv2 b)
 static int local_of(const mfmm_mesh *m, int32_t f, int32_t v)
 {
     for (int k = 0; k < 3; k++)
-        if (m->faces[3 * (size_t)f + k] == v)
+        if (m->face_records[f].v[k] == v)
             return k;
     return -1;
 }
@@ -71,7 +71,7 @@ static int rebary(const mfmm_mesh *m, int32_t g, const double b[3], int32_t f, d
     for (int k = 0; k < 3; k++) {
         if (b[k] <= ON_EDGE)
             continue;
-        int l = local_of(m, f, m->faces[3 * (size_t)g + k]);
+        int l = local_of(m, f, m->face_records[g].v[k]);
         if (l < 0)
             return 0;
         out[l] += b[k];
@@ -89,7 +89,7 @@ static int32_t point_vertex(const mfmm_mesh *m, const mfmm_surface_point *p)
 {
     for (int k = 0; k < 3; k++)
         if (p->bary[k] == 1.0)
-            return m->faces[3 * (size_t)p->face + k];
+            return m->face_records[p->face].v[k];
     return -1;
 }
 
@@ -98,8 +98,8 @@ static int unfold_strip(const mfmm_mesh *m, const int32_t *faces, int32_t nf, do
 {
     for (int32_t j = 0; j < nf; j++) {
         int32_t f = faces[j];
-        const int32_t *v = m->faces + 3 * (size_t)f;
-        if (m->degenerate[f])
+        const int32_t *v = m->face_records[f].v;
+        if (mfmm_mesh_degenerate(m, f))
             return 0;
         int ka, kb, kc;
         double A[2], B[2], away[2];
@@ -114,7 +114,7 @@ static int unfold_strip(const mfmm_mesh *m, const int32_t *faces, int32_t nf, do
             int lg[2], n = 0, og = -1;
             ka = kb = kc = -1;
             for (int k = 0; k < 3; k++) {
-                int l = local_of(m, f, m->faces[3 * (size_t)g + k]);
+                int l = local_of(m, f, m->face_records[g].v[k]);
                 if (l < 0)
                     og = k;
                 else if (n < 2) {
@@ -183,7 +183,7 @@ static int32_t fan_walk(const mfmm_mesh *m, int32_t a, int32_t v, int32_t w, int
     for (int step = 0; step < 64; step++) {
         int o = -1;
         for (int k = 0; k < 3; k++) {
-            int32_t x = m->faces[3 * (size_t)f + k];
+            int32_t x = m->face_records[f].v[k];
             if (x != v && x != w)
                 o = k;
         }
@@ -197,7 +197,7 @@ static int32_t fan_walk(const mfmm_mesh *m, int32_t a, int32_t v, int32_t w, int
         out[n++] = g;
         int32_t z = -1;
         for (int k = 0; k < 3; k++) {
-            int32_t x = m->faces[3 * (size_t)g + k];
+            int32_t x = m->face_records[g].v[k];
             if (x != v && x != w)
                 z = x;
         }
@@ -244,7 +244,7 @@ static double funnel(const mfmm_mesh *m, const mfmm_surface_point *ra,
         int32_t g = faces[j - 1];
         int ku = -1, kw = -1, ko = -1;
         for (int k = 0; k < 3; k++) {
-            if (local_of(m, faces[j], m->faces[3 * (size_t)g + k]) < 0)
+            if (local_of(m, faces[j], m->face_records[g].v[k]) < 0)
                 ko = k;
             else if (ku < 0)
                 ku = k;
@@ -256,7 +256,7 @@ static double funnel(const mfmm_mesh *m, const mfmm_surface_point *ra,
         sv2 U = {s->P[j - 1][ku][0], s->P[j - 1][ku][1]},
             W = {s->P[j - 1][kw][0], s->P[j - 1][kw][1]},
             O = {s->P[j - 1][ko][0], s->P[j - 1][ko][1]};
-        int32_t vu = m->faces[3 * (size_t)g + ku], vw = m->faces[3 * (size_t)g + kw];
+        int32_t vu = m->face_records[g].v[ku], vw = m->face_records[g].v[kw];
         /* walking away from O, the left end is W when O is left of U -> W */
         int w_left = cross2(U, W, O) > 0.0;
         s->por[j][0] = w_left ? W : U;
@@ -336,7 +336,7 @@ static int straighten_piece(const strip_ctx *t, const mfmm_surface_point *raw, i
                 q++;
             int32_t w = -1, fp = s->fa[p];
             for (int j = 0; j < 3; j++) {
-                int32_t x = m->faces[3 * (size_t)fp + j];
+                int32_t x = m->face_records[fp].v[j];
                 if (x != v && local_of(m, s->fa[p + 1], x) < 0)
                     w = x;
             }
@@ -450,7 +450,7 @@ static int straighten(const strip_ctx *t, const mfmm_surface_point *raw, int32_t
                 /* passed a vertex: join the faces by the shorter fan around it */
                 int32_t v = point_vertex(m, &raw[i - 1]), best = -1;
                 for (int side = 0; side < 2 && v >= 0 && local_of(m, g, v) >= 0; side++) {
-                    int32_t w = m->faces[3 * (size_t)g + (local_of(m, g, v) + 1 + side) % 3];
+                    int32_t w = m->face_records[g].v[(local_of(m, g, v) + 1 + side) % 3];
                     int32_t room = s->cap - nf - 1 - (best >= 0 ? best : 0);
                     int32_t *dst = s->fa + nf + (best >= 0 ? best : 0);
                     int32_t r = fan_walk(m, g, v, w, f, dst, room);

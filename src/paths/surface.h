@@ -17,7 +17,7 @@ static inline void mfmm_bary_to_xyz(const mfmm_mesh *m, int32_t f, const double 
     for (int i = 0; i < 3; i++)
         x[i] = 0.0;
     for (int k = 0; k < 3; k++) {
-        const double *X = m->xyz + 3 * (size_t)m->faces[3 * f + k];
+        const double *X = m->xyz + 3 * (size_t)m->face_records[f].v[k];
         for (int i = 0; i < 3; i++)
             x[i] += b[k] * X[i];
     }

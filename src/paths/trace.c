@@ -105,7 +105,7 @@ static int cost_at(tracer *t, int32_t f, const double b[3], double *out)
     double s = 0.0;
     for (int k = 0; k < 3; k++) {
         double c;
-        if (!read_cost(t, t->m->faces[3 * f + k], &c))
+        if (!read_cost(t, t->m->face_records[f].v[k], &c))
             return 0;
         s += b[k] * c;
     }
@@ -185,7 +185,7 @@ static int frame_build(tracer *t, int32_t f, frame *fr)
     memset(fr, 0, sizeof *fr);
     fr->f = f;
     for (int k = 0; k < 3; k++) {
-        fr->v[k] = m->faces[3 * f + k];
+        fr->v[k] = m->face_records[f].v[k];
         if (!read_T(t, fr->v[k], &fr->T[k]))
             return 0;
     }
@@ -200,7 +200,7 @@ static int frame_build(tracer *t, int32_t f, frame *fr)
     fr->max_edge = fmax(L, fmax(sqrt(mfmm_dot3(w, w)), mfmm_dist3(B, C)));
     double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
     double n2 = sqrt(mfmm_dot3(n, n));
-    if (m->degenerate[f] || !(L > 0.0) || !(n2 > 1e-14 * fr->max_edge * fr->max_edge)) {
+    if (mfmm_mesh_degenerate(m, f) || !(L > 0.0) || !(n2 > 1e-14 * fr->max_edge * fr->max_edge)) {
         fr->degenerate = 1;
         return 1;
     }
@@ -236,11 +236,11 @@ static int frame_build(tracer *t, int32_t f, frame *fr)
     double Fmin = fr->F, Fmax = fr->F;
     for (int k = 0; k < 3; k++) {
         int32_t g = m->face_neighbor[3 * f + k];
-        if (g < 0 || m->degenerate[g])
+        if (g < 0 || mfmm_mesh_degenerate(m, g))
             return 1; /* boundary or degenerate neighbour: linear */
         int32_t a1 = fr->v[(k + 1) % 3], a2 = fr->v[(k + 2) % 3], far = -1;
         for (int j = 0; j < 3; j++) {
-            int32_t x = m->faces[3 * g + j];
+            int32_t x = m->face_records[g].v[j];
             if (x != a1 && x != a2)
                 far = x;
         }
@@ -433,12 +433,12 @@ static int32_t face_source(tracer *t, const frame *fr, const double b[3], double
 static void edge_bary(const mfmm_mesh *m, int32_t f, int32_t u, int32_t w, double s, double b[3])
 {
     for (int k = 0; k < 3; k++) {
-        int32_t x = m->faces[3 * (size_t)f + k];
+        int32_t x = m->face_records[f].v[k];
         b[k] = x == u ? 1.0 - s : x == w ? s : 0.0;
     }
 }
 
-/* Where corner c's virtual edge crosses the edge of its strip's step k. */
+/* Where a virtual edge crosses the edge of its strip's step st. */
 static void virt_crossing(const mfmm_mesh *m, const mfmm_virt_step *st, double x[3])
 {
     const double *x1 = m->xyz + 3 * (size_t)st->e1, *x2 = m->xyz + 3 * (size_t)st->e2;
@@ -446,18 +446,22 @@ static void virt_crossing(const mfmm_mesh *m, const mfmm_virt_step *st, double x
         x[d] = (1.0 - st->t) * x1[d] + st->t * x2[d];
 }
 
-/* Length on the surface of corner c's virtual edge C -> V (section 4.2): its
- * pieces between the edges it crosses, each inside one face of the strip. */
-static double virt_length(const mfmm_mesh *m, int32_t c)
+/* Length on the surface of virtual edge j, C -> V (section 4.2): its pieces
+ * between the edges it crosses, each inside one face of the strip. */
+static double virt_length(const mfmm_mesh *m, int32_t j)
 {
     double prev[3], x[3], len = 0.0;
-    memcpy(prev, m->xyz + 3 * (size_t)m->faces[c], sizeof prev);
-    for (int32_t k = m->virt_offset[c]; k < m->virt_offset[c + 1]; k++) {
-        virt_crossing(m, m->virt_steps + k, x);
+    memcpy(prev, m->xyz + 3 * (size_t)m->virts[j].c, sizeof prev);
+    mfmm_strip_walk w;
+    mfmm_virt_step st;
+    int32_t V = -1;
+    mfmm_strip_begin(&w, m, j);
+    while (mfmm_strip_next(&w, &st)) {
+        virt_crossing(m, &st, x);
         len += mfmm_dist3(prev, x);
         memcpy(prev, x, sizeof x);
+        V = st.far;
     }
-    int32_t V = m->virt_steps[m->virt_offset[c + 1] - 1].far;
     return len + mfmm_dist3(prev, m->xyz + 3 * (size_t)V);
 }
 
@@ -471,12 +475,13 @@ static int32_t virt_descent(const tracer *t, int32_t v)
     int32_t bc = -1;
     for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
         int32_t c = m->vertex_face_corner[i];
-        if (m->virt_offset[c] == m->virt_offset[c + 1])
+        const mfmm_face *fr = m->face_records + c / 3;
+        if ((fr->virt & 3) != c % 3)
             continue;
-        double TV = t->T[m->virt_steps[m->virt_offset[c + 1] - 1].far];
+        double TV = t->T[fr->virt >> 2];
         if (!(TV < Tv))
             continue;
-        double L = virt_length(m, c), slope = L > 0.0 ? (Tv - TV) / L : INFINITY;
+        double L = virt_length(m, mfmm_mesh_virt_index(m, c)), slope = L > 0.0 ? (Tv - TV) / L : INFINITY;
         if (bc < 0 || slope > best) {
             best = slope;
             bc = c;
@@ -492,7 +497,7 @@ static int local_min(const tracer *t, int32_t v)
     double Tv = t->T[v];
     for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
         int32_t c = m->vertex_face_corner[i], f = c / 3, k = c % 3;
-        if (t->T[m->faces[3 * f + (k + 1) % 3]] < Tv || t->T[m->faces[3 * f + (k + 2) % 3]] < Tv)
+        if (t->T[m->face_records[f].v[(k + 1) % 3]] < Tv || t->T[m->face_records[f].v[(k + 2) % 3]] < Tv)
             return 0;
     }
     return virt_descent(t, v) < 0;
@@ -571,7 +576,7 @@ static void map_bary(const mfmm_mesh *m, const frame *fr, const double b[3], int
 {
     for (int j = 0; j < 3; j++) {
         bg[j] = 0.0;
-        int32_t x = m->faces[3 * g + j];
+        int32_t x = m->face_records[g].v[j];
         for (int k = 0; k < 3; k++)
             if (fr->v[k] == x)
                 bg[j] = b[k];
@@ -591,7 +596,7 @@ static void set_vertex(pos *p, const mfmm_mesh *m, int32_t f, int32_t v)
     p->vertex = v;
     p->from = -1;
     for (int k = 0; k < 3; k++)
-        p->b[k] = m->faces[3 * f + k] == v ? 1.0 : 0.0;
+        p->b[k] = m->face_records[f].v[k] == v ? 1.0 : 0.0;
 }
 
 /* At vertex v: steepest descent among the incident faces (a face whose
@@ -700,16 +705,19 @@ static int slide(tracer *t, pos *p, const frame *fr, int k, const double d[2], d
 static int follow_virt(tracer *t, pos *p, int32_t c)
 {
     const mfmm_mesh *m = t->m;
-    int32_t f = c / 3;
-    for (int32_t k = m->virt_offset[c]; k < m->virt_offset[c + 1]; k++) {
-        const mfmm_virt_step *st = m->virt_steps + k;
+    int32_t f = c / 3, V = -1;
+    mfmm_strip_walk w;
+    mfmm_virt_step st;
+    mfmm_strip_begin(&w, m, mfmm_mesh_virt_index(m, c));
+    while (mfmm_strip_next(&w, &st)) {
         double b[3];
-        edge_bary(m, f, st->e1, st->e2, st->t, b);
+        edge_bary(m, f, st.e1, st.e2, st.t, b);
         if (!emit(t, f, b)) /* the piece to it ran through f */
             return -1;
-        f = st->face;
+        f = st.face;
+        V = st.far;
     }
-    set_vertex(p, m, f, m->virt_steps[m->virt_offset[c + 1] - 1].far);
+    set_vertex(p, m, f, V);
     return emit(t, f, p->b) ? 1 : -1;
 }
 
@@ -774,10 +782,10 @@ static int finish_straight(tracer *t, int32_t v)
     int32_t f0 = best.face[0];
     double b[3];
     for (int k = 0; k < 3; k++) {
-        int32_t x = m->faces[3 * (size_t)f0 + k];
+        int32_t x = m->face_records[f0].v[k];
         b[k] = 0.0;
         for (int j = 0; j < 3; j++)
-            if (m->faces[3 * (size_t)s->face + j] == x)
+            if (m->face_records[s->face].v[j] == x)
                 b[k] = s->bary[j] > 0.0 ? s->bary[j] : 0.0;
     }
     double sum = b[0] + b[1] + b[2];

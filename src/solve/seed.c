@@ -33,7 +33,7 @@ static double reach_around(const mfmm_mesh *m, int32_t v, const double *p)
 {
     double r = 0.0;
     for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
-        const int32_t *f = m->faces + 3 * (size_t)(m->vertex_face_corner[i] / 3);
+        const int32_t *f = m->face_records[m->vertex_face_corner[i] / 3].v;
         for (int k = 0; k < 3; k++)
             r = fmax(r, mfmm_dist3(p, m->xyz + 3 * (size_t)f[k]));
     }
@@ -61,16 +61,16 @@ static mfmm_status exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const 
     if (s.face >= 0) {
         mfmm_source_loc at;
         mfmm_source_locate(mesh, &s, &at);
-        const int32_t *fv = mesh->faces + 3 * (size_t)s.face;
+        const int32_t *fv = mesh->face_records[s.face].v;
         int32_t g = at.across;
         center = at.vertex;
         if (at.kind == MFMM_AT_VERTEX) {
             s.face = -1;
             s.vertex = center;
-        } else if (g >= 0 && g < s.face && !mesh->degenerate[g]) {
+        } else if (g >= 0 && g < s.face && !mfmm_mesh_degenerate(mesh, g)) {
             /* on an edge: named by the lower of its two faces, so that the
              * patch does not depend on which face names the point */
-            const int32_t *gv = mesh->faces + 3 * (size_t)g;
+            const int32_t *gv = mesh->face_records[g].v;
             double b[3] = {0.0, 0.0, 0.0};
             for (int k = 0; k < 3; k++)
                 for (int j = 0; j < 3; j++)
@@ -86,7 +86,7 @@ static mfmm_status exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const 
             /* its own faces' corners (both faces of an edge it lies on) */
             for (int k = 0; k < 3; k++)
                 reach = fmax(reach, mfmm_dist3(at.p, mesh->xyz + 3 * (size_t)fv[k]));
-            const int32_t *gv = g >= 0 ? mesh->faces + 3 * (size_t)g : NULL;
+            const int32_t *gv = g >= 0 ? mesh->face_records[g].v : NULL;
             for (int k = 0; gv && k < 3; k++)
                 reach = fmax(reach, mfmm_dist3(at.p, mesh->xyz + 3 * (size_t)gv[k]));
         }

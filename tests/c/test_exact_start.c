@@ -297,8 +297,12 @@ static void test_saddle_corner_continuous(void **state)
     double *d0 = malloc((size_t)nv * sizeof *d0), *d1 = malloc((size_t)nv * sizeof *d1);
     assert_true(angle && d0 && d1);
     /* geometry from the mesh's own arrays (internal vertex ids) */
-    const int32_t *IF = mesh->faces;
+    int32_t *IF = malloc(3 * (size_t)nf * sizeof *IF);
+    assert_non_null(IF);
+    for (int32_t f = 0; f < nf; f++)
+        memcpy(IF + 3 * (size_t)f, mesh->face_records[f].v, 3 * sizeof *IF);
     tm_angle_sums(mesh->xyz, IF, nv, nf, angle);
+    free(IF);
     int n_saddles = 0, n_approaches = 0, n_jumps = 0;
     double worst = 0.0;
     for (int32_t v = 0; v < nv && n_saddles < 40; v++) {
@@ -321,7 +325,7 @@ static void test_saddle_corner_continuous(void **state)
             for (int j = 0; j < 3; j++) {
                 double x = 0.0;
                 for (int q = 0; q < 3; q++)
-                    x += p.bary[q] * mesh->xyz[3 * (size_t)IF[3 * (size_t)(c / 3) + q] + j];
+                    x += p.bary[q] * mesh->xyz[3 * (size_t)mesh->face_records[c / 3].v[q] + j];
                 move += (x - mesh->xyz[3 * (size_t)v + j]) * (x - mesh->xyz[3 * (size_t)v + j]);
             }
             move = sqrt(move);

@@ -344,7 +344,8 @@ static void test_deterministic(void **state)
     mfmm_gen_mesh g = mfmm_gen_lattice(10, 3.0);
     mfmm_mesh *a = tm_make(&g), *b = tm_make(&g);
     assert_memory_equal(a->to_internal, b->to_internal, (size_t)g.nv * sizeof(int32_t));
-    assert_memory_equal(a->faces, b->faces, 3 * (size_t)g.nf * sizeof(int32_t));
+    for (int32_t i = 0; i < g.nf; i++)
+        assert_memory_equal(a->face_records[i].v, b->face_records[i].v, sizeof a->face_records[i].v);
     assert_memory_equal(a->xyz, b->xyz, 3 * (size_t)g.nv * sizeof(double));
     for (int32_t v = 0; v < g.nv; v++) {
         assert_int_equal(a->to_external[a->to_internal[v]], v);
@@ -355,12 +356,12 @@ static void test_deterministic(void **state)
         int32_t i = a->face_to_internal[f];
         assert_int_equal(a->face_to_external[i], f);
         for (int k = 0; k < 3; k++)
-            assert_int_equal(a->faces[3 * i + k], a->to_internal[g.F[3 * f + k]]);
+            assert_int_equal(a->face_records[i].v[k], a->to_internal[g.F[3 * f + k]]);
         if (i > 0) {
-            int32_t lo = a->faces[3 * i], lo_prev = a->faces[3 * (i - 1)];
+            int32_t lo = a->face_records[i].v[0], lo_prev = a->face_records[i - 1].v[0];
             for (int k = 1; k < 3; k++) {
-                lo = a->faces[3 * i + k] < lo ? a->faces[3 * i + k] : lo;
-                lo_prev = a->faces[3 * (i - 1) + k] < lo_prev ? a->faces[3 * (i - 1) + k] : lo_prev;
+                lo = a->face_records[i].v[k] < lo ? a->face_records[i].v[k] : lo;
+                lo_prev = a->face_records[i - 1].v[k] < lo_prev ? a->face_records[i - 1].v[k] : lo_prev;
             }
             assert_true(lo_prev <= lo);
         }
