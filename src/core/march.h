@@ -252,7 +252,7 @@ MFMM_COLD void mfmm_march_corner(mfmm_march_state *s, const mfmm_march_mesh *m,
                                    MFMM_GLOBAL const mfmm_face *fr, mfmm_i32 f_id, mfmm_i32 jc,
                                    mfmm_i32 c, mfmm_u8 lc, mfmm_i32 x, double tx, int alive_y)
 {
-    mfmm_i32 ja = jc == 2 ? 0 : jc + 1, jb = ja == 2 ? 0 : ja + 1;
+    mfmm_i32 ja = (0x09 >> (2 * jc)) & 3, jb = (0x12 >> (2 * jc)) & 3; /* jc + 1, jc + 2 mod 3 */
     mfmm_i32 ia = fr->v[ja], ib = fr->v[jb];
     int x_is_a = ia == x;
     double f_a = 1.0, f_b = 1.0, f_t = 1.0, f = 1.0;
