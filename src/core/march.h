@@ -60,7 +60,10 @@ typedef struct mfmm_march_state {
  * one cache line of keys, and the tree is a third as deep as a binary one ---- */
 
 #ifndef MFMM_HEAP_ARITY
-#define MFMM_HEAP_ARITY 8 /* measured: 2, 4, 8, 16 -> 8 fastest (bench_solve) */
+/* measured: 2, 4, 8, 16 -> 8 fastest (bench_solve); 4 later 1-3 % faster on
+ * small meshes, but it settles equal keys in another order (icosphere rows
+ * change), so rows would not stay bit-identical */
+#define MFMM_HEAP_ARITY 8
 #endif
 
 MFMM_INLINE void mfmm_heap_place(mfmm_march_state *s, mfmm_i32 i, double key, mfmm_i32 v)
@@ -106,6 +109,8 @@ MFMM_INLINE mfmm_i32 mfmm_heap_pop(mfmm_march_state *s)
                 break;
             mfmm_i32 child = first;
             double ck = s->heap_key[first];
+            /* (a loop with a branch: unrolled, or without branches (cmov,
+             * a tournament), it ran fewer instructions but 4-18 % slower) */
             mfmm_i32 last = first + MFMM_HEAP_ARITY < n ? first + MFMM_HEAP_ARITY : n;
             for (mfmm_i32 c = first + 1; c < last; c++)
                 if (s->heap_key[c] < ck) {
