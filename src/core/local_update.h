@@ -18,6 +18,7 @@
 #define MFMM_COLD MFMM_INLINE
 #define MFMM_INF ((double)INFINITY)
 typedef int mfmm_i32;
+typedef uint mfmm_u32;
 typedef uchar mfmm_u8;
 #else
 #include <math.h>
@@ -36,6 +37,7 @@ typedef uchar mfmm_u8;
 #endif
 #define MFMM_INF ((double)INFINITY)
 typedef int32_t mfmm_i32;
+typedef uint32_t mfmm_u32;
 typedef uint8_t mfmm_u8;
 #endif
 

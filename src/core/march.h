@@ -60,7 +60,10 @@ typedef struct mfmm_march_state {
  * one cache line of keys, and the tree is a third as deep as a binary one ---- */
 
 #ifndef MFMM_HEAP_ARITY
-#define MFMM_HEAP_ARITY 8 /* measured: 2, 4, 8, 16 -> 8 fastest (bench_solve) */
+/* measured: 2, 4, 8, 16 -> 8 fastest (bench_solve); 4 later 1-3 % faster on
+ * small meshes, but it settles equal keys in another order (icosphere rows
+ * change), so rows would not stay bit-identical */
+#define MFMM_HEAP_ARITY 8
 #endif
 
 MFMM_INLINE void mfmm_heap_place(mfmm_march_state *s, mfmm_i32 i, double key, mfmm_i32 v)
@@ -106,6 +109,8 @@ MFMM_INLINE mfmm_i32 mfmm_heap_pop(mfmm_march_state *s)
                 break;
             mfmm_i32 child = first;
             double ck = s->heap_key[first];
+            /* (a loop with a branch: unrolled, or without branches (cmov,
+             * a tournament), it ran fewer instructions but 4-18 % slower) */
             mfmm_i32 last = first + MFMM_HEAP_ARITY < n ? first + MFMM_HEAP_ARITY : n;
             for (mfmm_i32 c = first + 1; c < last; c++)
                 if (s->heap_key[c] < ck) {
@@ -255,7 +260,7 @@ MFMM_COLD void mfmm_march_corner(mfmm_march_state *s, const mfmm_march_mesh *m,
                                    MFMM_GLOBAL const mfmm_face *fr, mfmm_i32 f_id, mfmm_i32 jc,
                                    mfmm_i32 c, mfmm_u8 lc, mfmm_i32 x, double tx, int alive_y)
 {
-    mfmm_i32 ja = jc == 2 ? 0 : jc + 1, jb = ja == 2 ? 0 : ja + 1;
+    mfmm_i32 ja = (0x09 >> (2 * jc)) & 3, jb = (0x12 >> (2 * jc)) & 3; /* jc + 1, jc + 2 mod 3 */
     mfmm_i32 ia = fr->v[ja], ib = fr->v[jb];
     int x_is_a = ia == x;
     double f_a = 1.0, f_b = 1.0, f_t = 1.0, f = 1.0;
@@ -330,83 +335,94 @@ MFMM_INLINE void mfmm_march_seed_fixed(mfmm_march_state *s, mfmm_i32 v, double v
         s->label[v] = (mfmm_u8)(s->label[v] | MFMM_FIXED);
 }
 
-/* Section 2's loop: settle the Close vertex of least T, recompute its
- * neighbours from settled values, until the heap is empty, T passes
- * max_distance, or every target is settled. Vertices not settled are set
- * to +inf and target flags cleared (with a touched list: only at the
- * touched vertices; labels stay Close/Alive there for the caller to reset).
- * Returns the number of vertices settled. */
-MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *m)
+/* Section 2's loop, until the heap is empty, T passes max_distance or every
+ * target is settled (mfmm_march_run). general: a cost (the updates of
+ * mfmm_march_corner); 0: F = 1, inline. A constant where it is called, so
+ * that each case compiles to a loop of its own. The workspace and the mesh
+ * are read through local copies (w, mm): a label store is a byte store,
+ * which may alias anything, and would make the compiler reload every field
+ * of s and m after it; s and m themselves are only passed (synced) to the
+ * out-of-line steps. */
+MFMM_INLINE mfmm_i32 mfmm_march_loop(mfmm_march_state *s, const mfmm_march_mesh *m,
+                                     const int general)
 {
+    mfmm_march_state w = *s;
+    mfmm_march_mesh mm = *m;
     mfmm_i32 settled = 0;
-    int stop_at_targets = s->targets_left > 0;
-    while (s->heap_size > 0) {
-        mfmm_i32 x = s->heap_vertex[0];
-        if (s->T[x] > s->max_distance)
+    int stop_at_targets = w.targets_left > 0;
+    mfmm_i32 no_virt = w.unfolding ? 0 : 3;
+    while (w.heap_size > 0) {
+        mfmm_i32 x = w.heap_vertex[0];
+        if (w.T[x] > w.max_distance)
             break;
-        mfmm_heap_pop(s);
-        mfmm_u8 lx = s->label[x];
-        s->label[x] = (mfmm_u8)((lx & MFMM_TARGET) | MFMM_ALIVE);
+        mfmm_heap_pop(&w);
+        mfmm_u8 lx = w.label[x];
+        w.label[x] = (mfmm_u8)((lx & MFMM_TARGET) | MFMM_ALIVE);
         settled++;
-        if (stop_at_targets && (lx & MFMM_TARGET) && --s->targets_left == 0)
+        if (stop_at_targets && (lx & MFMM_TARGET) && --w.targets_left == 0)
             break;
-        mfmm_i32 end = m->wedge_offset[x + 1];
+        mfmm_i32 end = mm.wedge_offset[x + 1];
         /* The march waits on face records (cache misses). The next vertex
          * to settle is almost always the new heap top: ask for its faces
          * one iteration ahead (this vertex's were asked for last iteration). */
-        if (s->heap_size > 0) {
-            mfmm_i32 y = s->heap_vertex[0];
-            for (mfmm_i32 j = m->wedge_offset[y]; j < m->wedge_offset[y + 1]; j++)
-                MFMM_PREFETCH(m->faces + m->wedge[j] / 3);
+        if (w.heap_size > 0) {
+            mfmm_i32 y = w.heap_vertex[0];
+            for (mfmm_i32 j = mm.wedge_offset[y]; j < mm.wedge_offset[y + 1]; j++)
+                MFMM_PREFETCH(mm.faces + (mfmm_u32)mm.wedge[j] / 3u);
             /* and the first virtual edge ending at y (its list is short) */
-            if (s->unfolding)
-                MFMM_PREFETCH(m->virts + m->virt_first[y]);
+            if (w.unfolding)
+                MFMM_PREFETCH(mm.virts + mm.virt_first[y]);
         }
-        double tx = s->T[x];
-        int general = s->cost_location != 0;
-        mfmm_i32 no_virt = s->unfolding ? 0 : 3;
+        double tx = w.T[x];
         /* the virtual edges that end at x (section 4.2), before x's faces:
          * their records and C's face are loads of their own, which then
          * overlap with the face walk instead of waiting after it (measured:
          * nefertiti unfolding 1 7.48 -> 7.14 ms; after the walk, behind a
          * flag in x's faces, they cost 2.5x main's virtual entries) */
-        if (s->unfolding)
-            for (mfmm_i32 j = m->virt_first[x]; j < m->virt_first[x + 1]; j++) {
-                MFMM_GLOBAL const mfmm_virt *vr = m->virts + j;
+        if (w.unfolding)
+            for (mfmm_i32 j = mm.virt_first[x]; j < mm.virt_first[x + 1]; j++) {
+                MFMM_GLOBAL const mfmm_virt *vr = mm.virts + j;
                 if (general) {
+                    s->heap_size = w.heap_size;
+                    s->n_touched = w.n_touched;
                     mfmm_march_virtual(s, m, vr, tx);
+                    w.heap_size = s->heap_size;
+                    w.n_touched = s->n_touched;
                     continue;
                 }
                 /* F = 1 (as mfmm_march_virtual): the virtual edge, and the
                  * virtual triangles with A and B that have settled */
                 mfmm_i32 c = vr->c;
-                mfmm_u8 lc = s->label[c];
+                mfmm_u8 lc = w.label[c];
                 if ((lc & MFMM_STATE_MASK) == MFMM_ALIVE || (lc & MFMM_FIXED))
                     continue;
-                mfmm_i32 kc = vr->corner, fc = kc / 3, jc = kc - 3 * fc;
-                MFMM_GLOBAL const mfmm_face *fr = m->faces + fc;
+                mfmm_i32 kc = vr->corner, fc = (mfmm_i32)((mfmm_u32)kc / 3u), jc = kc - 3 * fc;
+                MFMM_GLOBAL const mfmm_face *fr = mm.faces + fc;
                 mfmm_i32 ja = jc == 2 ? 0 : jc + 1, jb = ja == 2 ? 0 : ja + 1;
                 mfmm_i32 ia = fr->v[ja], ib = fr->v[jb];
                 double vlen = vr->len, t = tx + vlen;
-                if ((s->label[ia] & MFMM_STATE_MASK) == MFMM_ALIVE) {
-                    double ta = s->T[ia];
+                if ((w.label[ia] & MFMM_STATE_MASK) == MFMM_ALIVE) {
+                    double ta = w.T[ia];
                     t = mfmm_min(t, ta + fr->len[jb]);
                     t = mfmm_min(t, mfmm_triangle_interior(ta, tx, vlen, fr->len[jb], vr->cos_a, 1.0));
                 }
-                if ((s->label[ib] & MFMM_STATE_MASK) == MFMM_ALIVE) {
-                    double tb = s->T[ib];
+                if ((w.label[ib] & MFMM_STATE_MASK) == MFMM_ALIVE) {
+                    double tb = w.T[ib];
                     t = mfmm_min(t, tb + fr->len[ja]);
                     t = mfmm_min(t, mfmm_triangle_interior(tx, tb, fr->len[ja], vlen, vr->cos_b, 1.0));
                 }
-                mfmm_march_offer(s, m, c, lc, t);
+                mfmm_march_offer(&w, &mm, c, lc, t);
             }
         /* section 2's update of x's neighbours, face by face */
-        for (mfmm_i32 j = m->wedge_offset[x]; j < end; j++) {
-            mfmm_i32 w = m->wedge[j], f_id = w / 3, k = w - 3 * f_id;
-            MFMM_GLOBAL const mfmm_face *fr = m->faces + f_id;
-            mfmm_i32 jp = k == 2 ? 0 : k + 1, jq = jp == 2 ? 0 : jp + 1;
+        for (mfmm_i32 j = mm.wedge_offset[x]; j < end; j++) {
+            mfmm_i32 wc = mm.wedge[j], f_id = (mfmm_i32)((mfmm_u32)wc / 3u), k = wc - 3 * f_id;
+            MFMM_GLOBAL const mfmm_face *fr = mm.faces + f_id;
+            /* the next corners, k + 1 and k + 2 mod 3, from 2-bit tables
+             * (k is as good as random: a ?: compiled to a branch
+             * mispredicted 2.4 times per settled vertex, cachegrind) */
+            mfmm_i32 jp = (0x09 >> (2 * k)) & 3, jq = (0x12 >> (2 * k)) & 3;
             mfmm_i32 p = fr->v[jp], q = fr->v[jq];
-            mfmm_u8 lp = s->label[p], lq = s->label[q];
+            mfmm_u8 lp = w.label[p], lq = w.label[q];
             int alive_p = (lp & MFMM_STATE_MASK) == MFMM_ALIVE;
             int alive_q = (lq & MFMM_STATE_MASK) == MFMM_ALIVE;
             /* a cost: the general update. Else F = 1, inline: the edge from
@@ -419,57 +435,81 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
             mfmm_i32 jv = (fr->virt | no_virt) & 3; /* 3: none */
             if (!alive_p && !(lp & MFMM_FIXED)) {
                 if (general) {
+                    s->heap_size = w.heap_size;
+                    s->n_touched = w.n_touched;
                     mfmm_march_corner(s, m, fr, f_id, jp, p, lp, x, tx, alive_q);
+                    w.heap_size = s->heap_size;
+                    w.n_touched = s->n_touched;
                 } else {
                     /* p = C, q = A, x = B */
                     double t = tx + fr->len[jq], ta = 0.0, b = fr->len[k], cs = fr->cosv[jp];
                     int go = alive_q;
                     if (jv == jp) {
                         mfmm_i32 iv = fr->virt >> 2;
-                        go = (s->label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE;
+                        go = (w.label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE;
                         if (go) {
-                            MFMM_GLOBAL const mfmm_virt *vr = mfmm_march_virt_of(m, iv, w - k + jp);
-                            ta = s->T[iv];
+                            MFMM_GLOBAL const mfmm_virt *vr = mfmm_march_virt_of(&mm, iv, wc - k + jp);
+                            ta = w.T[iv];
                             b = vr->len;
                             cs = vr->cos_b;
                             t = mfmm_min(t, ta + b);
                         }
                     } else if (go) {
-                        ta = s->T[q];
+                        ta = w.T[q];
                     }
                     if (go)
                         t = mfmm_min(t, mfmm_triangle_interior(ta, tx, fr->len[jq], b, cs, 1.0));
-                    mfmm_march_offer(s, m, p, lp, t);
+                    mfmm_march_offer(&w, &mm, p, lp, t);
                 }
             }
             /* (p's update may have changed q's label only if p == q: never) */
             if (!alive_q && !(lq & MFMM_FIXED)) {
                 if (general) {
+                    s->heap_size = w.heap_size;
+                    s->n_touched = w.n_touched;
                     mfmm_march_corner(s, m, fr, f_id, jq, q, lq, x, tx, alive_p);
+                    w.heap_size = s->heap_size;
+                    w.n_touched = s->n_touched;
                 } else {
                     /* q = C, x = A, p = B */
                     double t = tx + fr->len[jp], tb = 0.0, a = fr->len[k], cs = fr->cosv[jq];
                     int go = alive_p;
                     if (jv == jq) {
                         mfmm_i32 iv = fr->virt >> 2;
-                        go = (s->label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE;
+                        go = (w.label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE;
                         if (go) {
-                            MFMM_GLOBAL const mfmm_virt *vr = mfmm_march_virt_of(m, iv, w - k + jq);
-                            tb = s->T[iv];
+                            MFMM_GLOBAL const mfmm_virt *vr = mfmm_march_virt_of(&mm, iv, wc - k + jq);
+                            tb = w.T[iv];
                             a = vr->len;
                             cs = vr->cos_a;
                             t = mfmm_min(t, tb + a);
                         }
                     } else if (go) {
-                        tb = s->T[p];
+                        tb = w.T[p];
                     }
                     if (go)
                         t = mfmm_min(t, mfmm_triangle_interior(tx, tb, a, fr->len[jp], cs, 1.0));
-                    mfmm_march_offer(s, m, q, lq, t);
+                    mfmm_march_offer(&w, &mm, q, lq, t);
                 }
             }
         }
     }
+    s->heap_size = w.heap_size;
+    s->n_touched = w.n_touched;
+    s->targets_left = w.targets_left;
+    return settled;
+}
+
+/* Section 2's loop: settle the Close vertex of least T, recompute its
+ * neighbours from settled values, until the heap is empty, T passes
+ * max_distance, or every target is settled. Vertices not settled are set
+ * to +inf and target flags cleared (with a touched list: only at the
+ * touched vertices; labels stay Close/Alive there for the caller to reset).
+ * Returns the number of vertices settled. */
+MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *m)
+{
+    mfmm_i32 settled = s->cost_location != 0 ? mfmm_march_loop(s, m, 1)
+                                             : mfmm_march_loop(s, m, 0);
     /* a list is worth it for a local march; past nv/8 touched vertices a
      * sequential pass is cheaper than scattered ones (measured, bench_scale) */
     if (s->touched && s->n_touched < m->nv / 8) {
