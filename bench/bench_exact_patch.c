@@ -2,7 +2,8 @@
  * many vertex sources with a radius of a few edges, against one full
  * mfmm_solve_exact. Usage:
  *   bench_exact_patch [--edges K] [--sources S] MESH...
- * radius = K mean edge lengths (default 6); S sources spread over the mesh
+ * radius = K mean edge lengths (default MFMM_EXACT_START_RADIUS, the library's
+ * base radius); S sources spread over the mesh
  * (default 200). Prints per mesh: mean patch size, mean time per patch, the
  * full solve's time, and the workspace's peak bytes. */
 #include <math.h>
@@ -81,7 +82,7 @@ static int bench(const char *path, double edges, int n_sources)
 
 int main(int argc, char **argv)
 {
-    double edges = 6.0;
+    double edges = MFMM_EXACT_START_RADIUS;
     int n_sources = 200, rc = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--edges") && i + 1 < argc)
