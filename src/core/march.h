@@ -57,12 +57,25 @@ typedef struct mfmm_march_state {
 } mfmm_march_state;
 
 /* ---- indexed d-ary min-heap with decrease-key: a node's 8 children are
- * one cache line of keys, and the tree is a third as deep as a binary one ---- */
+ * 8 keys in a row, and the tree is a third as deep as a binary one. Equal
+ * keys settle in the order the heap's steps leave them (the sift-down takes
+ * the first least child, the sift-up stops below an equal parent): set by
+ * the sequence of pushes, which every backend runs alike. ---- */
 
 #ifndef MFMM_HEAP_ARITY
 /* measured: 2, 4, 8, 16 -> 8 fastest (bench_solve); 4 later 1-3 % faster on
  * small meshes, but it settles equal keys in another order (icosphere rows
- * change), so rows would not stay bit-identical */
+ * change), so rows would not stay bit-identical.
+ * Session 7 (bench_solve, 10 alternating rounds, camelhead, bunny, nefertiti,
+ * igea, plain and exact start; median march time against this heap): arity
+ * 4 -2 to +2 % (igea slower); ties by (key, vertex id) +2 to +10 % (a tie
+ * flag in the child scan, or an SSE2 min tree); a radix heap on T's bits
+ * (bucket lists linked through the vertices) +14 to +24 %; a window of
+ * buckets of T +16 to +36 % (camelhead); a lazy heap without decrease-key
+ * +25 to +69 %; a bottom-up pop, 64-byte aligned children: +-1 %. The
+ * bucket window ran 24 % fewer instructions (the radix heap 5 % more), but
+ * both mispredict their list walks (camelhead 11.4 -> 14-15 per settled
+ * vertex) and wait on the links. */
 #define MFMM_HEAP_ARITY 8
 #endif
 
