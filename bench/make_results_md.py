@@ -753,11 +753,11 @@ def main():
         nef = [r for r in allp["results"] if r.get("radius_frac_diag") is None]
         # nefertiti (35k), where the heat peers come closest; else the largest mesh
         names = {r["mesh"] for r in nef}
-        big = ("nefertiti-lowres.obj" if "nefertiti-lowres.obj" in names else
+        shown = ("nefertiti-lowres.obj" if "nefertiti-lowres.obj" in names else
                max(names, key=lambda m: max(r["n_vertices"] for r in nef if r["mesh"] == m)))
-        block += [f"All pairs on {big} (rows spread over the mesh, time to the full matrix "
+        block += [f"All pairs on {shown} (rows spread over the mesh, time to the full matrix "
                   "extrapolated):", "",
-                  allpairs_table({"results": [r for r in nef if r["mesh"] == big]}), ""]
+                  allpairs_table({"results": [r for r in nef if r["mesh"] == shown]}), ""]
         block += heat_batched_ratios(allp) + [""]
     block += ["![convergence](docs/images/convergence.png)",
               "![scaling](docs/images/scaling.png)", "",
