@@ -73,7 +73,12 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_interna
                 ext = fmax(ext, xyz[3 * (size_t)v + k] - lo[k]);
         /* one cube (not a box per axis), so the curve keeps the shape's
          * proportions; 21 bits per axis */
+        /* a subnormal extent makes 2097151 / ext infinite, and 0 * inf NaN
+         * (the mesh is refused later for its tiny diagonal; the order must
+         * not fault before that) */
         double scale = ext > 0.0 ? 2097151.0 / ext : 0.0;
+        if (!isfinite(scale))
+            scale = 0.0;
         /* cells of ~64 vertices (a surface has about nv / 4^L cells at
          * level L) along the curve; inside a cell, rows by position (rows
          * beat the curve's own order at that scale: 125k sine 22.8 vs 23.8
@@ -86,7 +91,7 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_interna
             uint32_t u[3];
             for (int k = 0; k < 3; k++) {
                 double q = (xyz[3 * (size_t)v + k] - lo[k]) * scale;
-                u[k] = q > 2097151.0 ? 2097151u : (uint32_t)q;
+                u[k] = !(q > 0.0) ? 0u : q > 2097151.0 ? 2097151u : (uint32_t)q;
             }
             keys[v].fine = (uint64_t)u[1] << 42 | (uint64_t)u[0] << 21 | u[2];
             for (int k = 0; k < 3; k++)
