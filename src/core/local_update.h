@@ -96,45 +96,49 @@ MFMM_INLINE double mfmm_min(double x, double y)
 /* T(C) through the inside of triangle ABC, with T(A) = ta, T(B) = tb both
  * known; a = |BC|, b = |AC|, cos_c = cos theta at C; f = cost F. +inf when
  * the update does not come from within the triangle.
- * Eq. 4 gives t = T(C) - T(A) with u = T(B) - T(A) >= 0 (A the smaller); it is
- * accepted when u < t and the update comes from within the triangle, Eq. 5:
- * a cos theta < b(t-u)/t < a / cos theta. That test is used multiplied through
- * by cos theta (a cos theta < x and x cos theta < a, x = b(t-u)/t), which is
- * Eq. 5 for acute theta and stays meaningful for obtuse theta (where the
- * literal form rejects everything). */
+ * Eq. 4 gives t = T(C) - T(A) with u = T(B) - T(A) >= 0 (A the smaller); its
+ * larger root, with c^2 = a^2 + b^2 - 2ab cos theta (= |AB|^2), is
+ *   t = [b u (b - a cos theta) + a b sin theta sqrt(F^2 c^2 - u^2)] / c^2
+ * (the discriminant of Eq. 4 is 4 a^2 b^2 sin^2 theta (F^2 c^2 - u^2)). Only
+ * u, one sqrt and a multiply-add wait on T: the rest is the triangle's, and
+ * no power of a length above 2 appears, so nothing overflows or underflows
+ * for lengths within 1e-100..1e100. It is accepted when u < t and the update
+ * comes from within the triangle, Eq. 5: a cos theta < b(t-u)/t <
+ * a / cos theta. That test is used multiplied through by cos theta (a cos
+ * theta < x and x cos theta < a, x = b(t-u)/t), which is Eq. 5 for acute
+ * theta and stays meaningful for obtuse theta (where the literal form
+ * rejects everything). */
 MFMM_INLINE double mfmm_triangle_interior(double ta, double tb, double a, double b,
                                           double cos_c, double f)
 {
-    if (ta > tb) { /* let A be the vertex reached first */
-        double s = ta; ta = tb; tb = s;
-        s = a; a = b; b = s;
-    }
-    if (!(b > 0.0))
+    /* the triangle's part first, for either order of A and B: it does not
+     * wait on T */
+    double c2 = a * a + b * b - 2.0 * a * b * cos_c;
+    if (!(c2 > 0.0)) /* also a zero-area face's NaN cosine */
         return MFMM_INF;
-    /* Eq. 4 is homogeneous of degree 4 in lengths: solve it in units of b,
-     * so that no power of a length overflows or underflows at any scale */
-    double scale = b, inv = 1.0 / b;
-    a *= inv;
-    double u = (tb - ta) * inv;
-    b = 1.0;
-    double sin2 = (1.0 - cos_c) * (1.0 + cos_c);
-    /* Eq. 4: q2 t^2 + q1 t + q0 = 0, q2 = c^2 = a^2 + b^2 - 2ab cos theta */
-    double q2 = a * a + b * b - 2.0 * a * b * cos_c;
-    double q1 = 2.0 * b * u * (a * cos_c - b);
-    double q0 = b * b * (u * u - f * f * a * a * sin2);
-    if (!(q2 > 0.0))
-        return MFMM_INF;
-    double disc = q1 * q1 - 4.0 * q2 * q0;
-    disc = disc > 0.0 ? disc : 0.0; /* clamp: never the root of a negative */
-    double s = sqrt(disc);
-    /* the larger root, without cancellation */
-    double t = q1 <= 0.0 ? (s - q1) / (2.0 * q2) : (2.0 * q0) / (-q1 - s);
+    double inv = 1.0 / c2;
+    double beta = a * b * sqrt((1.0 - cos_c) * (1.0 + cos_c)) * inv;
+    double alpha_a = b * (b - a * cos_c) * inv, alpha_b = a * (a - b * cos_c) * inv;
+    double fc2 = f * f * c2;
+    /* let A be the vertex reached first: selects, not a branch (which of
+     * the two is first is as good as random) */
+    int swap = ta > tb;
+    double t0 = swap ? tb : ta, u = swap ? ta - tb : tb - ta;
+    double alpha = swap ? alpha_b : alpha_a;
+    double la = swap ? b : a, lb = swap ? a : b;
+    a = la;
+    b = lb;
+    /* (b = 0 makes alpha = beta = 0, so t = 0 <= u: rejected below) */
+    double d = fc2 - u * u;
+    d = d > 0.0 ? d : 0.0; /* u > F c: no root; the clamp's t fails a test below */
+    double t = alpha * u + beta * sqrt(d);
     if (!(t > u)) /* also rejects NaN */
         return MFMM_INF;
-    /* the test with x = CD = b (t - u) / t of section 4.1, multiplied by t > 0 */
+    /* the test with x = CD = b (t - u) / t of section 4.1, multiplied by t > 0
+     * (measured: these as one select instead of two branches, no faster) */
     double xt = b * (t - u);
     if (a * cos_c * t < xt && xt * cos_c < a * t)
-        return ta + t * scale;
+        return t0 + t;
     return MFMM_INF;
 }
 

@@ -1156,19 +1156,23 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
 }
 
 /* ---- the self-test of a program before it goes to or comes from the cache ----
- * All rows of a small mesh with obtuse corners (a sheared 5 x 4 grid), in
- * float64 and float32, against mfmm_solve, bit for bit. A cached binary that
- * fails to make a kernel, to run or to give exactly these rows is not used. */
+ * All rows of a small mesh with obtuse corners (a sheared 7 x 6 grid, its
+ * vertices jittered so that no two triangles are alike), in float64 and
+ * float32, against mfmm_solve, bit for bit. A cached binary that fails to
+ * make a kernel, to run or to give exactly these rows is not used. (A 5 x 4
+ * grid without jitter let a binary built with -cl-fast-relaxed-math
+ * -cl-mad-enable pass once the update was written in closed form: its rows
+ * happened to round alike there.) */
 static mfmm_status self_test(ocl *cl, mfmm_error *err)
 {
-    enum { NX = 5, NY = 4, NV = NX * NY, NF = 2 * (NX - 1) * (NY - 1) };
+    enum { NX = 7, NY = 6, NV = NX * NY, NF = 2 * (NX - 1) * (NY - 1) };
     double xyz[NV * 3];
     int32_t faces[NF * 3];
     for (int j = 0; j < NY; j++)
         for (int i = 0; i < NX; i++) {
             double *p = xyz + 3 * (j * NX + i);
-            p[0] = i + 0.7 * j;
-            p[1] = 0.4 * j;
+            p[0] = i + 0.7 * j + 0.031 * ((i * 5 + j * 11) % 7);
+            p[1] = 0.4 * j + 0.017 * ((i * 3 + j * 7) % 5);
             p[2] = 0.1 * ((i * 7 + j * 3) % 5);
         }
     int32_t *f = faces;
