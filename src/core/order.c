@@ -73,10 +73,10 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_interna
                 ext = fmax(ext, xyz[3 * (size_t)v + k] - lo[k]);
         /* one cube (not a box per axis), so the curve keeps the shape's
          * proportions; 21 bits per axis */
-        /* a subnormal extent makes 2097151 / ext infinite, and 0 * inf NaN
-         * (the mesh is refused later for its tiny diagonal; the order must
-         * not fault before that) */
         double scale = ext > 0.0 ? 2097151.0 / ext : 0.0;
+        /* a subnormal extent makes the scale infinite, and 0 * inf NaN (the
+         * mesh is refused later for its tiny diagonal; the order must not
+         * fault before that) */
         if (!isfinite(scale))
             scale = 0.0;
         /* cells of ~64 vertices (a surface has about nv / 4^L cells at
