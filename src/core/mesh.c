@@ -116,6 +116,74 @@ static mfmm_status build_edges(mfmm_mesh *m)
     return MFMM_OK;
 }
 
+/* The corner of face f in x's corner list list[0..n) (sorted by face, as
+ * build_vertex_faces makes it), or -1. */
+static int32_t find_corner(const int32_t *list, int32_t n, int32_t f)
+{
+    int32_t lo = 0, hi = n;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (list[mid] / 3 < f)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < n && list[lo] / 3 == f ? lo : -1;
+}
+
+/* Puts each vertex's corners in fan order: face (x, p, q) is followed by
+ * the face across edge xq when that face has x, q in the same orientation
+ * (its vertex after x is q), so that consecutive faces share a neighbour
+ * of x and the march offers it once for both (march.h). Fans start at a
+ * face with no predecessor (a boundary, non-manifold or flipped edge);
+ * closed fans follow. Any order is correct: this one saves work. */
+static mfmm_status fan_order(mfmm_mesh *m)
+{
+    int32_t dmax = 0;
+    for (int32_t v = 0; v < m->nv; v++) {
+        int32_t d = m->vertex_face_offset[v + 1] - m->vertex_face_offset[v];
+        dmax = d > dmax ? d : dmax;
+    }
+    int32_t *next = malloc(((size_t)dmax + 1) * 3 * sizeof *next);
+    if (!next)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    int32_t *has_prev = next + dmax + 1, *out = has_prev + dmax + 1;
+    for (int32_t v = 0; v < m->nv; v++) {
+        int32_t *list = m->vertex_face_corner + m->vertex_face_offset[v];
+        int32_t n = m->vertex_face_offset[v + 1] - m->vertex_face_offset[v];
+        for (int32_t i = 0; i < n; i++)
+            has_prev[i] = 0;
+        for (int32_t i = 0; i < n; i++) {
+            int32_t c = list[i], f = c / 3, k = c % 3;
+            int32_t kp = k == 2 ? 0 : k + 1, kq = kp == 2 ? 0 : kp + 1;
+            int32_t q = m->face_records[f].v[kq];
+            int32_t g = m->face_neighbor[3 * f + kp]; /* across edge x q */
+            int32_t j = g >= 0 ? find_corner(list, n, g) : -1;
+            next[i] = -1;
+            if (j >= 0 && j != i && !has_prev[j]) {
+                int32_t kg = list[j] % 3;
+                if (m->face_records[g].v[kg == 2 ? 0 : kg + 1] == q) {
+                    next[i] = j;
+                    has_prev[j] = 1;
+                }
+            }
+        }
+        int32_t n_out = 0;
+        for (int pass = 0; pass < 2; pass++)
+            for (int32_t i = 0; i < n; i++) {
+                if (has_prev[i] == 2 || (pass == 0 && has_prev[i]))
+                    continue;
+                for (int32_t j = i; j >= 0 && has_prev[j] != 2; j = next[j]) {
+                    out[n_out++] = list[j];
+                    has_prev[j] = 2;
+                }
+            }
+        memcpy(list, out, (size_t)n * sizeof *list);
+    }
+    free(next);
+    return MFMM_OK;
+}
+
 /* Vertex -> corner CSR. */
 static mfmm_status build_vertex_faces(mfmm_mesh *m)
 {
@@ -140,7 +208,7 @@ static mfmm_status build_vertex_faces(mfmm_mesh *m)
     off[0] = 0;
     m->vertex_face_offset = off;
     m->vertex_face_corner = list;
-    return MFMM_OK;
+    return fan_order(m);
 }
 
 static int32_t uf_find(int32_t *parent, int32_t x)

@@ -44,7 +44,8 @@ struct mfmm_mesh {
     double *xyz;               /* (nv, 3) */
     int32_t *face_neighbor;    /* (nf, 3): face across the edge opposite corner k,
                                   -1 at a boundary or non-manifold edge */
-    int32_t *vertex_face_offset; /* (nv+1,) CSR: corners (3f+k) at each vertex */
+    int32_t *vertex_face_offset; /* (nv+1,) CSR: corners (3f+k) at each vertex,
+                                    in fan order (mesh.c fan_order) */
     int32_t *vertex_face_corner;
     mfmm_corner_full *full;    /* (3 nf,) while building only, then NULL */
     mfmm_face *face_records;   /* (nf,) for the march (local_update.h), 64-byte aligned;
