@@ -371,6 +371,67 @@ static void test_deterministic(void **state)
     mfmm_gen_free(&g);
 }
 
+/* Each vertex's corner list in fan order (mesh.c, for the march): the list
+ * holds exactly the vertex's corners, and face (x, p, q) is followed by a
+ * face (x, q, r) except where a fan ends: never on a closed, consistently
+ * oriented surface (and the last face closes the cycle), never on an open
+ * one (each boundary vertex's fan starts at the boundary), once at a vertex
+ * shared by two fans. */
+static int32_t fan_breaks(const mfmm_mesh *m, int32_t v, int closed)
+{
+    int32_t lo = m->vertex_face_offset[v], hi = m->vertex_face_offset[v + 1], breaks = 0;
+    int32_t first_p = -1, q_prev = -1;
+    for (int32_t i = lo; i < hi; i++) {
+        int32_t c = m->vertex_face_corner[i], f = c / 3, k = c % 3;
+        const int32_t *fv = m->face_records[f].v;
+        assert_int_equal(fv[k], v);
+        for (int32_t j = lo; j < i; j++)
+            assert_int_not_equal(m->vertex_face_corner[j], c);
+        int32_t p = fv[(k + 1) % 3], q = fv[(k + 2) % 3];
+        if (i == lo)
+            first_p = p;
+        else if (p != q_prev)
+            breaks++;
+        q_prev = q;
+    }
+    if (closed && hi > lo)
+        assert_int_equal(q_prev, first_p);
+    return breaks;
+}
+
+static void check_fans(mfmm_gen_mesh g, int closed)
+{
+    mfmm_mesh *m = tm_make(&g);
+    int32_t corners = 0;
+    for (int32_t v = 0; v < m->nv; v++) {
+        assert_int_equal(fan_breaks(m, v, closed), 0);
+        corners += m->vertex_face_offset[v + 1] - m->vertex_face_offset[v];
+    }
+    assert_int_equal(corners, 3 * m->nf);
+    mfmm_mesh_destroy(m);
+    mfmm_gen_free(&g);
+}
+
+static void test_fan_order(void **state)
+{
+    (void)state;
+    check_fans(mfmm_gen_icosphere(2), 1);
+    check_fans(mfmm_gen_torus(12, 8, 1.0, 0.3), 1);
+    check_fans(mfmm_gen_sine(9), 0);
+    check_fans(mfmm_gen_lattice(6, 3.0), 0);
+    /* two fans at vertex 0 (a bowtie): one break there */
+    double V[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, -1, 0, 0, 0, -1, 0, 2, 2, 0};
+    int32_t F[] = {0, 1, 2, 0, 3, 4, 1, 5, 2};
+    mfmm_mesh *m = NULL;
+    mfmm_error err;
+    assert_int_equal(mfmm_mesh_create(V, 6, F, 3, NULL, &m, &err), MFMM_OK);
+    int32_t total = 0;
+    for (int32_t v = 0; v < m->nv; v++)
+        total += fan_breaks(m, v, 0);
+    assert_int_equal(total, 1);
+    mfmm_mesh_destroy(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -378,6 +439,7 @@ int main(void)
         cmocka_unit_test(test_shuffled_sine),
         cmocka_unit_test(test_shuffled_sparse),
         cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_fan_order),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
