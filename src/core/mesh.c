@@ -134,7 +134,8 @@ static int32_t find_corner(const int32_t *list, int32_t n, int32_t f)
 /* Puts each vertex's corners in fan order: face (x, p, q) is followed by
  * the face across edge xq when that face has x, q in the same orientation
  * (its vertex after x is q), so that consecutive faces share a neighbour
- * of x and the march offers it once for both (march.h). Fans start at a
+ * of x: the march (march.h) then meets x's settled neighbours in runs, which
+ * its branches predict, and offers a shared neighbour once. Fans start at a
  * face with no predecessor (a boundary, non-manifold or flipped edge);
  * closed fans follow. Any order is correct: this one saves work. */
 static mfmm_status fan_order(mfmm_mesh *m)
