@@ -56,8 +56,8 @@ static int graph_build(const mfmm_mesh *m, graph *g)
         for (int32_t j = 0; j < 2 * nw + m->virt_first[x + 1] - m->virt_first[x]; j++) {
             int32_t c, dup = 0;
             if (j < 2 * nw) {
-                int32_t w = m->vertex_face_corner[m->vertex_face_offset[x] + j / 2];
-                c = m->face_records[w / 3].v[(w % 3 + 1 + j % 2) % 3];
+                int32_t w = m->vertex_wedge[m->vertex_face_offset[x] + j / 2];
+                c = m->face_records[MFMM_WEDGE_FACE(w)].v[j % 2 ? MFMM_WEDGE_PREV(w) : MFMM_WEDGE_NEXT(w)];
             } else {
                 c = m->virts[m->virt_first[x] + j - 2 * nw].c;
             }

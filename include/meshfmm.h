@@ -118,7 +118,8 @@ MFMM_API void mfmm_mesh_options_init(mfmm_mesh_options *options);
  *   faces:    (nf, 3) int32, row-major, 0-based; copied.
  *   options:  NULL for defaults.
  *   out:      receives the mesh; NULL on failure.
- * Refused: nv < 1, nf < 1, NaN/inf coordinates (MFMM_ERR_NONFINITE_VERTEX),
+ * Refused: nv outside 1 .. 715827882, nf outside 1 .. 134217727
+ * (MFMM_ERR_BAD_COUNT), NaN/inf coordinates (MFMM_ERR_NONFINITE_VERTEX),
  * coordinates beyond +-1e100 or a bounding box whose diagonal is below 1e-100
  * (MFMM_ERR_BAD_ARGUMENT: rescale), indices out of
  * range, a face that repeats a vertex. Results do not depend on the mesh's

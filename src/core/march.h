@@ -14,7 +14,7 @@
 /* The arrays of a mesh that a march reads. */
 typedef struct mfmm_march_mesh {
     mfmm_i32 nv;
-    /* x's faces: corners 3 f + k (x = face f's vertex k) at
+    /* x's faces (x = face f's vertex k), as MFMM_WEDGE(f, k), at
      * wedge[wedge_offset[x]] .. wedge[wedge_offset[x + 1] - 1] */
     MFMM_GLOBAL const mfmm_i32 *wedge_offset;
     MFMM_GLOBAL const mfmm_i32 *wedge;
@@ -382,7 +382,7 @@ MFMM_INLINE mfmm_i32 mfmm_march_loop(mfmm_march_state *s, const mfmm_march_mesh 
         if (w.heap_size > 0) {
             mfmm_i32 y = w.heap_vertex[0];
             for (mfmm_i32 j = mm.wedge_offset[y]; j < mm.wedge_offset[y + 1]; j++)
-                MFMM_PREFETCH(mm.faces + (mfmm_u32)mm.wedge[j] / 3u);
+                MFMM_PREFETCH(mm.faces + MFMM_WEDGE_FACE(mm.wedge[j]));
             /* and the first virtual edge ending at y (its list is short) */
             if (w.unfolding)
                 MFMM_PREFETCH(mm.virts + mm.virt_first[y]);
@@ -438,12 +438,12 @@ MFMM_INLINE mfmm_i32 mfmm_march_loop(mfmm_march_state *s, const mfmm_march_mesh 
         mfmm_i32 pend = -1;
         double pend_t = 0.0;
         for (mfmm_i32 j = mm.wedge_offset[x]; j < end; j++) {
-            mfmm_i32 wc = mm.wedge[j], f_id = (mfmm_i32)((mfmm_u32)wc / 3u), k = wc - 3 * f_id;
+            mfmm_i32 wc = mm.wedge[j], f_id = MFMM_WEDGE_FACE(wc);
             MFMM_GLOBAL const mfmm_face *fr = mm.faces + f_id;
-            /* the next corners, k + 1 and k + 2 mod 3, from 2-bit tables
-             * (k is as good as random: a ?: compiled to a branch
+            /* the next corners, k + 1 and k + 2 mod 3, as the entry holds
+             * them (k is as good as random: a ?: compiled to a branch
              * mispredicted 2.4 times per settled vertex, cachegrind) */
-            mfmm_i32 jp = (0x09 >> (2 * k)) & 3, jq = (0x12 >> (2 * k)) & 3;
+            mfmm_i32 jp = MFMM_WEDGE_NEXT(wc), jq = MFMM_WEDGE_PREV(wc), k = 3 - jp - jq;
             mfmm_i32 p = fr->v[jp], q = fr->v[jq];
             mfmm_u8 lp = w.label[p], lq = w.label[q];
             int alive_p = (lp & MFMM_STATE_MASK) == MFMM_ALIVE;
@@ -469,7 +469,7 @@ MFMM_INLINE mfmm_i32 mfmm_march_loop(mfmm_march_state *s, const mfmm_march_mesh 
                         mfmm_i32 iv = fr->virt >> 2;
                         go = (w.label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE;
                         if (go) {
-                            MFMM_GLOBAL const mfmm_virt *vr = mfmm_march_virt_of(&mm, iv, wc - k + jp);
+                            MFMM_GLOBAL const mfmm_virt *vr = mfmm_march_virt_of(&mm, iv, 3 * f_id + jp);
                             ta = w.T[iv];
                             b = vr->len;
                             cs = vr->cos_b;
@@ -501,7 +501,7 @@ MFMM_INLINE mfmm_i32 mfmm_march_loop(mfmm_march_state *s, const mfmm_march_mesh 
                         mfmm_i32 iv = fr->virt >> 2;
                         go = (w.label[iv] & MFMM_STATE_MASK) == MFMM_ALIVE;
                         if (go) {
-                            MFMM_GLOBAL const mfmm_virt *vr = mfmm_march_virt_of(&mm, iv, wc - k + jq);
+                            MFMM_GLOBAL const mfmm_virt *vr = mfmm_march_virt_of(&mm, iv, 3 * f_id + jq);
                             tb = w.T[iv];
                             a = vr->len;
                             cs = vr->cos_a;

@@ -34,7 +34,7 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh->xyz);
     free(mesh->face_neighbor);
     free(mesh->vertex_face_offset);
-    free(mesh->vertex_face_corner);
+    free(mesh->vertex_wedge);
     free(mesh->full);
     free(mesh->face_block);
     free(mesh->virts);
@@ -150,7 +150,7 @@ static mfmm_status fan_order(mfmm_mesh *m)
         return MFMM_ERR_OUT_OF_MEMORY;
     int32_t *has_prev = next + dmax + 1, *out = has_prev + dmax + 1;
     for (int32_t v = 0; v < m->nv; v++) {
-        int32_t *list = m->vertex_face_corner + m->vertex_face_offset[v];
+        int32_t *list = m->vertex_wedge + m->vertex_face_offset[v];
         int32_t n = m->vertex_face_offset[v + 1] - m->vertex_face_offset[v];
         for (int32_t i = 0; i < n; i++)
             has_prev[i] = 0;
@@ -208,8 +208,13 @@ static mfmm_status build_vertex_faces(mfmm_mesh *m)
         off[v] = off[v - 1];
     off[0] = 0;
     m->vertex_face_offset = off;
-    m->vertex_face_corner = list;
-    return fan_order(m);
+    m->vertex_wedge = list;
+    mfmm_status st = fan_order(m);
+    if (st != MFMM_OK)
+        return st;
+    for (size_t i = 0; i < nc; i++)
+        list[i] = MFMM_WEDGE(list[i] / 3, list[i] % 3);
+    return MFMM_OK;
 }
 
 static int32_t uf_find(int32_t *parent, int32_t x)
@@ -453,10 +458,11 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
     if (!vertices || !faces)
         return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "%s is NULL",
                          !vertices ? "vertices" : "faces");
-    if (nv < 1 || nf < 1 || nf > INT32_MAX / 3 || nv > INT32_MAX / 3)
+    if (nv < 1 || nf < 1 || nf > MFMM_MAX_FACES || nv > INT32_MAX / 3)
         return mfmm_fail(err, MFMM_ERR_BAD_COUNT, -1,
-                         "a mesh needs 1 to %d vertices and faces (got %ld vertices, %ld faces)",
-                         INT32_MAX / 3, (long)nv, (long)nf);
+                         "a mesh needs 1 to %d vertices and 1 to %d faces (got %ld vertices, "
+                         "%ld faces)",
+                         INT32_MAX / 3, MFMM_MAX_FACES, (long)nv, (long)nf);
     mfmm_mesh_options opt;
     mfmm_mesh_options_init(&opt);
     if (options) {

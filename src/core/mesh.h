@@ -44,9 +44,10 @@ struct mfmm_mesh {
     double *xyz;               /* (nv, 3) */
     int32_t *face_neighbor;    /* (nf, 3): face across the edge opposite corner k,
                                   -1 at a boundary or non-manifold edge */
-    int32_t *vertex_face_offset; /* (nv+1,) CSR: corners (3f+k) at each vertex,
-                                    in fan order (mesh.c fan_order) */
-    int32_t *vertex_face_corner;
+    int32_t *vertex_face_offset; /* (nv+1,) CSR: each vertex's faces, as
+                                    MFMM_WEDGE(f, k) (local_update.h), in fan
+                                    order (mesh.c fan_order) */
+    int32_t *vertex_wedge;
     mfmm_corner_full *full;    /* (3 nf,) while building only, then NULL */
     mfmm_face *face_records;   /* (nf,) for the march (local_update.h), 64-byte aligned;
                                   face f's vertices: face_records[f].v (the
@@ -81,7 +82,7 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
     mfmm_march_mesh m;
     m.nv = mesh->nv;
     m.wedge_offset = mesh->vertex_face_offset;
-    m.wedge = mesh->vertex_face_corner;
+    m.wedge = mesh->vertex_wedge;
     m.faces = mesh->face_records;
     m.virts = mesh->virts;
     m.virt_first = mesh->virt_first;

@@ -291,7 +291,7 @@ void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double
         if (w.loc == 1)
             w.fp = cost[v];
         for (int32_t i = mesh->vertex_face_offset[v]; i < mesh->vertex_face_offset[v + 1] && !w.stop; i++) {
-            int32_t f = mesh->vertex_face_corner[i] / 3;
+            int32_t f = MFMM_WEDGE_FACE(mesh->vertex_wedge[i]);
             if (!mfmm_mesh_degenerate(mesh, f))
                 start_face(&w, f, p);
         }

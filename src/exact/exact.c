@@ -143,7 +143,7 @@ struct mfmm_exact_tables {
     const mfmm_mesh *mesh;
     int32_t nv, nf;
     const int32_t *vf_offset;
-    const int32_t *vf_corner; /* the mesh's vertex -> corner CSR (ex_corner) */
+    const int32_t *vf_corner; /* the mesh's vertex -> face CSR, MFMM_WEDGE entries (ex_corner) */
     int32_t *face_in;   /* (nf,) the mesh's face id -> its record */
     /* per face, its three half-edges 3f+k (the edge opposite corner k, from
      * corner k+1 to k+2) in one record, so that crossing a face reads one or
@@ -249,11 +249,11 @@ static double vdist(const double *p, const double *q)
     return sqrt(a * a + b * b + c * c);
 }
 
-/* Corner i of the vertex -> corner CSR, as 3 * record + k. */
+/* Entry i of the vertex -> face CSR, as corner 3 * record + k. */
 static int32_t ex_corner(const int32_t *vf_corner, const int32_t *face_in, int32_t i)
 {
-    int32_t c = vf_corner[i];
-    return 3 * face_in[c / 3] + c % 3;
+    int32_t w = vf_corner[i];
+    return 3 * face_in[MFMM_WEDGE_FACE(w)] + MFMM_WEDGE_K(w);
 }
 
 static int ex_corner_of(const int32_t *fv, int32_t v)
@@ -357,7 +357,7 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
         uintptr_t a = (uintptr_t)t->fr_block;
         t->fr = (ex_face *)(void *)((char *)t->fr_block + ((64 - a % 64) % 64));
     }
-    t->vf_corner = mesh->vertex_face_corner;
+    t->vf_corner = mesh->vertex_wedge;
     t->face_in = malloc((nf ? nf : 1) * sizeof *t->face_in);
     t->pseudo = calloc(nv ? nv : 1, sizeof *t->pseudo);
     double *angle = calloc(nv ? nv : 1, sizeof *angle);

@@ -869,7 +869,7 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
                                     mesh->vertex_face_offset, &e);
     if (e == CL_SUCCESS)
         mem[MB_CORNER] = api->clCreateBuffer(cl.context, ro, n_wedge * sizeof(int32_t),
-                                        mesh->vertex_face_corner, &e);
+                                        mesh->vertex_wedge, &e);
     if (e == CL_SUCCESS)
         mem[MB_CORNERS] = api->clCreateBuffer(cl.context, ro,
                                          (size_t)mesh->nf * sizeof(mfmm_face),

@@ -474,7 +474,7 @@ static int32_t virt_descent(const tracer *t, int32_t v)
     double Tv = t->T[v], best = 0.0;
     int32_t bc = -1;
     for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
-        int32_t c = m->vertex_face_corner[i];
+        int32_t c = MFMM_WEDGE_CORNER(m->vertex_wedge[i]);
         const mfmm_face *fr = m->face_records + c / 3;
         if ((fr->virt & 3) != c % 3)
             continue;
@@ -496,7 +496,7 @@ static int local_min(const tracer *t, int32_t v)
     const mfmm_mesh *m = t->m;
     double Tv = t->T[v];
     for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
-        int32_t c = m->vertex_face_corner[i], f = c / 3, k = c % 3;
+        int32_t c = MFMM_WEDGE_CORNER(m->vertex_wedge[i]), f = c / 3, k = c % 3;
         if (t->T[m->face_records[f].v[(k + 1) % 3]] < Tv || t->T[m->face_records[f].v[(k + 2) % 3]] < Tv)
             return 0;
     }
@@ -611,7 +611,7 @@ static int leave_vertex(tracer *t, pos *p, frame *fr, double *d_out)
     int32_t bf = -1, bw = -1;
     double bd[2] = {0.0, 0.0};
     for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
-        int32_t c = m->vertex_face_corner[i], f = c / 3, k = c % 3;
+        int32_t c = MFMM_WEDGE_CORNER(m->vertex_wedge[i]), f = c / 3, k = c % 3;
         frame cf;
         if (!frame_build(t, f, &cf))
             return -1;
@@ -1016,7 +1016,7 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
                              "target vertex %d is in no face", (int)mfmm_vertex_out(m, v));
         if (!read_T(t, v, &T0))
             return t->st;
-        set_vertex(&p, m, m->vertex_face_corner[m->vertex_face_offset[v]] / 3, v);
+        set_vertex(&p, m, MFMM_WEDGE_FACE(m->vertex_wedge[m->vertex_face_offset[v]]), v);
     } else {
         p.f = target->face;
         p.vertex = -1;
@@ -1052,7 +1052,7 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
             Tcur = t->T[v];
             /* the end may lie in any face around the vertex */
             for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
-                int32_t f = m->vertex_face_corner[i] / 3;
+                int32_t f = MFMM_WEDGE_FACE(m->vertex_wedge[i]);
                 frame cf;
                 if (!frame_build(t, f, &cf))
                     return t->st;

@@ -33,7 +33,7 @@ static double reach_around(const mfmm_mesh *m, int32_t v, const double *p)
 {
     double r = 0.0;
     for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
-        const int32_t *f = m->face_records[m->vertex_face_corner[i] / 3].v;
+        const int32_t *f = m->face_records[MFMM_WEDGE_FACE(m->vertex_wedge[i])].v;
         for (int k = 0; k < 3; k++)
             r = fmax(r, mfmm_dist3(p, m->xyz + 3 * (size_t)f[k]));
     }

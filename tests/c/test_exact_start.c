@@ -328,7 +328,7 @@ static void test_saddle_corner_continuous(void **state)
         solve_r(solver, &vs, MFMM_EXACT_START_RADIUS, d0);
         double *e0 = exact_row(mesh, &vs);
         for (int32_t i = mesh->vertex_face_offset[v]; i < mesh->vertex_face_offset[v + 1]; i++) {
-            int32_t c = mesh->vertex_face_corner[i];
+            int32_t c = MFMM_WEDGE_CORNER(mesh->vertex_wedge[i]);
             /* (the public calls take the face's input id) */
             mfmm_source p = {0, mfmm_face_out(mesh, c / 3), {1e-9, 1e-9, 1e-9}, 0.0};
             p.bary[c % 3] = 1.0 - 2e-9;

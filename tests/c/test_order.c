@@ -382,11 +382,11 @@ static int32_t fan_breaks(const mfmm_mesh *m, int32_t v, int closed)
     int32_t lo = m->vertex_face_offset[v], hi = m->vertex_face_offset[v + 1], breaks = 0;
     int32_t first_p = -1, q_prev = -1;
     for (int32_t i = lo; i < hi; i++) {
-        int32_t c = m->vertex_face_corner[i], f = c / 3, k = c % 3;
+        int32_t c = MFMM_WEDGE_CORNER(m->vertex_wedge[i]), f = c / 3, k = c % 3;
         const int32_t *fv = m->face_records[f].v;
         assert_int_equal(fv[k], v);
         for (int32_t j = lo; j < i; j++)
-            assert_int_not_equal(m->vertex_face_corner[j], c);
+            assert_int_not_equal(MFMM_WEDGE_CORNER(m->vertex_wedge[j]), c);
         int32_t p = fv[(k + 1) % 3], q = fv[(k + 2) % 3];
         if (i == lo)
             first_p = p;

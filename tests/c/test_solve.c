@@ -377,6 +377,9 @@ static void test_bad_meshes(void **state)
     expect_mesh_error(V, 4, NULL, 2, MFMM_ERR_NULL_POINTER);
     expect_mesh_error(V, 0, F, 2, MFMM_ERR_BAD_COUNT);
     expect_mesh_error(V, 4, F, -1, MFMM_ERR_BAD_COUNT);
+    /* (the count is checked before the faces are read) */
+    expect_mesh_error(V, 4, F, 134217728, MFMM_ERR_BAD_COUNT);
+    expect_mesh_error(V, 715827883, F, 2, MFMM_ERR_BAD_COUNT);
     V[4] = NAN;
     expect_mesh_error(V, 4, F, 2, MFMM_ERR_NONFINITE_VERTEX);
     V[4] = INFINITY;
