@@ -117,10 +117,8 @@ static inline int32_t mfmm_mesh_virt_index(const mfmm_mesh *mesh, int32_t corner
     const mfmm_face *fr = mesh->face_records + corner / 3;
     if ((fr->virt & 3) != corner % 3)
         return -1;
-    int32_t j = mesh->virt_first[fr->virt >> 2];
-    while (mesh->virts[j].corner != corner)
-        j++;
-    return j;
+    mfmm_march_mesh m = mfmm_mesh_march_view(mesh);
+    return (int32_t)(mfmm_march_virt_of(&m, fr->virt >> 2, corner) - mesh->virts);
 }
 
 /* A walk along a virtual edge's strip, rebuilding its steps as the build
