@@ -4,7 +4,7 @@
  * The public face is mfmm_exact_solver / mfmm_solve_exact in meshfmm.h; the
  * workspace here is the same object. It reads from the mesh only nv, nf,
  * xyz, the faces' vertices (face records), face_neighbor, the vertex ->
- * corner CSR and zero-area faces (mfmm_mesh_degenerate), and builds its own
+ * face CSR (MFMM_WEDGE entries) and zero-area faces (mfmm_mesh_degenerate), and builds its own
  * edge geometry once. */
 #ifndef MFMM_EXACT_H
 #define MFMM_EXACT_H

@@ -496,8 +496,9 @@ static int local_min(const tracer *t, int32_t v)
     const mfmm_mesh *m = t->m;
     double Tv = t->T[v];
     for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
-        int32_t c = MFMM_WEDGE_CORNER(m->vertex_wedge[i]), f = c / 3, k = c % 3;
-        if (t->T[m->face_records[f].v[(k + 1) % 3]] < Tv || t->T[m->face_records[f].v[(k + 2) % 3]] < Tv)
+        int32_t w = m->vertex_wedge[i];
+        const int32_t *fv = m->face_records[MFMM_WEDGE_FACE(w)].v;
+        if (t->T[fv[MFMM_WEDGE_NEXT(w)]] < Tv || t->T[fv[MFMM_WEDGE_PREV(w)]] < Tv)
             return 0;
     }
     return virt_descent(t, v) < 0;
