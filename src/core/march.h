@@ -582,8 +582,13 @@ MFMM_INLINE mfmm_i32 mfmm_march_loop(mfmm_march_state *s, const mfmm_march_mesh 
  * Returns the number of vertices settled. */
 MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *m)
 {
+    int targets = s->targets_left > 0;
     mfmm_i32 settled = s->cost_location != 0 ? mfmm_march_loop(s, m, 1)
                                              : mfmm_march_loop(s, m, 0);
+    /* every vertex settled and no target flags: nothing to reset (a full
+     * row of a connected mesh) */
+    if (settled == m->nv && !targets)
+        return settled;
     /* a list is worth it for a local march; past nv/8 touched vertices a
      * sequential pass is cheaper than scattered ones (measured, bench_scale) */
     if (s->touched && s->n_touched < m->nv / 8) {
