@@ -577,9 +577,11 @@ MFMM_INLINE mfmm_i32 mfmm_march_loop(mfmm_march_state *s, const mfmm_march_mesh 
 /* Section 2's loop: settle the Close vertex of least T, recompute its
  * neighbours from settled values, until the heap is empty, T passes
  * max_distance, or every target is settled. Vertices not settled are set
- * to +inf and target flags cleared (with a touched list: only at the
- * touched vertices; labels stay Close/Alive there for the caller to reset).
- * Returns the number of vertices settled. */
+ * to +inf and target and fixed flags cleared (with a touched list: only at
+ * the touched vertices; labels stay Close/Alive there for the caller to
+ * reset; when every vertex settled, the labels keep their fixed flags:
+ * callers reset labels before the next march, as solve.c and the kernel's
+ * mfmm_march_reset do). Returns the number of vertices settled. */
 MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *m)
 {
     int targets = s->targets_left > 0;
