@@ -64,8 +64,8 @@ inline void mfmm_row_march(int nv, __global const int *wedge_offset,
         }
     }
     if (seeds) {
-        for (int j = seeds[row]; j < seeds[row + 1]; j++)
-            mfmm_march_seed_fixed(&s, seeds[j], seed_value[j]);
+        int j = seeds[row];
+        mfmm_march_seed_patch(&s, &m, seeds + j, seed_value + j, seeds[row + 1] - j, 0.0, 1.0);
     } else {
         mfmm_march_seed(&s, source, 0.0);
     }

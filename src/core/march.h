@@ -54,6 +54,9 @@ typedef struct mfmm_march_state {
      * OpenCL kernel's per-item workspace) the final pass covers all nv. */
     MFMM_GLOBAL mfmm_i32 *touched;
     mfmm_i32 n_touched;
+    /* vertices settled while seeding (mfmm_march_seed_patch), counted in the
+     * march's total */
+    mfmm_i32 n_preset;
 } mfmm_march_state;
 
 /* ---- indexed d-ary min-heap with decrease-key: a node's 8 children are
@@ -152,6 +155,7 @@ MFMM_INLINE void mfmm_march_reset(mfmm_march_state *s, mfmm_i32 nv)
     s->heap_size = 0;
     s->targets_left = 0;
     s->n_touched = 0;
+    s->n_preset = 0;
 }
 
 /* Vertex v leaves Far: remember it when the march keeps a touched list. */
@@ -349,6 +353,48 @@ MFMM_INLINE void mfmm_march_seed_fixed(mfmm_march_state *s, mfmm_i32 v, double v
         s->label[v] = (mfmm_u8)(s->label[v] | MFMM_FIXED);
 }
 
+/* Seeds one source's exact patch (the exact start, src/solve/seed.h): the
+ * n vertices pv at values value + f * pd, final (mfmm_march_seed_fixed), in
+ * this order. A patch vertex whose neighbours are all in the patch, as are
+ * the corners of the virtual edges that end at it, settles here, off the
+ * heap: settling it would offer nothing (its neighbours are fixed), and an
+ * update of a vertex outside the patch never reads it (that vertex would be
+ * its neighbour, or the corner of one of its virtual edges). So the rows are
+ * those of seeding it, but for the order of equal keys in the heap. Not
+ * with targets (the march stops at the last one: the vertices it has not
+ * settled are +inf) nor past max_distance. */
+MFMM_INLINE void mfmm_march_seed_patch(mfmm_march_state *s, const mfmm_march_mesh *m,
+                                       MFMM_GLOBAL const mfmm_i32 *pv,
+                                       MFMM_GLOBAL const double *pd, mfmm_i32 n, double value,
+                                       double f)
+{
+    int settle = s->targets_left == 0;
+    if (settle)
+        for (mfmm_i32 i = 0; i < n; i++)
+            s->label[pv[i]] = (mfmm_u8)(s->label[pv[i]] | MFMM_FIXED);
+    for (mfmm_i32 i = 0; i < n; i++) {
+        mfmm_i32 v = pv[i];
+        double t = value + f * pd[i];
+        int inside = settle && t <= s->max_distance && t < s->T[v];
+        for (mfmm_i32 j = m->wedge_offset[v]; inside && j < m->wedge_offset[v + 1]; j++) {
+            mfmm_i32 wc = m->wedge[j];
+            MFMM_GLOBAL const mfmm_face *fr = m->faces + MFMM_WEDGE_FACE(wc);
+            inside = (s->label[fr->v[MFMM_WEDGE_NEXT(wc)]] & MFMM_FIXED) &&
+                     (s->label[fr->v[MFMM_WEDGE_PREV(wc)]] & MFMM_FIXED);
+        }
+        for (mfmm_i32 j = m->virt_first[v]; inside && s->unfolding && j < m->virt_first[v + 1]; j++)
+            inside = (s->label[m->virts[j].c] & MFMM_FIXED) != 0;
+        if (!inside) {
+            mfmm_march_seed_fixed(s, v, t);
+            continue;
+        }
+        s->T[v] = t;
+        mfmm_march_touch(s, v, s->label[v] & MFMM_STATE_MASK);
+        s->label[v] = (mfmm_u8)(MFMM_ALIVE | MFMM_FIXED);
+        s->n_preset++;
+    }
+}
+
 /* Section 2's loop, until the heap is empty, T passes max_distance or every
  * target is settled (mfmm_march_run). general: a cost (the updates of
  * mfmm_march_corner); 0: F = 1, inline. A constant where it is called, so
@@ -362,7 +408,7 @@ MFMM_INLINE mfmm_i32 mfmm_march_loop(mfmm_march_state *s, const mfmm_march_mesh 
 {
     mfmm_march_state w = *s;
     mfmm_march_mesh mm = *m;
-    mfmm_i32 settled = 0;
+    mfmm_i32 settled = w.n_preset;
     int stop_at_targets = w.targets_left > 0;
     mfmm_i32 no_virt = w.unfolding ? 0 : 3;
     while (w.heap_size > 0) {
@@ -531,13 +577,20 @@ MFMM_INLINE mfmm_i32 mfmm_march_loop(mfmm_march_state *s, const mfmm_march_mesh 
 /* Section 2's loop: settle the Close vertex of least T, recompute its
  * neighbours from settled values, until the heap is empty, T passes
  * max_distance, or every target is settled. Vertices not settled are set
- * to +inf and target flags cleared (with a touched list: only at the
- * touched vertices; labels stay Close/Alive there for the caller to reset).
- * Returns the number of vertices settled. */
+ * to +inf and target and fixed flags cleared (with a touched list: only at
+ * the touched vertices; labels stay Close/Alive there for the caller to
+ * reset; when every vertex settled, the labels keep their fixed flags:
+ * callers reset labels before the next march, as solve.c and the kernel's
+ * mfmm_march_reset do). Returns the number of vertices settled. */
 MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *m)
 {
+    int targets = s->targets_left > 0;
     mfmm_i32 settled = s->cost_location != 0 ? mfmm_march_loop(s, m, 1)
                                              : mfmm_march_loop(s, m, 0);
+    /* every vertex settled and no target flags: nothing to reset (a full
+     * row of a connected mesh) */
+    if (settled == m->nv && !targets)
+        return settled;
     /* a list is worth it for a local march; past nv/8 touched vertices a
      * sequential pass is cheaper than scattered ones (measured, bench_scale) */
     if (s->touched && s->n_touched < m->nv / 8) {

@@ -174,10 +174,11 @@ mfmm_status mfmm_exact_start_seed(const mfmm_mesh *mesh, mfmm_exact_ws **ws,
         mfmm_start_seed(mesh, st, src);
         return MFMM_OK;
     }
-    for (int32_t i = 0; i < n; i++) {
-        if (fixed)
-            mfmm_march_seed_fixed(st, pv[i], src->value + f * pd[i]);
-        else
+    if (fixed) {
+        mfmm_march_mesh mm = mfmm_mesh_march_view(mesh);
+        mfmm_march_seed_patch(st, &mm, pv, pd, n, src->value, f);
+    } else {
+        for (int32_t i = 0; i < n; i++)
             mfmm_march_seed(st, pv[i], src->value + f * pd[i]);
     }
     if (src->face >= 0) {

@@ -2,7 +2,8 @@
  * equals the exact solver; the march from it is never worse than the
  * paper's start on the test meshes; the option off gives the rows of the
  * plain start as they were before the option existed; a point beside a
- * saddle vertex gives T continuous with the vertex (issue 9.3b). */
+ * saddle vertex gives T continuous with the vertex (issue 9.3b); the
+ * patch's inner vertices settle at seeding with the same rows. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -102,6 +103,92 @@ static void test_patch_is_exact(void **state)
                       (int)worst_n);
         free(d);
         mfmm_solver_destroy(solver);
+        mfmm_exact_ws_destroy(ws);
+        mfmm_mesh_destroy(mesh);
+        mfmm_free(F);
+    }
+}
+
+/* One march from an exact patch (internal ids): seeded vertex by vertex
+ * through the heap (mfmm_march_seed_fixed), or by mfmm_march_seed_patch,
+ * which settles the patch's inner vertices at once. T into T, returns the
+ * vertices settled, *preset those settled at seeding. */
+static int32_t march_patch(const mfmm_mesh *mesh, const int32_t *pv, const double *pd, int32_t n,
+                           int by_patch, int unfolding, double max_distance, double *T,
+                           int32_t *preset)
+{
+    int32_t nv = mfmm_mesh_vertex_count(mesh);
+    mfmm_march_state s;
+    memset(&s, 0, sizeof s);
+    s.T = T;
+    s.label = malloc((size_t)nv);
+    s.heap_key = malloc((size_t)nv * sizeof *s.heap_key);
+    s.heap_vertex = malloc((size_t)nv * sizeof *s.heap_vertex);
+    s.heap_pos = malloc((size_t)nv * sizeof *s.heap_pos);
+    assert_true(s.label && s.heap_key && s.heap_vertex && s.heap_pos);
+    s.max_distance = max_distance;
+    s.unfolding = unfolding;
+    mfmm_march_reset(&s, nv);
+    mfmm_march_mesh mm = mfmm_mesh_march_view(mesh);
+    if (by_patch)
+        mfmm_march_seed_patch(&s, &mm, pv, pd, n, 0.0, 1.0);
+    else
+        for (int32_t i = 0; i < n; i++)
+            mfmm_march_seed_fixed(&s, pv[i], 0.0 + 1.0 * pd[i]);
+    *preset = s.n_preset;
+    int32_t settled = mfmm_march_run(&s, &mm);
+    free(s.label);
+    free(s.heap_key);
+    free(s.heap_vertex);
+    free(s.heap_pos);
+    return settled;
+}
+
+/* The patch's inner vertices settle at seeding (mfmm_march_seed_patch,
+ * core/march.h): the rows and the settled counts equal those of seeding
+ * every patch vertex through the heap, bit for bit, with and without
+ * unfolding and max_distance (inside the patch too), and most of a patch
+ * settles early. */
+static void test_patch_settles_early(void **state)
+{
+    (void)state;
+    const char *names[] = {"meshes/hand_lowres.obj", "meshes/spot.obj", "meshes/camelhead.off",
+                           "meshes/decimated-max.obj", "meshes/fertility_FE_10k.off"};
+    for (size_t m = 0; m < sizeof names / sizeof names[0]; m++) {
+        int32_t nv = 0, nf = 0, *F = NULL;
+        mfmm_mesh *mesh = tm_load_data(names[m], &nv, &nf, &F);
+        mfmm_mesh_info info;
+        mfmm_mesh_get_info(mesh, &info);
+        mfmm_exact_ws *ws = NULL;
+        assert_int_equal(mfmm_exact_ws_create(mesh, &ws), MFMM_OK);
+        double *a = malloc((size_t)nv * sizeof *a), *b = malloc((size_t)nv * sizeof *b);
+        assert_true(a && b);
+        int64_t early = 0, total = 0;
+        for (int k = 0; k < 6; k++) {
+            mfmm_source src = tm_vertex_source(mfmm_vertex_in(mesh, F[3 * ((nf / 6) * k + 1)]));
+            double R = MFMM_EXACT_START_RADIUS * info.mean_edge_length;
+            int32_t n = 0;
+            const int32_t *pv = NULL;
+            const double *pd = NULL;
+            assert_int_equal(mfmm_exact_patch(ws, &src, 1, R, 0, &n, &pv, &pd, NULL), MFMM_OK);
+            /* all, then a max_distance inside the patch */
+            double limit = k % 2 ? INFINITY : 0.5 * R;
+            for (int unfolding = 0; unfolding < 2; unfolding++) {
+                int32_t pa = 0, pb = 0;
+                int32_t sa = march_patch(mesh, pv, pd, n, 0, unfolding, limit, a, &pa);
+                int32_t sb = march_patch(mesh, pv, pd, n, 1, unfolding, limit, b, &pb);
+                assert_int_equal(sa, sb);
+                assert_int_equal(pa, 0);
+                assert_memory_equal(a, b, (size_t)nv * sizeof *a);
+                early += pb;
+                total += n;
+            }
+        }
+        print_message("%s: %.0f %% of the patch vertices settled at seeding\n", names[m],
+                      100.0 * (double)early / (double)total);
+        assert_true(early > 0);
+        free(a);
+        free(b);
         mfmm_exact_ws_destroy(ws);
         mfmm_mesh_destroy(mesh);
         mfmm_free(F);
@@ -473,6 +560,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_patch_is_exact),
+        cmocka_unit_test(test_patch_settles_early),
         cmocka_unit_test(test_never_worse),
         cmocka_unit_test(test_shared_tables),
         cmocka_unit_test(test_off_is_plain_start),

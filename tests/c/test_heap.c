@@ -19,7 +19,7 @@ static void test_heap_random_sequences(void **state)
     static double ref[N]; /* reference keys; +inf = not in heap */
     unsigned seed = 12345;
     for (int round = 0; round < 20; round++) {
-        mfmm_march_state s = {T, label, key, vert, pos, 0, NULL, 0, INFINITY, 1, 0, NULL, NULL, 0};
+        mfmm_march_state s = {T, label, key, vert, pos, 0, NULL, 0, INFINITY, 1, 0, NULL, NULL, 0, 0};
         for (int v = 0; v < N; v++) {
             ref[v] = INFINITY;
             label[v] = MFMM_FAR;
