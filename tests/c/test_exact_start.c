@@ -42,6 +42,18 @@ static void solve_r(mfmm_solver *solver, const mfmm_source *src, double r, doubl
         fail_msg("mfmm_solve: %s", err.message);
 }
 
+/* A test mesh (tm_load_data), its info and an exact workspace for its
+ * patches. */
+static mfmm_mesh *load_with_ws(const char *name, int32_t *nv, int32_t *nf, int32_t **F,
+                               mfmm_mesh_info *info, mfmm_exact_ws **ws)
+{
+    mfmm_mesh *mesh = tm_load_data(name, nv, nf, F);
+    mfmm_mesh_get_info(mesh, info);
+    *ws = NULL;
+    assert_int_equal(mfmm_exact_ws_create(mesh, ws), MFMM_OK);
+    return mesh;
+}
+
 /* The patch (mfmm_exact_patch) holds the exact solver's distances, and the
  * march keeps them: T at every patch vertex is the exact distance. */
 static void test_patch_is_exact(void **state)
@@ -51,11 +63,9 @@ static void test_patch_is_exact(void **state)
                            "meshes/beetle.obj", "meshes/decimated-max.obj"};
     for (size_t m = 0; m < sizeof names / sizeof names[0]; m++) {
         int32_t nv = 0, nf = 0, *F = NULL;
-        mfmm_mesh *mesh = tm_load_data(names[m], &nv, &nf, &F);
         mfmm_mesh_info info;
-        mfmm_mesh_get_info(mesh, &info);
         mfmm_exact_ws *ws = NULL;
-        assert_int_equal(mfmm_exact_ws_create(mesh, &ws), MFMM_OK);
+        mfmm_mesh *mesh = load_with_ws(names[m], &nv, &nf, &F, &info, &ws);
         mfmm_solver *solver = NULL;
         assert_int_equal(mfmm_solver_create(mesh, &solver), MFMM_OK);
         double *d = malloc((size_t)nv * sizeof *d);
@@ -156,11 +166,9 @@ static void test_patch_settles_early(void **state)
                            "meshes/decimated-max.obj", "meshes/fertility_FE_10k.off"};
     for (size_t m = 0; m < sizeof names / sizeof names[0]; m++) {
         int32_t nv = 0, nf = 0, *F = NULL;
-        mfmm_mesh *mesh = tm_load_data(names[m], &nv, &nf, &F);
         mfmm_mesh_info info;
-        mfmm_mesh_get_info(mesh, &info);
         mfmm_exact_ws *ws = NULL;
-        assert_int_equal(mfmm_exact_ws_create(mesh, &ws), MFMM_OK);
+        mfmm_mesh *mesh = load_with_ws(names[m], &nv, &nf, &F, &info, &ws);
         double *a = malloc((size_t)nv * sizeof *a), *b = malloc((size_t)nv * sizeof *b);
         assert_true(a && b);
         int64_t early = 0, total = 0;
