@@ -3,8 +3,9 @@
  * mfmm_solve_exact. Usage:
  *   bench_exact_patch [--edges K] [--sources S] MESH...
  * radius = K mean edge lengths (default MFMM_EXACT_START_RADIUS, the library's
- * base radius); S sources spread over the mesh (default 200). Prints per mesh: mean patch size, mean time per patch, the
- * full solve's time, and the workspace's peak bytes. */
+ * base radius); S sources spread over the mesh (default 200). Prints per
+ * mesh: mean patch size, mean time per patch, the full solve's time, and the
+ * workspace's peak bytes. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
