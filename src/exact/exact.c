@@ -104,16 +104,6 @@
 /* a vertex whose angle sum exceeds 2 pi by this much is a saddle */
 #define EX_SADDLE_TOL 1e-12
 
-/* a step of a window's propagation, inlined where it is called: ex_emit
- * in ex_propagate made a patch 4-6 % faster (bench_exact_patch: hand,
- * spot, camelhead; a call spilled the window's doubles). ex_link inlined
- * too: no faster. */
-#if defined(__GNUC__) || defined(__clang__)
-#define EX_INLINE static inline __attribute__((always_inline))
-#else
-#define EX_INLINE static inline
-#endif
-
 /* k + 1 and k - 1 modulo 3, looked up: with k of a random window, a
  * comparison there is a branch mispredicted about half the time */
 static const int8_t ex_next[3] = {1, 2, 0}, ex_prev[3] = {2, 0, 1};
@@ -865,9 +855,12 @@ static double ex_gap(double x, double s0, double s1)
  * interval [s0, s1], leaving f: updates the vertices it reaches, trims it
  * against the edge's ends, and queues it in the face across, in that face's
  * frame. known: its ends at a vertex whose distance through this window
- * is already set (bit 0: at s = 0, bit 1: at s = L; see ex_propagate). */
-EX_INLINE void ex_emit_inline(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double ix,
-                              double iy, double sigma, int known)
+ * is already set (bit 0: at s = 0, bit 1: at s = L; see ex_propagate).
+ * Inlined where it is called (MFMM_INLINE): in ex_propagate that made a
+ * patch 4-6 % faster (bench_exact_patch: hand, spot, camelhead), as a call
+ * spilled the window's doubles; ex_link inlined too was no faster. */
+MFMM_INLINE void ex_emit_inline(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double ix,
+                                double iy, double sigma, int known)
 {
     const ex_face *r = ws->fr + h / 3;
     int k = h % 3;
