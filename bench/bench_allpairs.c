@@ -20,14 +20,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "bench_util.h"
 #include "meshfmm.h"
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 static double cpu_seconds(void)
 {

@@ -49,21 +49,9 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "meshfmm.h"
 #include "core/mesh.h"
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 typedef struct nrec {
     int32_t c;
@@ -248,16 +236,21 @@ static int build_indexed(const mfmm_mesh *mesh, imesh *n)
     return 1;
 }
 
-static int32_t indexed_march(mfmm_march_state *s, const imesh *nm)
+/* Section 2's loop head: settles the heap's top and returns it. */
+MFMM_INLINE mfmm_i32 settle_top(mfmm_march_state *w)
+{
+    mfmm_i32 x = w->heap_vertex[0];
+    mfmm_heap_pop(w);
+    w->label[x] = (mfmm_u8)((w->label[x] & MFMM_TARGET) | MFMM_ALIVE);
+    return x;
+}
+
+static void indexed_march(mfmm_march_state *s, const imesh *nm)
 {
     mfmm_march_state w = *s;
     imesh n = *nm;
-    int32_t settled = 0;
     while (w.heap_size > 0) {
-        mfmm_i32 x = w.heap_vertex[0];
-        mfmm_heap_pop(&w);
-        w.label[x] = (mfmm_u8)((w.label[x] & MFMM_TARGET) | MFMM_ALIVE);
-        settled++;
+        mfmm_i32 x = settle_top(&w);
         if (w.heap_size > 0) {
             mfmm_i32 y = w.heap_vertex[0];
             for (mfmm_i32 j = n.off[y]; j < n.off[y + 1]; j++)
@@ -300,7 +293,6 @@ static int32_t indexed_march(mfmm_march_state *s, const imesh *nm)
         }
     }
     s->heap_size = w.heap_size;
-    return settled;
 }
 
 MFMM_INLINE void probe_offer(mfmm_march_state *s, const nmesh *n, mfmm_i32 c, mfmm_u8 lc,
@@ -316,16 +308,12 @@ MFMM_INLINE void probe_offer(mfmm_march_state *s, const nmesh *n, mfmm_i32 c, mf
     }
 }
 
-static int32_t probe_march(mfmm_march_state *s, const nmesh *nm)
+static void probe_march(mfmm_march_state *s, const nmesh *nm)
 {
     mfmm_march_state w = *s;
     nmesh n = *nm;
-    int32_t settled = 0;
     while (w.heap_size > 0) {
-        mfmm_i32 x = w.heap_vertex[0];
-        mfmm_heap_pop(&w);
-        w.label[x] = (mfmm_u8)((w.label[x] & MFMM_TARGET) | MFMM_ALIVE);
-        settled++;
+        mfmm_i32 x = settle_top(&w);
         if (w.heap_size > 0) {
             mfmm_i32 y = w.heap_vertex[0];
             const char *b = (const char *)(n.rec + n.off[y]);
@@ -355,7 +343,6 @@ static int32_t probe_march(mfmm_march_state *s, const nmesh *nm)
         }
     }
     s->heap_size = w.heap_size;
-    return settled;
 }
 
 /* A march's row as the library returns it (+inf where not settled). */
