@@ -47,7 +47,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "bench_util.h"
 #include "meshfmm.h"
@@ -380,22 +379,15 @@ static void bench(const char *name, const double *V, int32_t nv, const int32_t *
     mfmm_march_mesh m = mfmm_mesh_march_view(mesh);
     size_t n = (size_t)nv + 1; /* + the never-Alive vertex nv */
     mfmm_march_state s;
-    memset(&s, 0, sizeof s);
-    s.T = malloc(n * sizeof *s.T);
-    s.label = malloc(n);
-    s.heap_key = malloc(n * sizeof *s.heap_key);
-    s.heap_vertex = malloc(n * sizeof *s.heap_vertex);
-    s.heap_pos = malloc(n * sizeof *s.heap_pos);
+    int have_state = bench_state_alloc(&s, n);
     double *ref = malloc(n * sizeof *ref), *row = malloc(n * sizeof *row);
     size_t nt = (size_t)repeats * n_sources;
     double *t_walk = malloc(nt * sizeof(double)), *t_rec = malloc(nt * sizeof(double)),
            *t_idx = malloc(nt * sizeof(double));
-    if (!s.T || !s.label || !s.heap_key || !s.heap_vertex || !s.heap_pos || !ref || !row ||
-        !t_walk || !t_rec || !t_idx) {
+    if (!have_state || !ref || !row || !t_walk || !t_rec || !t_idx) {
         fprintf(stderr, "out of memory\n");
         exit(1);
     }
-    s.max_distance = MFMM_INF;
     s.label[nv] = MFMM_FAR;
     for (int unfolding = 1; unfolding >= 0; unfolding--) {
         if (only_unfolding >= 0 && unfolding != only_unfolding)
@@ -455,11 +447,7 @@ static void bench(const char *name, const double *V, int32_t nv, const int32_t *
         free(nm.off);
         free(nm.rec);
     }
-    free(s.T);
-    free(s.label);
-    free(s.heap_key);
-    free(s.heap_vertex);
-    free(s.heap_pos);
+    bench_state_free(&s);
     free(ref);
     free(row);
     free(t_walk);
@@ -485,18 +473,6 @@ int main(int argc, char **argv)
         }
         first += 2;
     }
-    for (int i = first; i < argc; i++) {
-        double *V = NULL;
-        int32_t *F = NULL, nv = 0, nf = 0;
-        mfmm_error err;
-        if (mfmm_load_mesh(argv[i], &V, &nv, &F, &nf, &err) != MFMM_OK) {
-            fprintf(stderr, "%s: %s\n", argv[i], err.message);
-            continue;
-        }
-        const char *base = strrchr(argv[i], '/');
-        bench(base ? base + 1 : argv[i], V, nv, F, nf, repeats, n_sources);
-        mfmm_free(V);
-        mfmm_free(F);
-    }
+    bench_mesh_files((const char *const *)(argv + first), argc - first, bench, repeats, n_sources);
     return 0;
 }

@@ -99,15 +99,9 @@ static double ceiling_time(const mfmm_mesh *mesh, int repeats, int n_sources, do
     graph g = {0, NULL, NULL, NULL};
     size_t n = (size_t)mesh->nv;
     mfmm_march_state s;
-    memset(&s, 0, sizeof s);
-    s.T = malloc(n * sizeof *s.T);
-    s.label = malloc(n);
-    s.heap_key = malloc(n * sizeof *s.heap_key);
-    s.heap_vertex = malloc(n * sizeof *s.heap_vertex);
-    s.heap_pos = malloc(n * sizeof *s.heap_pos);
+    int have_state = bench_state_alloc(&s, n);
     double med = NAN;
-    if (graph_build(mesh, &g) && s.T && s.label && s.heap_key && s.heap_vertex && s.heap_pos) {
-        s.max_distance = MFMM_INF;
+    if (graph_build(mesh, &g) && have_state) {
         int k = 0;
         for (int q = 0; q < n_sources; q++) {
             /* the march's source, in the mesh's internal order */
@@ -125,11 +119,7 @@ static double ceiling_time(const mfmm_mesh *mesh, int repeats, int n_sources, do
     free(g.off);
     free(g.nbr);
     free(g.len);
-    free(s.T);
-    free(s.label);
-    free(s.heap_key);
-    free(s.heap_vertex);
-    free(s.heap_pos);
+    bench_state_free(&s);
     return med;
 }
 
@@ -234,18 +224,6 @@ int main(int argc, char **argv)
             mfmm_gen_free(&g);
         }
     }
-    for (int i = 0; i < n_paths; i++) {
-        double *V = NULL;
-        int32_t *F = NULL, nv = 0, nf = 0;
-        mfmm_error err;
-        if (mfmm_load_mesh(paths[i], &V, &nv, &F, &nf, &err) != MFMM_OK) {
-            fprintf(stderr, "%s: %s\n", paths[i], err.message);
-            continue;
-        }
-        const char *base = strrchr(paths[i], '/');
-        bench(base ? base + 1 : paths[i], V, nv, F, nf, repeats, n_sources);
-        mfmm_free(V);
-        mfmm_free(F);
-    }
+    bench_mesh_files(paths, n_paths, bench, repeats, n_sources);
     return 0;
 }
