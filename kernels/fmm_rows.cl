@@ -29,7 +29,9 @@ inline void mfmm_row_march(int nv, __global const int *wedge_offset,
                            __global const mfmm_virt *virts, __global const int *strip_offset,
                            __global const int *seeds, int row,
                            __global const double *seed_value,
-                           __global const int *virt_first)
+                           __global const int *virt_first, int use_spokes,
+                           __global const int *spoke_offset,
+                           __global const mfmm_spoke *spokes)
 {
     mfmm_march_mesh m;
     m.nv = nv;
@@ -40,6 +42,9 @@ inline void mfmm_row_march(int nv, __global const int *wedge_offset,
     m.virt_first = virt_first;
     m.strip_offset = strip_offset;
     m.strip = strip;
+    /* the spokes at F = 1 with unfolding, as the serial solver (solve.c) */
+    m.spoke_offset = use_spokes ? spoke_offset : 0;
+    m.spokes = use_spokes ? spokes : 0;
     mfmm_march_state s;
     s.T = T_row;
     s.label = label;
@@ -88,7 +93,9 @@ __kernel void fmm_rows_f64(int nv, __global const int *wedge_offset,
                            __global const int *strip_offset,
                            int n_seeds, __global const int *seeds,
                            __global const double *seed_value,
-                           __global const int *virt_first)
+                           __global const int *virt_first, int use_spokes,
+                           __global const int *spoke_offset,
+                           __global const mfmm_spoke *spokes)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
@@ -99,7 +106,7 @@ __kernel void fmm_rows_f64(int nv, __global const int *wedge_offset,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
                    key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets,
                    virts, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value,
-                   virt_first);
+                   virt_first, use_spokes, spoke_offset, spokes);
     if (n_targets > 0) {
         __global double *row = out + (ulong)i * (ulong)n_targets;
         for (int j = 0; j < n_targets; j++)
@@ -127,7 +134,9 @@ __kernel void fmm_rows_f32(int nv, __global const int *wedge_offset,
                            __global const int *strip_offset,
                            int n_seeds, __global const int *seeds,
                            __global const double *seed_value,
-                           __global const int *virt_first)
+                           __global const int *virt_first, int use_spokes,
+                           __global const int *spoke_offset,
+                           __global const mfmm_spoke *spokes)
 {
     int i = (int)get_global_id(0);
     if (i >= count)
@@ -138,7 +147,7 @@ __kernel void fmm_rows_f32(int nv, __global const int *wedge_offset,
                    max_distance, unfolding, sources[first + i], T, label_ws + o,
                    key_ws + o, vert_ws + o, pos_ws + o, strip, uniform, targets, n_targets,
                    virts, strip_offset, n_seeds > 0 ? seeds : 0, i, seed_value,
-                   virt_first);
+                   virt_first, use_spokes, spoke_offset, spokes);
     (void)unused;
     if (n_targets > 0) {
         __global float *row = out + (ulong)i * (ulong)n_targets;

@@ -71,6 +71,26 @@ typedef struct mfmm_virt {
     double cos_b; /* cos of angle V-C-B */
 } mfmm_virt;
 
+/* A spoke: what vertex x's settling offers one neighbour c at F = 1 with
+ * unfolding (march.h, the spoke walk; built by src/core/spokes.c): |xc| and
+ * the (up to) two triangles through x that update c, each with its third
+ * vertex y, |yc| and the cosine at c, oriented for mfmm_triangle_interior
+ * (bit s of x_is_a: x is the triangle's A, so a = |yc| and b = |xc|).
+ * Where c's obtuse corner has a virtual edge (section 4.2) y is its V, with
+ * the virtual edge's length and cosine. A missing triangle names y = c,
+ * which is never Alive when c is updated. x's spokes: first one per virtual
+ * edge that ends at x (c its corner, y its A and B), then x's neighbours in
+ * fan order, a face's q and the next face's p in one spoke. 56 bytes, C and
+ * OpenCL C; about 7.5 per vertex. */
+typedef struct mfmm_spoke {
+    mfmm_i32 c;
+    mfmm_i32 y[2];
+    mfmm_u32 x_is_a;
+    double len;   /* |xc| */
+    double ly[2]; /* |yc| */
+    double cs[2]; /* cos of the angle at c */
+} mfmm_spoke;
+
 /* An entry of a vertex's face list (mfmm_march_mesh.wedge): face f where
  * the vertex is corner k, packed as 16 f + 4 ((k + 2) mod 3) + (k + 1) mod 3,
  * so that the march reads the face and the corners after k by shifts and

@@ -44,6 +44,8 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh->build_steps);
     if (mesh->exact_tables)
         mesh->exact_tables_free(mesh->exact_tables);
+    free(mesh->spoke_offset);
+    free(mesh->spoke_block);
     pthread_mutex_destroy(&mesh->cache_lock);
     free(mesh);
 }
@@ -610,7 +612,7 @@ int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, i
     /* the exact tables may be built by another thread meanwhile (mesh.h) */
     pthread_mutex_t *lock = (pthread_mutex_t *)(uintptr_t)&mesh->cache_lock;
     pthread_mutex_lock(lock);
-    size_t exact_bytes = mesh->exact_tables_bytes;
+    size_t exact_bytes = mesh->exact_tables_bytes, spoke_bytes = mesh->spokes_bytes;
     pthread_mutex_unlock(lock);
     const struct {
         const char *name;
@@ -627,6 +629,7 @@ int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, i
         {"virt_strip", (n_virts + 1) * sizeof(int32_t)},
         {"mesh struct", sizeof *mesh},
         {"exact tables (once built)", exact_bytes},
+        {"spokes (once built)", spoke_bytes},
     };
     int n = (int)(sizeof a / sizeof a[0]);
     for (int i = 0; i < n && i < max; i++) {

@@ -74,6 +74,12 @@ struct mfmm_mesh {
     void *exact_tables;
     void (*exact_tables_free)(void *);
     size_t exact_tables_bytes;
+    /* The march's spokes (spokes.c), built on the first march at F = 1 with
+     * unfolding, under cache_lock, then read-only; NULL until then. */
+    int32_t *spoke_offset;     /* (nv+1,) CSR into spokes */
+    mfmm_spoke *spokes;        /* 64-byte aligned, in spoke_block */
+    void *spoke_block;
+    size_t spokes_bytes;
 };
 
 /* The arrays a march reads. */
@@ -88,8 +94,17 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
     m.virt_first = mesh->virt_first;
     m.strip_offset = mesh->virt_strip;
     m.strip = mesh->strip;
+    m.spoke_offset = NULL; /* the face walk (a march that wants spokes sets them) */
+    m.spokes = NULL;
     return m;
 }
+
+/* The mesh's spokes for the march (march.h: F = 1, unfolding on), built
+ * on first use under the mesh's lock and kept until mfmm_mesh_destroy:
+ * *offset (nv+1) and *spokes. MFMM_ERR_OUT_OF_MEMORY (both NULL: the
+ * face walk gives the same rows) or MFMM_OK. */
+mfmm_status mfmm_mesh_spokes_of(const mfmm_mesh *mesh, const int32_t **offset,
+                                const mfmm_spoke **spokes);
 
 /* Finds the virtual edge of every obtuse corner by unfolding (section 4.2);
  * fills full[].virt, virt_len, virt_cos_a, virt_cos_b, strip_at, strip_n, the

@@ -697,7 +697,7 @@ const char *mfmm_opencl_context_device_name(const mfmm_opencl_context *context)
 
 /* ---- rows ---- */
 
-enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_ORDER, MB_VIRTS, MB_STRIPOFF, MB_VFIRST, MB_LABEL, MB_KEY, MB_VERT,
+enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_ORDER, MB_VIRTS, MB_STRIPOFF, MB_VFIRST, MB_SPOKEOFF, MB_SPOKES, MB_LABEL, MB_KEY, MB_VERT,
        MB_POS, MB_T, MB_OUT, MB_COUNT };
 
 /* Bytes per work-item on the device (workspace and output row), and on the
@@ -899,6 +899,22 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
         mem[MB_STRIPOFF] = api->clCreateBuffer(cl.context, ro,
                                                ((size_t)mesh->n_virts + 1) * sizeof(int32_t),
                                                mesh->virt_strip, &e);
+    /* F = 1 with unfolding: the mesh's spokes (march.h), as the serial
+     * solver reads them (solve.c); out of memory: the face walk, which
+     * gives the same rows */
+    const int32_t *spoke_offset = NULL;
+    const mfmm_spoke *spokes = NULL;
+    if (!job->cost && job->opt->unfolding)
+        (void)mfmm_mesh_spokes_of(mesh, &spoke_offset, &spokes);
+    cl_int use_spokes = spokes != NULL;
+    if (e == CL_SUCCESS)
+        mem[MB_SPOKEOFF] = api->clCreateBuffer(cl.context, ro, (use_spokes ? nv + 1 : 1) * sizeof(int32_t),
+                                               use_spokes ? (void *)spoke_offset : (void *)&no_target, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_SPOKES] = api->clCreateBuffer(cl.context, ro,
+                                             use_spokes ? (size_t)spoke_offset[nv] * sizeof(mfmm_spoke)
+                                                        : sizeof(double),
+                                             use_spokes ? (void *)spokes : (void *)&one, &e);
     /* with a cost: the cost around each vertex, for the virtual stencils
      * (march.h), once for the job */
     if (e == CL_SUCCESS && job->cost && (job->opt->unfolding || exact)) {
@@ -1016,6 +1032,9 @@ static mfmm_status run_rows(const ocl *shared, const mfmm_rows_job *job, int32_t
     e |= api->clSetKernelArg(cl.kernel, seed_arg + 1, sizeof(cl_mem), &mem[MB_SOURCES]);
     e |= api->clSetKernelArg(cl.kernel, seed_arg + 2, sizeof(cl_mem), &mem[MB_COST]);
     e |= api->clSetKernelArg(cl.kernel, seed_arg + 3, sizeof(cl_mem), &mem[MB_VFIRST]);
+    e |= api->clSetKernelArg(cl.kernel, seed_arg + 4, sizeof use_spokes, &use_spokes);
+    e |= api->clSetKernelArg(cl.kernel, seed_arg + 5, sizeof(cl_mem), &mem[MB_SPOKEOFF]);
+    e |= api->clSetKernelArg(cl.kernel, seed_arg + 6, sizeof(cl_mem), &mem[MB_SPOKES]);
     if (e != CL_SUCCESS) {
         st = runtime_fail(err, "clSetKernelArg", e);
         goto done;

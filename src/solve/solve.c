@@ -27,6 +27,11 @@ struct mfmm_solver {
     int fixed_location;
     mfmm_exact_ws *exact; /* the exact start's workspace, made on first use */
     mfmm_mapped_args args; /* mfmm_solve's arguments in internal order (order.h) */
+    /* the mesh's spokes (mfmm_mesh_spokes_of), asked for by the first march
+     * at F = 1 with unfolding; NULL then only if out of memory (the face
+     * walk gives the same rows) */
+    const int32_t *spoke_offset;
+    const mfmm_spoke *spokes;
 };
 
 mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out)
@@ -231,6 +236,12 @@ static int32_t solver_march(mfmm_solver *solver, const mfmm_source *sources, int
         }
     }
     mfmm_march_mesh mm = mfmm_mesh_march_view(mesh);
+    if (!s.cost && s.unfolding) {
+        if (!solver->spokes)
+            (void)mfmm_mesh_spokes_of(mesh, &solver->spoke_offset, &solver->spokes);
+        mm.spoke_offset = solver->spoke_offset;
+        mm.spokes = solver->spokes;
+    }
     int32_t settled = mfmm_march_run(&s, &mm);
     /* target flags on vertices never touched (touched ones: reset below) */
     for (int32_t i = 0; i < opt.n_targets; i++)
