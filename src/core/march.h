@@ -241,15 +241,15 @@ MFMM_INLINE int mfmm_march_virt_ok(const mfmm_march_state *s, const mfmm_march_m
 
 /* Offers t to vertex c (label lc): lowers T(c) and its heap key if t is
  * less. */
-MFMM_INLINE void mfmm_march_offer(mfmm_march_state *s, const mfmm_march_mesh *m, mfmm_i32 c,
-                                  mfmm_u8 lc, double t)
+MFMM_INLINE void mfmm_march_offer_to(mfmm_march_state *s, const mfmm_march_mesh *m, mfmm_i32 c,
+                                     mfmm_u8 lc, double t, const int spokes)
 {
     if (t < s->T[c]) {
         mfmm_u8 st = lc & MFMM_STATE_MASK;
         /* c joins the front: its own spokes or faces are read when it
          * settles */
         if (st == MFMM_FAR) {
-            if (m->spokes)
+            if (spokes)
                 MFMM_PREFETCH(m->spokes + m->spoke_offset[c]);
             else
                 MFMM_PREFETCH(m->wedge + m->wedge_offset[c]);
@@ -259,6 +259,13 @@ MFMM_INLINE void mfmm_march_offer(mfmm_march_state *s, const mfmm_march_mesh *m,
         mfmm_march_touch(s, c, st);
         s->label[c] = (mfmm_u8)((lc & MFMM_TARGET) | MFMM_CLOSE);
     }
+}
+
+/* The face walk's offer (mfmm_march_offer_to: it prefetches c's faces). */
+MFMM_INLINE void mfmm_march_offer(mfmm_march_state *s, const mfmm_march_mesh *m, mfmm_i32 c,
+                                  mfmm_u8 lc, double t)
+{
+    mfmm_march_offer_to(s, m, c, lc, t, 0);
 }
 
 /* The virtual edge of corner k = 3 f + k' that ends at V = iv: V's list
@@ -595,6 +602,22 @@ MFMM_INLINE mfmm_i32 mfmm_march_loop(mfmm_march_state *s, const mfmm_march_mesh 
     return settled;
 }
 
+/* Spoke r's triangle q (0 or 1, a constant where called) once its y has
+ * settled: min(t, its update of c from x and y). */
+MFMM_INLINE double mfmm_march_spoke_triangle(const mfmm_march_state *w,
+                                             MFMM_GLOBAL const mfmm_spoke *r, const int q,
+                                             double tx, double t)
+{
+    mfmm_i32 y = r->y[q];
+    if ((w->label[y] & MFMM_STATE_MASK) != MFMM_ALIVE)
+        return t;
+    double ty = w->T[y];
+    int xa = (int)((r->x_is_a >> q) & 1u);
+    double ta = xa ? tx : ty, tb = xa ? ty : tx;
+    double la = xa ? r->ly[q] : r->len, lb = xa ? r->len : r->ly[q];
+    return mfmm_min(t, mfmm_triangle_interior(ta, tb, la, lb, r->cs[q], 1.0));
+}
+
 /* Section 2's loop over spokes (F = 1, unfolding on): the updates of the
  * face walk (mfmm_march_loop with general = 0), the same operands in the
  * same order of offers, so the same rows bit for bit, from records that
@@ -639,17 +662,9 @@ MFMM_INLINE mfmm_i32 mfmm_march_spoke_loop(mfmm_march_state *s, const mfmm_march
              * (section 4.1; its virtual triangle at an obtuse corner,
              * section 4.2) */
             double t = tx + r->len;
-            for (int q = 0; q < 2; q++) {
-                mfmm_i32 y = r->y[q];
-                if ((w.label[y] & MFMM_STATE_MASK) == MFMM_ALIVE) {
-                    double ty = w.T[y];
-                    int xa = (int)((r->x_is_a >> q) & 1u);
-                    double ta = xa ? tx : ty, tb = xa ? ty : tx;
-                    double la = xa ? r->ly[q] : r->len, lb = xa ? r->len : r->ly[q];
-                    t = mfmm_min(t, mfmm_triangle_interior(ta, tb, la, lb, r->cs[q], 1.0));
-                }
-            }
-            mfmm_march_offer(&w, &mm, c, lc, t);
+            t = mfmm_march_spoke_triangle(&w, r, 0, tx, t);
+            t = mfmm_march_spoke_triangle(&w, r, 1, tx, t);
+            mfmm_march_offer_to(&w, &mm, c, lc, t, 1);
         }
     }
     s->heap_size = w.heap_size;
