@@ -183,6 +183,25 @@ MFMM_INLINE void mfmm_march_seed(mfmm_march_state *s, mfmm_i32 v, double value)
     }
 }
 
+/* Section 2's loop head, for both marches: settles the heap's top x (the
+ * heap is not empty) and returns it, or -1 when the march stops: x's T
+ * passes max_distance (x stays Close), or x was the last target (x
+ * settled and counted). */
+MFMM_INLINE mfmm_i32 mfmm_march_settle(mfmm_march_state *w, mfmm_i32 *settled,
+                                       int stop_at_targets)
+{
+    mfmm_i32 x = w->heap_vertex[0];
+    if (w->T[x] > w->max_distance)
+        return -1;
+    mfmm_heap_pop(w);
+    mfmm_u8 lx = w->label[x];
+    w->label[x] = (mfmm_u8)((lx & MFMM_TARGET) | MFMM_ALIVE);
+    (*settled)++;
+    if (stop_at_targets && (lx & MFMM_TARGET) && --w->targets_left == 0)
+        return -1;
+    return x;
+}
+
 /* The costs for updating vertex c of face f from its other vertices a, b
  * (the face's vertices after c, in its order): f_a along edge CB, f_b along
  * CA, f_t across the triangle; returns F(C) (per face: the face's F), what
@@ -428,14 +447,8 @@ MFMM_INLINE mfmm_i32 mfmm_march_loop(mfmm_march_state *s, const mfmm_march_mesh 
     int stop_at_targets = w.targets_left > 0;
     mfmm_i32 no_virt = w.unfolding ? 0 : 3;
     while (w.heap_size > 0) {
-        mfmm_i32 x = w.heap_vertex[0];
-        if (w.T[x] > w.max_distance)
-            break;
-        mfmm_heap_pop(&w);
-        mfmm_u8 lx = w.label[x];
-        w.label[x] = (mfmm_u8)((lx & MFMM_TARGET) | MFMM_ALIVE);
-        settled++;
-        if (stop_at_targets && (lx & MFMM_TARGET) && --w.targets_left == 0)
+        mfmm_i32 x = mfmm_march_settle(&w, &settled, stop_at_targets);
+        if (x < 0)
             break;
         mfmm_i32 end = mm.wedge_offset[x + 1];
         /* The march waits on face records (cache misses). The next vertex
@@ -633,14 +646,8 @@ MFMM_INLINE mfmm_i32 mfmm_march_spoke_loop(mfmm_march_state *s, const mfmm_march
     mfmm_i32 settled = w.n_preset;
     int stop_at_targets = w.targets_left > 0;
     while (w.heap_size > 0) {
-        mfmm_i32 x = w.heap_vertex[0];
-        if (w.T[x] > w.max_distance)
-            break;
-        mfmm_heap_pop(&w);
-        mfmm_u8 lx = w.label[x];
-        w.label[x] = (mfmm_u8)((lx & MFMM_TARGET) | MFMM_ALIVE);
-        settled++;
-        if (stop_at_targets && (lx & MFMM_TARGET) && --w.targets_left == 0)
+        mfmm_i32 x = mfmm_march_settle(&w, &settled, stop_at_targets);
+        if (x < 0)
             break;
         /* the next vertex to settle is almost always the new heap top: ask
          * for its spokes one iteration ahead, as one range */
