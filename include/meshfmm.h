@@ -106,6 +106,13 @@ typedef struct mfmm_mesh_options {
      * obtuse corner (paper section 4.2); a walk that needs more fails and the
      * corner keeps its plain stencil. Default 64; must be >= 1. */
     int32_t max_unfold_steps;
+    /* 1 (default): the march at F = 1 with unfolding reads per-vertex update
+     * records ("spokes"), built on the first such solve and kept with the
+     * mesh: about 420 bytes per vertex (mfmm_mesh_memory lists them), for a
+     * march 0.72-0.83x as long. 0: never build them; the march walks the
+     * faces instead, with the same results bit for bit (memory first: a
+     * 1M-vertex mesh holds 0.42 GB less). Other values are refused. */
+    int32_t spokes;
 } mfmm_mesh_options;
 
 /* Fills `options` with the defaults. */

@@ -21,6 +21,7 @@ void mfmm_mesh_options_init(mfmm_mesh_options *options)
     memset(options, 0, sizeof *options);
     options->struct_size = sizeof *options;
     options->max_unfold_steps = 64;
+    options->spokes = 1;
 }
 
 void mfmm_mesh_destroy(mfmm_mesh *mesh)
@@ -475,6 +476,9 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
     if (opt.max_unfold_steps < 1)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "max_unfold_steps must be >= 1 (got %ld)",
                          (long)opt.max_unfold_steps);
+    if (opt.spokes != 0 && opt.spokes != 1)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "spokes must be 0 or 1 (got %ld)",
+                         (long)opt.spokes);
     mfmm_status st = validate(vertices, nv, faces, nf, err);
     if (st != MFMM_OK)
         return st;
@@ -488,6 +492,7 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
     }
     m->nv = nv;
     m->nf = nf;
+    m->spokes_allowed = opt.spokes;
     size_t nc = (size_t)nf * 3;
     m->xyz = malloc((size_t)nv * 3 * sizeof *m->xyz);
     /* the face records, on cache-line boundaries (one record, one line):

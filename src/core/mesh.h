@@ -75,7 +75,9 @@ struct mfmm_mesh {
     void (*exact_tables_free)(void *);
     size_t exact_tables_bytes;
     /* The march's spokes (spokes.c), built on the first march at F = 1 with
-     * unfolding, under cache_lock, then read-only; NULL until then. */
+     * unfolding, under cache_lock, then read-only; NULL until then, and
+     * always where spokes_allowed is 0 (mfmm_mesh_options.spokes). */
+    int spokes_allowed;
     int32_t *spoke_offset;     /* (nv+1,) CSR into spokes */
     mfmm_spoke *spokes;        /* 64-byte aligned, in spoke_block */
     void *spoke_block;
@@ -102,7 +104,8 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
 /* The mesh's spokes for the march (march.h: F = 1, unfolding on), built
  * on first use under the mesh's lock and kept until mfmm_mesh_destroy:
  * *offset (nv+1) and *spokes. MFMM_ERR_OUT_OF_MEMORY (both NULL: the
- * face walk gives the same rows) or MFMM_OK. */
+ * face walk gives the same rows) or MFMM_OK (both NULL when the mesh was
+ * made with mfmm_mesh_options.spokes = 0). */
 mfmm_status mfmm_mesh_spokes_of(const mfmm_mesh *mesh, const int32_t **offset,
                                 const mfmm_spoke **spokes);
 

@@ -138,6 +138,10 @@ mfmm_status mfmm_mesh_spokes_of(const mfmm_mesh *mesh, const int32_t **offset,
     /* the mesh's cache is the one mutable part of a built mesh (mesh.h) */
     mfmm_mesh *m = (mfmm_mesh *)(uintptr_t)mesh;
     mfmm_status st = MFMM_OK;
+    *offset = NULL;
+    *spokes = NULL;
+    if (!m->spokes_allowed) /* set at creation: no lock needed */
+        return MFMM_OK;
     pthread_mutex_lock(&m->cache_lock);
     if (!m->spokes)
         st = spokes_build(m);

@@ -397,6 +397,10 @@ static void test_bad_meshes(void **state)
     mo.max_unfold_steps = 0;
     mfmm_mesh *mesh = NULL;
     assert_int_equal(mfmm_mesh_create(V, 4, F, 2, &mo, &mesh, NULL), MFMM_ERR_BAD_ARGUMENT);
+    mfmm_mesh_options_init(&mo);
+    mo.spokes = 2;
+    assert_int_equal(mfmm_mesh_create(V, 4, F, 2, &mo, &mesh, NULL), MFMM_ERR_BAD_ARGUMENT);
+    assert_null(mesh);
     assert_int_equal(mfmm_mesh_create(V, 4, F, 2, NULL, NULL, NULL), MFMM_ERR_NULL_POINTER);
 }
 

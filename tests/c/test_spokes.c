@@ -175,12 +175,63 @@ static void test_memory_report(void **state)
     mfmm_gen_free(&g);
 }
 
+/* A mesh made with spokes = 0 (memory first) never builds them, and its
+ * solves (public API, default exact start) equal the default mesh's bit for
+ * bit: the face walk is the same march. */
+static void test_spokes_off(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh g = mfmm_gen_sine(40);
+    mfmm_mesh_options mo;
+    mfmm_mesh_options_init(&mo);
+    assert_int_equal(mo.spokes, 1);
+    mo.spokes = 0;
+    mfmm_mesh *on = tm_make(&g), *off = NULL;
+    assert_int_equal(mfmm_mesh_create(g.V, g.nv, g.F, g.nf, &mo, &off, NULL), MFMM_OK);
+    const int32_t *offset = (const int32_t *)1;
+    const mfmm_spoke *spokes = (const mfmm_spoke *)1;
+    assert_int_equal(mfmm_mesh_spokes_of(off, &offset, &spokes), MFMM_OK);
+    assert_null(offset);
+    assert_null(spokes);
+    double *d_on = malloc((size_t)g.nv * sizeof *d_on), *d_off = malloc((size_t)g.nv * sizeof *d_off);
+    assert_non_null(d_on);
+    assert_non_null(d_off);
+    mfmm_solver *s_on = NULL, *s_off = NULL;
+    assert_int_equal(mfmm_solver_create(on, &s_on), MFMM_OK);
+    assert_int_equal(mfmm_solver_create(off, &s_off), MFMM_OK);
+    for (int q = 0; q < 4; q++) {
+        mfmm_source src = tm_vertex_source((int32_t)(((int64_t)g.nv * (2 * q + 1)) / 8));
+        assert_int_equal(mfmm_solve(s_on, &src, 1, NULL, d_on, NULL), MFMM_OK);
+        assert_int_equal(mfmm_solve(s_off, &src, 1, NULL, d_off, NULL), MFMM_OK);
+        assert_memory_equal(d_on, d_off, (size_t)g.nv * sizeof *d_on);
+    }
+    const char *names[32];
+    size_t bytes[32];
+    int n = mfmm_mesh_memory(off, names, bytes, 32), seen = 0;
+    for (int i = 0; i < n && i < 32; i++)
+        if (!strcmp(names[i], "spokes (once built)")) {
+            assert_int_equal(bytes[i], 0);
+            seen = 1;
+        }
+    assert_true(seen);
+    assert_int_equal(mfmm_mesh_spokes_of(on, &offset, &spokes), MFMM_OK);
+    assert_non_null(spokes);
+    mfmm_solver_destroy(s_on);
+    mfmm_solver_destroy(s_off);
+    free(d_on);
+    free(d_off);
+    mfmm_mesh_destroy(on);
+    mfmm_mesh_destroy(off);
+    mfmm_gen_free(&g);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_real_meshes),
         cmocka_unit_test(test_generated_meshes),
         cmocka_unit_test(test_memory_report),
+        cmocka_unit_test(test_spokes_off),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -46,6 +46,10 @@ OCL_ICD_VENDORS="$T/no_icd" "$M" allpairs "$MESH" -o "$T/fb.npy" --sources "$T/s
 [ "$(grep -c "falling back to threads" "$T/err_fb.txt")" -eq 1 ] || fail "fallback line"
 grep -q "backend threads" "$T/err_fb.txt" || fail "fallback summary"
 cmp "$T/fb.npy" "$T/d_serial.npy" || fail "fallback rows differ from serial"
+# memory first: the face walk's rows are the spokes' rows, bit for bit
+"$M" allpairs "$MESH" -o "$T/ns.npy" --sources "$T/src.txt" --dtype float64 --backend threads \
+    --no-spokes --quiet 2>/dev/null || fail "allpairs --no-spokes"
+cmp "$T/ns.npy" "$T/d_serial.npy" || fail "--no-spokes rows differ"
 OCL_ICD_VENDORS="$T/no_icd" "$M" allpairs "$MESH" -o "$T/x.npy" --backend opencl 2>/dev/null \
     && fail "opencl without a platform succeeded"
 [ -e "$T/x.npy" ] && fail "file written by a failed run"

@@ -148,6 +148,7 @@ BAD = [
      "MeshError", ["4294967297"]),
     ("F repeated vertex", "G = F.copy(); G[6] = (1, 1, 2); meshfmm.Mesh(V, G)", "MeshError", ["6"]),
     ("max_unfold_steps 0", "meshfmm.Mesh(V, F, max_unfold_steps=0)", "MeshError", []),
+    ("spokes 2", "meshfmm.Mesh(V, F, spokes=2)", "TypeError", ["spokes"]),
     ("source -1", "m.distance(-1)", "ValueError", ["-1"]),
     ("source nv", "m.distance(len(V))", "ValueError", [str(16)]),
     ("source 2**40", "m.distance(2**40)", "ValueError", ["1099511627776"]),

@@ -409,3 +409,27 @@ def test_exact_start_is_passed_through_and_part_of_the_job(hand, client, tmp_pat
     with pytest.raises(ValueError):
         md.distance_matrix(hand, str(tmp_path / "bad.zarr"), sources=src, client=client,
                            progress=False, exact_start=-1.0)
+
+
+def test_mesh_options_reach_the_workers_and_the_job(hand, client, tmp_path):
+    """The workers build the caller's mesh, options included: one unfolding
+    step changes the rows of hand_lowres (an obtuse corner keeps its plain
+    stencil), and the job records it, so that a store is not resumed with
+    another mesh. spokes=False gives the same rows."""
+    V, F = hand.vertices, hand.faces
+    short = meshfmm.Mesh(V, F, max_unfold_steps=1)
+    src = SOURCES[:24]
+    ref = short.distance_matrix(src, backend="serial", dtype="float64")
+    assert not np.array_equal(ref, hand.distance_matrix(src, backend="serial", dtype="float64"))
+    store = str(tmp_path / "short.zarr")
+    Z = md.distance_matrix(short, store, sources=src, client=client, dtype="float64",
+                           block_rows=8, progress=False)
+    assert np.array_equal(Z[:], ref)
+    assert Z.attrs[md.JOB_ATTR]["max_unfold_steps"] == 1
+    with pytest.raises(ValueError, match="max_unfold_steps"):
+        md.distance_matrix(hand, store, sources=src, client=client, dtype="float64",
+                           progress=False)
+    lean = meshfmm.Mesh(V, F, spokes=False)
+    Z = md.distance_matrix(lean, str(tmp_path / "lean.zarr"), sources=src, client=client,
+                           dtype="float64", block_rows=8, progress=False)
+    assert np.array_equal(Z[:], hand.distance_matrix(src, backend="serial", dtype="float64"))

@@ -159,6 +159,21 @@ def test_copy_then_close_one_other_works():
     assert proc.stdout.strip() == "ok"
 
 
+def test_spokes_off_gives_the_same_rows_and_survives_copies():
+    """Mesh(spokes=False), memory first: the march walks the faces instead
+    of the spokes, the same rows bit for bit (one march, two readings of
+    the mesh), and copies keep the choice."""
+    V, F = meshfmm.load_mesh(HERE.parent / "data" / "meshes" / "wingnut.obj")
+    on, off = meshfmm.Mesh(V, F), meshfmm.Mesh(V, F, spokes=False)
+    src = np.arange(0, len(V), 97)
+    np.testing.assert_array_equal(off.distance_matrix(src, dtype="float64"),
+                                  on.distance_matrix(src, dtype="float64"))
+    np.testing.assert_array_equal(off.distance(3), on.distance(3))
+    c = pickle.loads(pickle.dumps(off))
+    assert c._options() == {"max_unfold_steps": None, "spokes": False}
+    np.testing.assert_array_equal(c.distance(5), on.distance(5))
+
+
 @pytest.mark.parametrize("how", ["copy", "deepcopy", "pickle"])
 def test_copies_are_equal_and_independent(how):
     V, F = grid(5)

@@ -128,7 +128,7 @@ class mfmm_error(Structure):
 # Option structs start with struct_size (set by their C _init function, which
 # the package always calls before setting fields).
 class mfmm_mesh_options(Structure):
-    _fields_ = [("struct_size", c_size_t), ("max_unfold_steps", c_int32)]
+    _fields_ = [("struct_size", c_size_t), ("max_unfold_steps", c_int32), ("spokes", c_int32)]
 
 
 class mfmm_mesh_info(Structure):

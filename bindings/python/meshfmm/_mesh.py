@@ -280,6 +280,10 @@ class Mesh:
     turns into integer ``(m, 3)`` (0-based vertex ids; int64 accepted when the
     values fit). Both are copied. ``max_unfold_steps`` bounds the unfolding
     walk that finds the virtual edge of an obtuse corner (default 64).
+    ``spokes=False`` puts memory first: the march then never builds its
+    per-vertex update records (about 420 bytes per vertex, built on the
+    first solve and kept with the mesh) and walks the faces instead, with
+    the same results bit for bit and a march about 1.25x as long.
 
     ``Mesh(obj)``: any object with ``.vertices`` and ``.faces`` (a
     ``trimesh.Trimesh``, for one). ``Mesh.from_file(path)`` reads a file.
@@ -299,7 +303,8 @@ class Mesh:
     closing one copy leaves the others working.
     """
 
-    def __init__(self, V: Any, F: Any = None, *, max_unfold_steps: Optional[int] = None) -> None:
+    def __init__(self, V: Any, F: Any = None, *, max_unfold_steps: Optional[int] = None,
+                 spokes: bool = True) -> None:
         self._ptr: Optional[int] = None
         if F is None:
             # Mesh(obj): anything with .vertices and .faces (a trimesh.Trimesh,
@@ -311,6 +316,9 @@ class Mesh:
                 )
             V, F = V.vertices, V.faces
         self._max_unfold_steps = max_unfold_steps
+        if not isinstance(spokes, (bool, np.bool_)):
+            raise TypeError(f"spokes must be True or False, got {spokes!r}")
+        self._spokes = bool(spokes)
         self._lock = threading.Lock()
         self._active = 0
         self._solvers: List[int] = []
@@ -355,6 +363,7 @@ class Mesh:
         _lib.mfmm_mesh_options_init(byref(opts))
         if max_unfold_steps is not None:
             opts.max_unfold_steps = _as_index(max_unfold_steps, "max_unfold_steps")
+        opts.spokes = int(self._spokes)
         err = _lib.mfmm_error()
         out = ctypes.c_void_p()
         status = _lib.mfmm_mesh_create(
@@ -379,7 +388,7 @@ class Mesh:
 
     # ---- copies and pickling: by vertices, faces and options, never the C pointer
     def _options(self) -> dict:
-        return {"max_unfold_steps": self._max_unfold_steps}
+        return {"max_unfold_steps": self._max_unfold_steps, "spokes": self._spokes}
 
     def __reduce__(self) -> Tuple[Any, ...]:
         if self._ptr is None:
