@@ -266,11 +266,20 @@ MFMM_INLINE void mfmm_march_offer_to(mfmm_march_state *s, const mfmm_march_mesh 
     if (t < s->T[c]) {
         mfmm_u8 st = lc & MFMM_STATE_MASK;
         /* c joins the front: its own spokes or faces are read when it
-         * settles */
+         * settles. Its spokes (~7 lines) are fetched now, long before
+         * (measured, bench_spokes: one line -> six, march nefertiti -9 %,
+         * sine 500 -14 %, camelhead within noise; from a cold cache -12 to
+         * -20 %; eight no better, a loop to the exact end slower) */
         if (st == MFMM_FAR) {
-            if (spokes)
-                MFMM_PREFETCH(m->spokes + m->spoke_offset[c]);
-            else
+            if (spokes) {
+                MFMM_GLOBAL const char *b = (MFMM_GLOBAL const char *)(m->spokes + m->spoke_offset[c]);
+                MFMM_PREFETCH(b);
+                MFMM_PREFETCH(b + 64);
+                MFMM_PREFETCH(b + 128);
+                MFMM_PREFETCH(b + 192);
+                MFMM_PREFETCH(b + 256);
+                MFMM_PREFETCH(b + 320);
+            } else
                 MFMM_PREFETCH(m->wedge + m->wedge_offset[c]);
         }
         s->T[c] = t;
