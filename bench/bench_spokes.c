@@ -10,6 +10,15 @@
  * 0.1 ms (hand) to 69 ms (251k); no entry differs. Session 14's probe of
  * the same records (bench history) measured 0.73-0.79x; 72-byte records
  * 0.77-0.87x; an indexed form (two 4-byte face slots per spoke) 0.92-1.04x.
+ * Session 16: each triangle's 1/c^2 and sin theta stored in the spoke (88
+ * bytes, the same rows bit for bit: no division and one sqrt fewer per
+ * update) ran 0.82-0.86x against 0.80-0.83x for 56 bytes in the same run:
+ * the march waits on memory, not on the divider. Prefetching six lines of a
+ * vertex's spokes when it joins the front (march.h, mfmm_march_offer_to):
+ * spokes nefertiti 4.00-4.15 -> 3.64-3.80 ms, sine 500 32.7-33.5 -> 27.9-28.1,
+ * camelhead, spot, hand within noise; with a 64 MB write between runs (a
+ * cold cache, a probe): camelhead 1.45-1.50 -> 1.16-1.24, nefertiti
+ * 4.90-5.06 -> 4.20-4.32.
  *
  *   bench_spokes [--repeats R] [--sources S] MESH... */
 #include <stdio.h>
