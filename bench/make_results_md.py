@@ -498,10 +498,16 @@ def plan_section(pl, cl, co):
     node_h = core_h / cores / eff_used
     chunk = br * n * 4
     mesh_mib = pl["rss_mib"]["after_mesh"] - pl["rss_mib"]["with_v_f"]
+    # a worker's mesh once it has marched: + spokes, exact tables, a workspace
+    # (older plan_1m.json files lack it: the mesh alone)
+    held_mib = pl["rss_mib"].get("after_first_row", pl["rss_mib"]["after_mesh"]) \
+        - pl["rss_mib"]["with_v_f"]
     vf_mib = pl["v_f_bytes"] / 2**20
     task_mib = 3 * chunk / 2**20  # the block, its encoded copy, zarr's buffer
-    per_proc = pl["dask_worker_idle_rss_mib"] + vf_mib + mesh_mib + task_mib
-    per_node_threads = pl["dask_worker_idle_rss_mib"] + vf_mib + mesh_mib + cores * task_mib
+    per_proc = pl["dask_worker_idle_rss_mib"] + vf_mib + held_mib + task_mib
+    ws_mib = 37 * n / 2**20  # a march's workspace (the matrix backends' 37 B per vertex)
+    per_node_threads = (pl["dask_worker_idle_rss_mib"] + vf_mib + held_mib + cores * task_mib
+                        + (cores - 1) * ws_mib)
     sched = tasks * pl["dask_seconds_per_noop_task"]
     bw = cores * n / t * 4 / lz  # compressed bytes/s a node writes
     per_task_s = br * t
@@ -522,6 +528,8 @@ def plan_section(pl, cl, co):
          f"| best of {pl.get('repeats', 2)} blocks of {pl['rows_timed']} contiguous rows |",
          f"| mesh build on a worker | {pl['mesh_build_seconds']:.1f} s, {mesh_mib:.0f} MiB | m | "
          "`Mesh(V, F)`, resident memory before/after |",
+         f"| the mesh once it has marched | {held_mib:.0f} MiB | m | + the spokes and the exact "
+         "start's tables its first row builds and keeps, and a row's workspace (after one row) |",
          f"| compression ratio, float32, this mesh | lz4 {lz:.2f}, zstd {zs:.2f} | m | rows above, "
          "bit shuffle |"]
     if real and real[0]:
@@ -558,9 +566,10 @@ def plan_section(pl, cl, co):
           + f" | x | core-hours / {cores} / {eff_used * 100:.0f} % efficiency (measured on 2 "
           "cores; assumed to hold per node) |",
           f"| memory, 16 processes x 1 thread per node | {per_proc / 1024:.2f} GiB per worker, "
-          f"{cores * per_proc / 1024:.1f} GiB per node | x | idle worker + V, F + mesh + 3 chunks |",
+          f"{cores * per_proc / 1024:.1f} GiB per node | x | idle worker + V, F + marched mesh + 3 chunks |",
           f"| memory, 1 process x 16 threads per node | {per_node_threads / 1024:.1f} GiB per node "
-          "| x | one mesh per worker process, shared by its threads |",
+          "| x | one marched mesh per worker process, shared by its threads; 3 chunks and a "
+          "workspace (37 B/vertex) per thread |",
           f"| write bandwidth | {fbytes(bw)}/s per node, compressed | x | {cores} x N / time per "
           "row x 4 B / ratio |",
           "", "Steps:", "",

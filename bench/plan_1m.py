@@ -67,6 +67,11 @@ def main() -> None:
 
     # warm-up row (page faults of the solver's arrays), not timed
     mesh.distance_matrix(np.array([0], np.int32), backend="threads", n_threads=1)
+    # what a worker holds once it has computed a row: the mesh, the tables
+    # its first march builds and keeps (spokes, the exact start's), a workspace
+    rss_row = rss_mib()
+    print(f"after the first row (spokes, exact tables, workspace): RSS {rss_row:.0f} MiB",
+          flush=True)
     r0 = int(rng.integers(0, nv - a.rows))
     src = np.arange(r0, r0 + a.rows, dtype=np.int32)
     t_rows = float("inf")
@@ -115,6 +120,7 @@ def main() -> None:
            "seconds_per_row_1_thread": per_row,
            "rss_mib": {"after_import": rss0, "with_v_f": rss_vf,
                                                             "after_mesh": rss_mesh,
+                                                            "after_first_row": rss_row,
                                                             "after_block": rss_block},
            "v_f_bytes": vf_bytes, "dask_worker_idle_rss_mib": worker_rss,
            "dask_seconds_per_noop_task": per_task,
