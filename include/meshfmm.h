@@ -171,6 +171,21 @@ MFMM_API mfmm_status mfmm_mesh_get_info(const mfmm_mesh *mesh, mfmm_mesh_info *i
 MFMM_API int32_t mfmm_mesh_vertex_count(const mfmm_mesh *mesh);
 MFMM_API int32_t mfmm_mesh_face_count(const mfmm_mesh *mesh);
 
+/* The memory a mesh holds, array by array (workspaces of solvers and
+ * matrix calls apart).
+ *   names: (max,) receives each array's name, a static string of the
+ *          library (never freed);
+ *   bytes: (max,) receives its size in bytes;
+ *   max:   room in names and bytes; 0 (with NULL arrays) to ask for the count.
+ * Returns the number of arrays, all of them even past max; -1 when mesh is
+ * NULL, max < 0, or names or bytes is NULL with max > 0. Two entries are
+ * built on first use and kept with the mesh, and count 0 until then:
+ * "spokes (once built)" (the march's update records, mfmm_mesh_options.spokes)
+ * and "exact tables (once built)" (the exact start and mfmm_solve_exact).
+ * Safe to call while other threads solve on the mesh. */
+MFMM_API int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes,
+                              int max);
+
 /* --------------------------------------------------------------- sources */
 
 /* A source: a vertex (face == -1), or a point inside a face given by

@@ -11,7 +11,8 @@ static void help(FILE *out)
             "Reads MESH (.obj, .off, .ply, .stl) and prints its counts: vertices, faces, edges,\n"
             "boundary and non-manifold edges, components, unreferenced vertices,\n"
             "degenerate faces, obtuse corners, virtual edges found by unfolding and\n"
-            "unfolding failures, edge lengths and the bounding-box diagonal.\n\n"
+            "unfolding failures, edge lengths, the bounding-box diagonal, and the bytes\n"
+            "the built mesh holds (mfmm_mesh_memory).\n\n"
             "  --json                 one JSON object instead of text\n"
             "  --max-unfold-steps N   faces one unfolding walk may cross (default 64)\n");
 }
@@ -71,6 +72,12 @@ int cmd_info(int argc, char **argv)
         return CLI_FAIL;
     mfmm_mesh_info m;
     mfmm_status st = mfmm_mesh_get_info(mesh, &m);
+    /* the built mesh's bytes (the tables a first solve adds are 0 here) */
+    const char *names[32];
+    size_t bytes[32], mesh_bytes = 0;
+    int n_arrays = mfmm_mesh_memory(mesh, names, bytes, 32);
+    for (int i = 0; i < n_arrays && i < 32; i++)
+        mesh_bytes += bytes[i];
     mfmm_mesh_destroy(mesh);
     if (st != MFMM_OK) {
         cli_error("%s: %s", path, mfmm_status_string(st));
@@ -84,12 +91,12 @@ int cmd_info(int argc, char **argv)
                "\"degenerate_faces\": %d, \"obtuse_corners\": %d, \"virtual_edges\": %d, "
                "\"unfold_failures\": %d, \"min_edge_length\": %.17g, "
                "\"max_edge_length\": %.17g, \"mean_edge_length\": %.17g, "
-               "\"bbox_diagonal\": %.17g}\n",
+               "\"bbox_diagonal\": %.17g, \"mesh_bytes\": %.0f}\n",
                (int)m.n_vertices, (int)m.n_faces, (int)m.n_edges, (int)m.n_boundary_edges,
                (int)m.n_nonmanifold_edges, (int)m.n_components, (int)m.n_unreferenced_vertices,
                (int)m.n_degenerate_faces, (int)m.n_obtuse_corners, (int)m.n_virtual_edges,
                (int)m.n_unfold_failures, m.min_edge_length, m.max_edge_length,
-               m.mean_edge_length, m.bbox_diagonal);
+               m.mean_edge_length, m.bbox_diagonal, (double)mesh_bytes);
     } else {
         printf("file:                  %s\n", path);
         printf("vertices:              %d\n", (int)m.n_vertices);
@@ -107,6 +114,9 @@ int cmd_info(int argc, char **argv)
         printf("edge length max:       %.6g\n", m.max_edge_length);
         printf("edge length mean:      %.6g\n", m.mean_edge_length);
         printf("bbox diagonal:         %.6g\n", m.bbox_diagonal);
+        printf("mesh memory:           %.1f MB (%.0f bytes per vertex; a first solve adds\n"
+               "                       its spokes and exact tables, about 750 more)\n",
+               (double)mesh_bytes / 1e6, (double)mesh_bytes / (m.n_vertices > 0 ? m.n_vertices : 1));
     }
     if (fflush(stdout) != 0) {
         cli_error("cannot write to standard output");

@@ -612,6 +612,8 @@ void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_locat
 
 int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, int max)
 {
+    if (!mesh || max < 0 || (max > 0 && (!names || !bytes)))
+        return -1;
     size_t nv = (size_t)mesh->nv, nf = (size_t)mesh->nf, nc = 3 * nf;
     size_t n_virts = (size_t)mesh->n_virts, n_steps = (size_t)mesh->virt_strip[n_virts];
     /* the exact tables may be built by another thread meanwhile (mesh.h) */

@@ -165,11 +165,6 @@ int mfmm_strip_next(mfmm_strip_walk *w, mfmm_virt_step *step);
 void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_location,
                        double *uniform);
 
-/* The bytes a built mesh holds, array by array (issue 13.3): up to `max`
- * entries of (name, bytes) into names/bytes; returns the number of arrays
- * (all of them, even past max). */
-int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, int max);
-
 /* Fills err (if any) and returns status. */
 mfmm_status mfmm_fail(mfmm_error *err, mfmm_status status, int64_t index, const char *fmt, ...)
 #ifdef __GNUC__

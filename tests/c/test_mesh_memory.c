@@ -2,7 +2,7 @@
  * shared mesh and on generated sine and sphere meshes, counted array by
  * array (mfmm_mesh_memory); and the virtual edges' strips, which the mesh
  * keeps only as their vertices (mesh.h), re-walked (mfmm_strip_next) to the
- * same virtual edge the build found. */
+ * same virtual edge the build found; the public report's contract. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -138,10 +138,66 @@ static void test_strips_rewalk(void **state)
     }
 }
 
+/* The entry of that name in a full report; fails if absent. */
+static size_t entry(const char **names, const size_t *bytes, int n, const char *name)
+{
+    for (int i = 0; i < n; i++)
+        if (!strcmp(names[i], name))
+            return bytes[i];
+    fail_msg("the memory report has no entry \"%s\"", name);
+    return 0;
+}
+
+/* The public report's contract (meshfmm.h): the count alone, refusals,
+ * a partial fill, sizes that follow from nv and nf alone (analytic), and
+ * the tables built on first use counted 0 until the first solve builds them. */
+static void test_public_report(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh g = mfmm_gen_sine(20);
+    mfmm_mesh *mesh = tm_make(&g);
+    size_t nv = (size_t)g.nv, nf = (size_t)g.nf;
+    int n = mfmm_mesh_memory(mesh, NULL, NULL, 0);
+    assert_true(n >= 12 && n <= 32);
+    const char *names[32], *few[2] = {NULL, NULL};
+    size_t bytes[32], few_bytes[2] = {0, 0};
+    assert_int_equal(mfmm_mesh_memory(NULL, names, bytes, 32), -1);
+    assert_int_equal(mfmm_mesh_memory(mesh, names, bytes, -1), -1);
+    assert_int_equal(mfmm_mesh_memory(mesh, NULL, bytes, 32), -1);
+    assert_int_equal(mfmm_mesh_memory(mesh, names, NULL, 32), -1);
+    assert_int_equal(mfmm_mesh_memory(mesh, few, few_bytes, 1), n);
+    assert_int_equal(mfmm_mesh_memory(mesh, names, bytes, 32), n);
+    assert_string_equal(few[0], names[0]);
+    assert_int_equal(few_bytes[0], bytes[0]);
+    assert_null(few[1]);
+    assert_int_equal(entry(names, bytes, n, "xyz"), 24 * nv);
+    assert_int_equal(entry(names, bytes, n, "to_internal/to_external"), 8 * nv);
+    assert_int_equal(entry(names, bytes, n, "face_to_internal/external"), 8 * nf);
+    assert_int_equal(entry(names, bytes, n, "face_neighbor"), 12 * nf);
+    assert_int_equal(entry(names, bytes, n, "spokes (once built)"), 0);
+    assert_int_equal(entry(names, bytes, n, "exact tables (once built)"), 0);
+    /* a default solve (spokes, exact start) builds both and keeps them */
+    double *d = malloc(nv * sizeof *d);
+    assert_non_null(d);
+    mfmm_solver *solver = NULL;
+    assert_int_equal(mfmm_solver_create(mesh, &solver), MFMM_OK);
+    mfmm_source src = tm_vertex_source(0);
+    assert_int_equal(mfmm_solve(solver, &src, 1, NULL, d, NULL), MFMM_OK);
+    assert_int_equal(mfmm_mesh_memory(mesh, names, bytes, 32), n);
+    assert_true(entry(names, bytes, n, "spokes (once built)") > 0);
+    assert_true(entry(names, bytes, n, "exact tables (once built)") > 0);
+    assert_int_equal(entry(names, bytes, n, "xyz"), 24 * nv);
+    mfmm_solver_destroy(solver);
+    free(d);
+    mfmm_mesh_destroy(mesh);
+    mfmm_gen_free(&g);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_strips_rewalk),
+        cmocka_unit_test(test_public_report),
         cmocka_unit_test(test_shared_meshes_within_budget),
         cmocka_unit_test(test_generated_meshes_within_budget),
     };

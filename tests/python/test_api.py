@@ -79,6 +79,31 @@ def test_properties_and_info():
     assert set(info.as_dict()) >= {"n_virtual_edges", "n_unfold_failures", "mean_edge_length"}
 
 
+def test_memory_report():
+    """Mesh.memory(): the C report (mfmm_mesh_memory), sizes that follow from
+    the counts alone; the tables a march builds count from the first solve
+    (spokes only with spokes=True)."""
+    V, F = grid(6)
+    for spokes in (True, False):
+        m = meshfmm.Mesh(V, F, spokes=spokes)
+        mem = m.memory()
+        nv, nf = m.n_vertices, m.n_faces
+        assert mem["xyz"] == 24 * nv
+        assert mem["to_internal/to_external"] == 8 * nv
+        assert mem["face_to_internal/external"] == 8 * nf
+        assert mem["face_neighbor"] == 12 * nf
+        assert mem["spokes (once built)"] == 0 and mem["exact tables (once built)"] == 0
+        assert all(isinstance(b, int) and b >= 0 for b in mem.values())
+        m.distance(0)
+        after = m.memory()
+        assert (after["spokes (once built)"] > 0) == spokes
+        assert after["exact tables (once built)"] > 0
+        assert sum(after.values()) > sum(mem.values())
+        m.close()
+        with pytest.raises(ValueError, match="closed"):
+            m.memory()
+
+
 def test_distance_results():
     V, F = grid(8)
     m = meshfmm.Mesh(V, F)

@@ -7,6 +7,7 @@ and the Python package's library must be built from the same tree.
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
@@ -16,7 +17,7 @@ import numpy as np
 import pytest
 
 import meshfmm
-from conftest import REPO, load, mesh, need_data
+from conftest import MESHES, REPO, load, mesh, need_data
 
 
 def find_cli():
@@ -105,3 +106,14 @@ def test_path_straighten_flag(cli, tmp_path):
         p = m.geodesic_path(d, 1500, sources=[77], straighten=straighten)
         assert lengths[straighten] == pytest.approx(p.length, rel=1e-12)
     assert lengths[True] <= lengths[False]
+
+
+def test_info_json_mesh_bytes(cli, tmp_path):
+    """info --json's mesh_bytes: the built mesh's bytes, as Mesh.memory()
+    reports them for the same mesh (before any solve)."""
+    need_data()
+    path = MESHES / "hand_lowres.obj"
+    got = json.loads(run(cli, "info", "--json", path).stdout)
+    want = sum(meshfmm.Mesh.from_file(path).memory().values())
+    assert got["mesh_bytes"] == want
+    assert got["vertices"] == 810

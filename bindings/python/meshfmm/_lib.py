@@ -366,6 +366,12 @@ mfmm_mesh_destroy = _proto("mfmm_mesh_destroy", None, [c_void_p])
 mfmm_mesh_get_info = _proto("mfmm_mesh_get_info", c_enum, [c_void_p, P(mfmm_mesh_info)])
 mfmm_mesh_vertex_count = _proto("mfmm_mesh_vertex_count", c_int32, [c_void_p])
 mfmm_mesh_face_count = _proto("mfmm_mesh_face_count", c_int32, [c_void_p])
+mfmm_mesh_memory = _proto(
+    "mfmm_mesh_memory",
+    c_int,
+    # mesh, names (const char **), bytes (size_t *), max
+    [c_void_p, P(c_char_p), P(c_size_t), c_int],
+)
 # solver
 mfmm_solver_create = _proto("mfmm_solver_create", c_enum, [c_void_p, P(c_void_p)])
 mfmm_solver_destroy = _proto("mfmm_solver_destroy", None, [c_void_p])

@@ -17,7 +17,7 @@ import os
 import signal
 import threading
 from ctypes import byref
-from typing import Any, Callable, Iterator, List, NamedTuple, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterator, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -489,6 +489,22 @@ class Mesh:
         virtual edges and failed unfoldings; edge lengths; bounding-box
         diagonal (:class:`MeshInfo`)."""
         return self._info
+
+    def memory(self) -> Dict[str, int]:
+        """The bytes the mesh holds, array by array (mfmm_mesh_memory), as an
+        ordered dict of name -> bytes; ``sum(mesh.memory().values())`` is the
+        total. "spokes (once built)" and "exact tables (once built)" are 0
+        until the first solve that builds them (then kept with the mesh);
+        solver workspaces are not counted. Raises ValueError on a closed mesh."""
+        ptr = self._enter()
+        try:
+            n = _lib.mfmm_mesh_memory(ptr, None, None, 0)
+            names = (ctypes.c_char_p * n)()
+            sizes = (ctypes.c_size_t * n)()
+            n = _lib.mfmm_mesh_memory(ptr, names, sizes, n)
+        finally:
+            self._leave()
+        return {names[i].decode(): int(sizes[i]) for i in range(n)}
 
     def __repr__(self) -> str:
         state = "closed" if self._ptr is None else f"{self._nv} vertices, {self._nf} faces"
