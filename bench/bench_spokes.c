@@ -19,6 +19,15 @@
  * camelhead, spot, hand within noise; with a 64 MB write between runs (a
  * cold cache, a probe): camelhead 1.45-1.50 -> 1.16-1.24, nefertiti
  * 4.90-5.06 -> 4.20-4.32.
+ * Session 17 probes (spokes march, two rounds against the same tree built
+ * apart): the 8 children of a heap node scanned by SSE2 (4 minpd, a
+ * movemask for the first least): camelhead 1.04-1.05 -> 1.06-1.08 ms,
+ * nefertiti 3.76 -> 3.59-3.63, hand equal: not kept. A spoke loop in two
+ * passes (the t of up to 16 spokes, then their offers in order: the same
+ * rows): camelhead 1.06 -> 1.26 ms, nefertiti 3.80 -> 4.60, hand +20 %,
+ * sine 316 (100k) +1 %: not kept. The update arithmetic replaced by a
+ * multiply-add (wrong rows, bench_solve): camelhead -23 %, sine 316 -7 %:
+ * on meshes that fit in cache a quarter of the march is the update's chain.
  *
  *   bench_spokes [--repeats R] [--sources S] MESH... */
 #include <stdio.h>
