@@ -138,16 +138,6 @@ static void test_strips_rewalk(void **state)
     }
 }
 
-/* The entry of that name in a full report; fails if absent. */
-static size_t entry(const char **names, const size_t *bytes, int n, const char *name)
-{
-    for (int i = 0; i < n; i++)
-        if (!strcmp(names[i], name))
-            return bytes[i];
-    fail_msg("the memory report has no entry \"%s\"", name);
-    return 0;
-}
-
 /* The public report's contract (meshfmm.h): the count alone, refusals,
  * a partial fill, sizes that follow from nv and nf alone (analytic), and
  * the tables built on first use counted 0 until the first solve builds them. */
@@ -170,12 +160,12 @@ static void test_public_report(void **state)
     assert_string_equal(few[0], names[0]);
     assert_int_equal(few_bytes[0], bytes[0]);
     assert_null(few[1]);
-    assert_int_equal(entry(names, bytes, n, "xyz"), 24 * nv);
-    assert_int_equal(entry(names, bytes, n, "to_internal/to_external"), 8 * nv);
-    assert_int_equal(entry(names, bytes, n, "face_to_internal/external"), 8 * nf);
-    assert_int_equal(entry(names, bytes, n, "face_neighbor"), 12 * nf);
-    assert_int_equal(entry(names, bytes, n, "spokes (once built)"), 0);
-    assert_int_equal(entry(names, bytes, n, "exact tables (once built)"), 0);
+    assert_int_equal(tm_memory_entry(mesh, "xyz"), 24 * nv);
+    assert_int_equal(tm_memory_entry(mesh, "to_internal/to_external"), 8 * nv);
+    assert_int_equal(tm_memory_entry(mesh, "face_to_internal/external"), 8 * nf);
+    assert_int_equal(tm_memory_entry(mesh, "face_neighbor"), 12 * nf);
+    assert_int_equal(tm_memory_entry(mesh, "spokes (once built)"), 0);
+    assert_int_equal(tm_memory_entry(mesh, "exact tables (once built)"), 0);
     /* a default solve (spokes, exact start) builds both and keeps them */
     double *d = malloc(nv * sizeof *d);
     assert_non_null(d);
@@ -184,9 +174,9 @@ static void test_public_report(void **state)
     mfmm_source src = tm_vertex_source(0);
     assert_int_equal(mfmm_solve(solver, &src, 1, NULL, d, NULL), MFMM_OK);
     assert_int_equal(mfmm_mesh_memory(mesh, names, bytes, 32), n);
-    assert_true(entry(names, bytes, n, "spokes (once built)") > 0);
-    assert_true(entry(names, bytes, n, "exact tables (once built)") > 0);
-    assert_int_equal(entry(names, bytes, n, "xyz"), 24 * nv);
+    assert_true(tm_memory_entry(mesh, "spokes (once built)") > 0);
+    assert_true(tm_memory_entry(mesh, "exact tables (once built)") > 0);
+    assert_int_equal(tm_memory_entry(mesh, "xyz"), 24 * nv);
     mfmm_solver_destroy(solver);
     free(d);
     mfmm_mesh_destroy(mesh);

@@ -149,14 +149,7 @@ static void test_generated_meshes(void **state)
 /* The memory report's entry for the spokes (the test fails if it has none). */
 static size_t spoke_bytes(const mfmm_mesh *mesh)
 {
-    const char *names[32];
-    size_t bytes[32];
-    int n = mfmm_mesh_memory(mesh, names, bytes, 32);
-    for (int i = 0; i < n && i < 32; i++)
-        if (!strcmp(names[i], "spokes (once built)"))
-            return bytes[i];
-    fail_msg("the memory report has no spokes entry");
-    return 0;
+    return tm_memory_entry(mesh, "spokes (once built)");
 }
 
 /* The memory report names the spokes once a march has built them. */

@@ -10,6 +10,18 @@
 
 #include "testutil.h"
 
+size_t tm_memory_entry(const mfmm_mesh *mesh, const char *name)
+{
+    const char *names[32];
+    size_t bytes[32];
+    int n = mfmm_mesh_memory(mesh, names, bytes, 32);
+    for (int i = 0; i < n && i < 32; i++)
+        if (!strcmp(names[i], name))
+            return bytes[i];
+    fail_msg("the memory report has no entry \"%s\"", name);
+    return 0;
+}
+
 mfmm_mesh *tm_make(const mfmm_gen_mesh *m)
 {
     assert_non_null(m->V);

@@ -28,6 +28,10 @@ mfmm_mesh *tm_make(const mfmm_gen_mesh *m);
 /* One vertex source, value 0. */
 mfmm_source tm_vertex_source(int32_t v);
 
+/* The bytes of the array `name` in mesh's memory report (mfmm_mesh_memory);
+ * fails the test if the report has no such entry. */
+size_t tm_memory_entry(const mfmm_mesh *mesh, const char *name);
+
 /* The vertex nearest to p. */
 int32_t tm_nearest_vertex(const mfmm_gen_mesh *m, const double p[3]);
 
