@@ -3,7 +3,11 @@
  * (issue 13): a plain Dijkstra over the march's own edge graph (every vertex's
  * update list, each neighbour once, edge lengths precomputed), with the same
  * 8-ary heap, vertex order and per-solve reset. ratio = march time / Dijkstra
- * time. Usage:
+ * time. With unfolding (the march over spokes) it also times the spoke walk
+ * with its edge updates alone, which splits the ratio in two: the spoke
+ * records against the graph's edges (records = edges-only walk / Dijkstra)
+ * and the triangles' updates (updates = march / edges-only walk).
+ * Usage:
  *   bench_solve [--repeats R] [--sources S] [--exact-start R] MESH...
  * The march starts plain (the paper's start) unless --exact-start R > 0.
  * With no MESH, the larger meshes of tests/data/meshes and generated spheres. */
@@ -93,6 +97,67 @@ static int32_t dijkstra(const graph *g, mfmm_march_state *s, int32_t v)
     return settled;
 }
 
+/* The march over spokes with the edge updates alone, T(x) + |xc| (the
+ * rows are Dijkstra's over the spokes' edges, not the march's: a split of
+ * the march's time, not a solver): the march's reads of its spoke records,
+ * heap and labels without the triangles. Returns vertices settled. */
+static int32_t spoke_edges(const mfmm_march_mesh *m, mfmm_march_state *s, int32_t v)
+{
+    mfmm_march_reset(s, m->nv);
+    mfmm_march_seed(s, v, 0.0);
+    /* local copies, as the march reads them (march.h, mfmm_march_loop) */
+    mfmm_march_state w = *s;
+    mfmm_march_mesh mm = *m;
+    int32_t settled = 0;
+    while (w.heap_size > 0) {
+        int32_t x = mfmm_march_settle(&w, &settled, 0);
+        if (w.heap_size > 0) {
+            const char *b = (const char *)(mm.spokes + mm.spoke_offset[w.heap_vertex[0]]);
+            const char *e = (const char *)(mm.spokes + mm.spoke_offset[w.heap_vertex[0] + 1]);
+            for (; b < e; b += 64)
+                MFMM_PREFETCH(b);
+        }
+        double tx = w.T[x];
+        for (int32_t j = mm.spoke_offset[x]; j < mm.spoke_offset[x + 1]; j++) {
+            const mfmm_spoke *r = mm.spokes + j;
+            uint8_t lc = w.label[r->c];
+            if ((lc & MFMM_STATE_MASK) != MFMM_ALIVE)
+                mfmm_march_offer_to(&w, &mm, r->c, lc, tx + r->len, 1);
+        }
+    }
+    for (int32_t u = 0; u < m->nv; u++) /* the march's closing pass, for a like count */
+        if (w.label[u] != MFMM_ALIVE)
+            w.T[u] = MFMM_INF;
+    return settled;
+}
+
+/* Median time of spoke_edges over the sources and repeats (NAN without
+ * spokes); *min_out its least. */
+static double spoke_edges_time(const mfmm_mesh *mesh, int repeats, int n_sources, double *times,
+                               double *min_out)
+{
+    mfmm_march_mesh m = mfmm_mesh_march_view(mesh);
+    mfmm_march_state s;
+    double med = NAN;
+    if (bench_state_alloc(&s, (size_t)mesh->nv) &&
+        mfmm_mesh_spokes_of(mesh, &m.spoke_offset, &m.spokes) == MFMM_OK && m.spokes) {
+        int k = 0;
+        for (int q = 0; q < n_sources; q++) {
+            int32_t v = mesh->to_internal[((int64_t)mesh->nv * (2 * q + 1)) / (2 * n_sources)];
+            for (int r = 0; r < repeats; r++) {
+                double t1 = now();
+                spoke_edges(&m, &s, v);
+                times[k++] = now() - t1;
+            }
+        }
+        qsort(times, (size_t)k, sizeof *times, cmp_double);
+        med = times[k / 2];
+        *min_out = times[0];
+    }
+    bench_state_free(&s);
+    return med;
+}
+
 static double ceiling_time(const mfmm_mesh *mesh, int repeats, int n_sources, double *times,
                            double *min_out)
 {
@@ -180,6 +245,14 @@ static void bench(const char *name, const double *V, int32_t nv, const int32_t *
                "  Dijkstra ceiling %8.3f ms  ratio %.2f  (min %8.3f / %8.3f ms, ratio %.2f)\n",
                name, nv, 1e3 * t_build, unfolding, 1e3 * med, settled / med / 1e6,
                1e3 * ceil_med, med / ceil_med, 1e3 * min, 1e3 * ceil_min, min / ceil_min);
+        if (unfolding) {
+            double edges_min = NAN;
+            double edges_med = spoke_edges_time(mesh, repeats, n_sources, times, &edges_min);
+            printf("%-22s nv=%7d   spokes, edge updates alone: median %8.3f ms  records %.2f  updates %.2f"
+                   "  (min %8.3f ms: records %.2f, updates %.2f)\n",
+                   name, nv, 1e3 * edges_med, edges_med / ceil_med, med / edges_med, 1e3 * edges_min,
+                   edges_min / ceil_min, min / edges_min);
+        }
     }
     free(d);
     free(times);

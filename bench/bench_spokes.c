@@ -28,6 +28,22 @@
  * sine 316 (100k) +1 %: not kept. The update arithmetic replaced by a
  * multiply-add (wrong rows, bench_solve): camelhead -23 %, sine 316 -7 %:
  * on meshes that fit in cache a quarter of the march is the update's chain.
+ * Session 18 (bench_solve's split, one run, --repeats 7 --sources 3;
+ * records = the spoke walk with edge updates alone / Dijkstra, updates =
+ * march / that walk): sine 316 (100k) 1.15 x 1.32, igea 1.04 x 1.30,
+ * camelhead 1.23 x 1.41. So "the 100k gap is memory" (session 17) was
+ * wrong: the triangles' updates are the larger share everywhere. Per
+ * settled vertex (sine 316, cachegrind): 2.48 triangles evaluated (one per
+ * face and per virtual triangle: the least any label-setting march can do),
+ * +300 instructions and +2.8 mispredicted branches against the edges-only
+ * walk (y Alive 1.5, the Eq. 5 test 1.4, the min 0.6). Probes, not kept
+ * (same tree, a copy of the loop, min of 7): every triangle evaluated
+ * without branches (+INF for a y not Alive, results by bit masks): the
+ * same rows, 1.5-1.75x slower (7.8 evaluations instead of 2.5); only the
+ * Eq. 5 test and the min without branches: -1.1 mispredictions a vertex
+ * but +3-6 % time (the offer then waits on the square root's chain). The
+ * spokes, T, labels and heap on 2 MB pages (madvise; AnonHugePages 66 MB):
+ * sine 316 and igea within 1 %, sine 1000 (1M) -3 %.
  *
  *   bench_spokes [--repeats R] [--sources S] MESH... */
 #include <stdio.h>
