@@ -44,6 +44,16 @@
  * but +3-6 % time (the offer then waits on the square root's chain). The
  * spokes, T, labels and heap on 2 MB pages (madvise; AnonHugePages 66 MB):
  * sine 316 and igea within 1 %, sine 1000 (1M) -3 %.
+ * Kept (session 18): around a closed fan the first face's p (alone in the
+ * first spoke) is the last face's q (alone in the last): one spoke, the
+ * face walk deferring that p to the fan's end likewise. 7.95 -> 6.96
+ * spokes per vertex on sine 316 (445 -> 394 B), 7.87 -> 6.87 camelhead;
+ * bench_solve ratio, two alternating rounds: camelhead 1.74-1.83 ->
+ * 1.64-1.67, sine 316 1.53 -> 1.43-1.46, igea 1.36-1.38 -> 1.35-1.38; all
+ * pairs (float64, serial, both starts) on two icospheres, hand, beetle,
+ * spot and camelhead equal to the previous core's bit for bit. This run:
+ * spokes / face walk hand 0.76x, spot 0.79x, camelhead 0.79x, nefertiti
+ * 0.75x, sine 500 0.63x.
  *
  *   bench_spokes [--repeats R] [--sources S] MESH... */
 #include <stdio.h>

@@ -108,10 +108,10 @@ typedef struct mfmm_mesh_options {
     int32_t max_unfold_steps;
     /* 1 (default): the march at F = 1 with unfolding reads per-vertex update
      * records ("spokes"), built on the first such solve and kept with the
-     * mesh: about 420 bytes per vertex (mfmm_mesh_memory lists them), for a
-     * march 0.72-0.83x as long. 0: never build them; the march walks the
+     * mesh: about 380 bytes per vertex (mfmm_mesh_memory lists them), for a
+     * march 0.63-0.79x as long. 0: never build them; the march walks the
      * faces instead, with the same results bit for bit (memory first: a
-     * 1M-vertex mesh holds 0.42 GB less). Other values are refused. */
+     * 1M-vertex mesh holds 0.39 GB less). Other values are refused. */
     int32_t spokes;
 } mfmm_mesh_options;
 
@@ -224,9 +224,9 @@ typedef struct mfmm_solver mfmm_solver;
  * the exact start, an exact solver's workspace (about 45 bytes per vertex;
  * the mesh's exact tables, about 156 bytes per face, are built once per mesh
  * and shared: see mfmm_exact_solver_create). The first solve without a cost
- * and with unfolding also builds the mesh's spokes (about 420 bytes per
+ * and with unfolding also builds the mesh's spokes (about 380 bytes per
  * vertex: each neighbour's update data, ready in the order the march reads
- * it, which makes that march about a fifth faster), likewise built once
+ * it, which makes that march 0.63-0.79x as long), likewise built once
  * per mesh under a lock and shared by every solver, thread and job on it
  * (if there is no memory for them, the march reads the faces instead and
  * gives the same distances). After that first solve, solving allocates nothing beyond a copy of

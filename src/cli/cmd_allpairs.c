@@ -49,7 +49,7 @@ static void help(FILE *out)
             "  --plain-start       the paper's start (as --exact-start-radius 0)\n"
             "  --threads N         threads for the threads backend (0, the default: all cores)\n"
             "  --memory MB         memory for workspaces and blocks in flight\n"
-            "  --no-spokes         memory first: no per-vertex update records (~420 bytes\n"
+            "  --no-spokes         memory first: no per-vertex update records (~380 bytes\n"
             "                      per vertex, built once for the march); the same\n"
             "                      matrix, each row's march ~1.25x as long\n"
             "  --quiet             no progress lines\n\n"

@@ -115,7 +115,7 @@ int cmd_info(int argc, char **argv)
         printf("edge length mean:      %.6g\n", m.mean_edge_length);
         printf("bbox diagonal:         %.6g\n", m.bbox_diagonal);
         printf("mesh memory:           %.1f MB (%.0f bytes per vertex; a first solve adds\n"
-               "                       its spokes and exact tables, about 750 more)\n",
+               "                       its spokes and exact tables, about 710 more)\n",
                (double)mesh_bytes / 1e6, (double)mesh_bytes / (m.n_vertices > 0 ? m.n_vertices : 1));
     }
     if (fflush(stdout) != 0) {

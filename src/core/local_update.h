@@ -80,8 +80,9 @@ typedef struct mfmm_virt {
  * the virtual edge's length and cosine. A missing triangle names y = c,
  * which is never Alive when c is updated. x's spokes: first one per virtual
  * edge that ends at x (c its corner, y its A and B), then x's neighbours in
- * fan order, a face's q and the next face's p in one spoke. 56 bytes, C and
- * OpenCL C; about 7.5 per vertex. */
+ * fan order, a face's q and the next face's p in one spoke, the first
+ * face's p last (around a closed fan, with the last face's q). 56 bytes, C
+ * and OpenCL C; one per neighbour and per virtual edge (6.4-7 per vertex). */
 typedef struct mfmm_spoke {
     mfmm_i32 c;
     mfmm_i32 y[2];

@@ -81,6 +81,13 @@ static int32_t vertex_spokes(const mfmm_march_mesh *m, int32_t x, spoke_slot *sl
         sl[ns++] = sp;
         sl[ns++] = sq;
     }
+    /* the first face's p goes last, as the face walk offers it (first):
+     * around a closed fan it is the last face's q, and pairs with it */
+    if (ns >= 2) {
+        spoke_slot s0 = sl[0];
+        memmove(sl, sl + 1, (size_t)(ns - 1) * sizeof *sl);
+        sl[ns - 1] = s0;
+    }
     /* a face's q and the next face's p in one spoke (the face walk's pend) */
     for (int32_t i = 0; i < ns; n++) {
         int pair = i + 1 < ns && sl[i + 1].c == sl[i].c && sl[i + 1].len == sl[i].len;

@@ -281,7 +281,7 @@ class Mesh:
     values fit). Both are copied. ``max_unfold_steps`` bounds the unfolding
     walk that finds the virtual edge of an obtuse corner (default 64).
     ``spokes=False`` puts memory first: the march then never builds its
-    per-vertex update records (about 420 bytes per vertex, built on the
+    per-vertex update records (about 380 bytes per vertex, built on the
     first solve and kept with the mesh) and walks the faces instead, with
     the same results bit for bit and a march about 1.25x as long.
 

@@ -345,7 +345,7 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
 
     mesh: a :class:`meshfmm.Mesh`; shipped to the workers as V and F, with
         its options (``Mesh(..., spokes=False)``: each worker's mesh skips
-        the march's ~420 bytes per vertex of spokes, same rows).
+        the march's ~380 bytes per vertex of spokes, same rows).
     store: a directory path or an fsspec URL (with `storage_options`).
     sources: vertex ids (S,), None for every vertex; targets: vertex ids
         (T,) for the columns, in the given order; None for every vertex.
@@ -596,7 +596,7 @@ def cli_allpairs_zarr(argv: Sequence[str]) -> int:
     ap.add_argument("--no-progress", action="store_true")
     ap.add_argument("--no-spokes", action="store_true",
                     help="memory first: no per-vertex update records on the workers "
-                         "(~420 bytes per vertex each; same matrix, marches ~1.25x as long)")
+                         "(~380 bytes per vertex each; same matrix, marches 1.25-1.6x as long)")
     a = ap.parse_args(list(argv))
     try:
         from ._mesh import load_mesh
