@@ -5,6 +5,7 @@
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <cmocka.h>
 
 #include "core/local_update.h"
@@ -82,12 +83,85 @@ static void test_no_nan(void **state)
     }
 }
 
+/* The update with Eq. 5 tested after the root only (the core before its
+ * bounds on u were read first): a reference for test_bounds_first. */
+static double interior_after_root(double ta, double tb, double a, double b, double cos_c,
+                                  double f)
+{
+    double c2 = a * a + b * b - 2.0 * a * b * cos_c;
+    if (!(c2 > 0.0))
+        return INFINITY;
+    double inv = 1.0 / c2;
+    double beta = a * b * sqrt((1.0 - cos_c) * (1.0 + cos_c)) * inv;
+    double alpha_a = b * (b - a * cos_c) * inv, alpha_b = a * (a - b * cos_c) * inv;
+    int swap = ta > tb;
+    double t0 = swap ? tb : ta, u = swap ? ta - tb : tb - ta;
+    double alpha = swap ? alpha_b : alpha_a;
+    double la = swap ? b : a, lb = swap ? a : b;
+    double d = f * f * c2 - u * u;
+    d = d > 0.0 ? d : 0.0;
+    double t = alpha * u + beta * sqrt(d);
+    if (!(t > u))
+        return INFINITY;
+    double xt = lb * (t - u);
+    if (la * cos_c * t < xt && xt * cos_c < la * t)
+        return t0 + t;
+    return INFINITY;
+}
+
+/* Eq. 5's bounds on u, read before the root, only skip updates that the
+ * test after the root rejects or that an edge update beats: the same
+ * local update (with the edges, as the march always takes it), bit for
+ * bit, on random triangles (sides 1e-3..1e3 apart, angles from 1e-6 to
+ * pi - 1e-6, costs 0.3..3) and arrival times around both bounds. (The
+ * test after the root alone accepts some u > F c on slivers, where no root
+ * exists: t = alpha u, above the edge update.) */
+static void test_bounds_first(void **state)
+{
+    (void)state;
+    uint64_t x = 88172645463325252ull;
+    int accepted = 0, rejected = 0;
+    for (int i = 0; i < 400000; i++) {
+        double r[6];
+        for (int k = 0; k < 6; k++) { /* xorshift64: uniform in [0, 1) */
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            r[k] = (double)(x >> 11) * (1.0 / 9007199254740992.0);
+        }
+        double a = pow(10.0, 6.0 * r[0] - 3.0), b = pow(10.0, 6.0 * r[1] - 3.0);
+        double theta = i % 4 == 0 ? 1e-6 + PI * r[2] * 1e-3 : i % 4 == 1 ? PI - 1e-6 - PI * r[2] * 1e-3 : 1e-6 + (PI - 2e-6) * r[2];
+        double cs = cos(theta), f = 0.3 + 2.7 * r[3];
+        /* u around the upper bound F (b - a cos) or the lower F (b cos - a) */
+        double bound = r[4] < 0.5 ? f * (b - a * cs) : f * (b * cs - a);
+        double u = bound * (1.0 + (r[5] - 0.5) * (i % 2 ? 1e-3 : 2.0));
+        if (u < 0.0)
+            u = -u;
+        double ta = 1.0, tb = 1.0 + u;
+        if (i % 3 == 0) { /* B reached first */
+            ta = 1.0 + u;
+            tb = 1.0;
+        }
+        double edge = fmin(ta + b * f, tb + a * f);
+        double inside = interior_after_root(ta, tb, a, b, cs, f);
+        double want = inside < edge ? inside : edge;
+        double got = mfmm_triangle_update(ta, tb, a, b, cs, f);
+        assert_memory_equal(&got, &want, sizeof got);
+        if (inside < edge)
+            accepted++;
+        else
+            rejected++;
+    }
+    assert_true(accepted > 10000 && rejected > 10000);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_acute_triangles),
         cmocka_unit_test(test_obtuse_triangles),
         cmocka_unit_test(test_no_nan),
+        cmocka_unit_test(test_bounds_first),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
