@@ -54,6 +54,20 @@
  * spot and camelhead equal to the previous core's bit for bit. This run:
  * spokes / face walk hand 0.76x, spot 0.79x, camelhead 0.79x, nefertiti
  * 0.75x, sine 500 0.63x.
+ * Session 19: each triangle's c^2, beta, alpha_A, alpha_B stored in the
+ * spoke (120 bytes, no division or square root but the one on T; the same
+ * rows bit for bit): 1.05-1.12x slower (camelhead, sine 316, igea; a copy
+ * of the loop, min of 7), as session 16's 88 bytes were. Kept: Eq. 5's
+ * bounds on u read before the root (local_update.h). Per settled vertex
+ * (camelhead, sine 316, igea) 2.44, 2.48, 2.19 triangles are evaluated and
+ * Eq. 5 rejects 1.43, 1.47, 1.19 of them: the bounds reject those same
+ * ones (no other), before the division and both square roots, so that
+ * their branch no longer waits on the root. Probe 0.91-0.95x of the spoke
+ * march; bench_solve, two rounds against the tree before: camelhead ratio
+ * 1.63-1.64 -> 1.49-1.50 (updates 1.35 -> 1.24), sine 316 1.43-1.46 ->
+ * 1.34-1.38, igea 1.35-1.36 -> 1.25-1.26; sine 1000 (1M) 107-109 ms with
+ * either tree (memory-bound); all pairs camelhead 2000 rows, 1 core,
+ * 2.56-2.57 -> 2.35-2.38 s.
  *
  *   bench_spokes [--repeats R] [--sources S] MESH... */
 #include <stdio.h>
