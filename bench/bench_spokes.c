@@ -67,7 +67,9 @@
  * 1.63-1.64 -> 1.49-1.50 (updates 1.35 -> 1.24), sine 316 1.43-1.46 ->
  * 1.34-1.38, igea 1.35-1.36 -> 1.25-1.26; sine 1000 (1M) 107-109 ms with
  * either tree (memory-bound); all pairs camelhead 2000 rows, 1 core,
- * 2.56-2.57 -> 2.35-2.38 s.
+ * 2.56-2.57 -> 2.35-2.38 s. Not kept: with the bounds first, every
+ * triangle's y read without a branch (T(y), or +inf where y is not Alive,
+ * by bit masks) so that one branch decides: 1.21-1.26x slower.
  *
  *   bench_spokes [--repeats R] [--sources S] MESH... */
 #include <stdio.h>
