@@ -119,6 +119,7 @@ typedef struct cli_sources_and_cost {
     int32_t n_src;
     double *cost;     /* loaded by cli_sources_and_cost_load */
     double exact_start_radius; /* --exact-start-radius R, --plain-start (0) */
+    int start_given;  /* 1: --plain-start, 2: --exact-start-radius (both: an error) */
 } cli_sources_and_cost;
 
 /* The shared options, for a command's getopt_long table. */
@@ -133,17 +134,22 @@ typedef struct cli_sources_and_cost {
 /* A macro's value as a string literal (help texts quote the library's defaults). */
 #define CLI_STR_(x) #x
 #define CLI_STR(x) CLI_STR_(x)
-/* The help lines of the start options (distance, path, allpairs). */
-#define CLI_START_HELP                                                                       \
+/* The help lines of the start options (distance, path); `when` ends the
+ * auto radius's rule (path has no --max-distance). */
+#define CLI_START_HELP_(when)                                                                \
     "  --exact-start-radius R  start the march from exact distances within R mean\n"        \
     "                          edge lengths of each source (default auto: " CLI_STR(       \
         MFMM_EXACT_START_RADIUS) ", times\n"                                                \
     "                          sqrt(vertices / " CLI_STR(MFMM_EXACT_START_AUTO_VERTICES)    \
-    ") above that size without\n"                                                          \
-    "                          --max-distance)\n"                                          \
+    ") above that size" when "\n"                                                          \
     "  --plain-start           the paper's start (as --exact-start-radius 0)\n"
+#define CLI_START_HELP CLI_START_HELP_(" without\n                          --max-distance)")
+#define CLI_START_HELP_NO_LIMIT CLI_START_HELP_(")")
 /* Parses --exact-start-radius's value: CLI_OK, or CLI_USAGE with the error printed. */
 int cli_parse_start_radius(const char *sub, const char *arg, double *radius);
+/* Records a start option (1: --plain-start, 2: --exact-start-radius) in *given:
+ * CLI_OK, or CLI_USAGE with the error printed when the other one was given too. */
+int cli_start_option(const char *sub, int which, int *given);
 #define CLI_SHARED_SHORT_OPTIONS ":ho:"
 
 /* 0, or -1 with "out of memory" printed. argc: the subcommand's. */

@@ -55,7 +55,8 @@ static void help(FILE *out)
             "  --quiet             no progress lines\n\n"
             "Environment: MESHFMM_OPENCL_DEVICE (device index or name substring),\n"
             "MESHFMM_CACHE_DIR (OpenCL program cache, default ~/.cache/meshfmm).\n"
-            "SIGINT/SIGTERM stop the run, remove the temporary file and exit with 130.\n"
+            "SIGINT, SIGTERM or SIGHUP stop the run, remove the temporary file and exit\n"
+            "with 130.\n"
             "Options take their value as --dtype float64 or --dtype=float64.\n");
 }
 
@@ -202,7 +203,7 @@ int cmd_allpairs(int argc, char **argv)
     mfmm_backend backend = MFMM_BACKEND_AUTO;
     mfmm_mesh_options mo;
     mfmm_mesh_options_init(&mo);
-    int quiet = 0;
+    int quiet = 0, start_given = 0;
     static const struct option longopts[] = {
         {"help", no_argument, NULL, 'h'},
         {"output", required_argument, NULL, 'o'},
@@ -219,6 +220,9 @@ int cmd_allpairs(int argc, char **argv)
         {"plain-start", no_argument, NULL, OPT_PLAIN_START},
         {"exact-start-radius", required_argument, NULL, OPT_EXACT_START_RADIUS},
         {"no-spokes", no_argument, NULL, OPT_NO_SPOKES},
+        /* not an option of allpairs: named so that getopt does not take it
+         * for an abbreviation of --sources */
+        {"source", required_argument, NULL, OPT_SOURCE},
         {NULL, 0, NULL, 0}};
     int c;
     opterr = 0;
@@ -246,7 +250,12 @@ int cmd_allpairs(int argc, char **argv)
             if (!parse_backend(val, &backend))
                 return cli_usage_error("allpairs", "--backend is auto, opencl, serial or threads");
             break;
+        case OPT_SOURCE:
+            return cli_usage_error("allpairs", "takes its rows' sources as --sources FILE (one "
+                                                "source: meshfmm distance --source %s)", val);
         case OPT_SOURCES:
+            if (sources_path)
+                return cli_usage_error("allpairs", "--sources given twice");
             sources_path = val;
             break;
         case OPT_TARGETS:
@@ -267,13 +276,16 @@ int cmd_allpairs(int argc, char **argv)
                 return cli_usage_error("allpairs", "--threads needs a count >= 0 (0: all cores)");
             break;
         case OPT_PLAIN_START:
+            if (cli_start_option("allpairs", 1, &start_given) != CLI_OK)
+                return CLI_USAGE;
             o.exact_start_radius = 0.0;
             break;
         case OPT_NO_SPOKES:
             mo.spokes = 0;
             break;
         case OPT_EXACT_START_RADIUS:
-            if (cli_parse_start_radius("allpairs", val, &o.exact_start_radius) != CLI_OK)
+            if (cli_start_option("allpairs", 2, &start_given) != CLI_OK ||
+                cli_parse_start_radius("allpairs", val, &o.exact_start_radius) != CLI_OK)
                 return CLI_USAGE;
             break;
         case OPT_MEMORY: {

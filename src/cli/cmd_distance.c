@@ -106,9 +106,10 @@ int cmd_distance(int argc, char **argv)
             goto done;
         }
     }
-    if (exact && (o.cost_path || !opt.unfolding)) {
+    if (exact && (o.cost_path || !opt.unfolding || o.start_given)) {
         rc = cli_usage_error("distance", "--exact computes geodesic distance: it takes no "
-                                         "--cost and no --no-unfolding");
+                                         "--cost, --no-unfolding, --plain-start or "
+                                         "--exact-start-radius");
         goto done;
     }
     int is_txt;

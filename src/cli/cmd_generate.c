@@ -43,6 +43,7 @@ int cmd_generate(int argc, char **argv)
 {
     const char *shape = NULL, *n_arg = NULL, *out_path = NULL;
     double stretch = 3.0, R = 1.0, r = 0.4;
+    int have_stretch = 0, have_radii = 0;
     static const struct option longopts[] = {
         {"help", no_argument, NULL, 'h'},
         {"output", required_argument, NULL, 'o'},
@@ -60,12 +61,14 @@ int cmd_generate(int argc, char **argv)
         } else if (c == OPT_STRETCH) {
             if (!cli_parse_double(optarg, &stretch) || !(stretch > 0) || stretch > 1e6)
                 return cli_usage_error("generate", "--stretch needs a number > 0");
+            have_stretch = 1;
         } else if (c == OPT_RADII) {
             /* two values: R in optarg, r next */
             if (optind >= argc || !cli_parse_double(optarg, &R) ||
                 !cli_parse_double(argv[optind], &r) || !(r > 0) || !(R > r) || R > 1e100)
                 return cli_usage_error("generate", "--radii needs R > r > 0");
             optind++;
+            have_radii = 1;
         } else {
             return cli_getopt_error("generate", c, argv);
         }
@@ -95,6 +98,11 @@ int cmd_generate(int argc, char **argv)
     if (!is_sphere && strcmp(shape, "grid") && strcmp(shape, "sine") && strcmp(shape, "torus") &&
         strcmp(shape, "lattice"))
         return cli_usage_error("generate", "unknown shape '%s'", shape);
+    /* an option that shapes another mesh is a mistake, not a no-op */
+    if (have_stretch && strcmp(shape, "lattice") != 0)
+        return cli_usage_error("generate", "--stretch applies to lattice only, not %s", shape);
+    if (have_radii && strcmp(shape, "torus") != 0)
+        return cli_usage_error("generate", "--radii applies to torus only, not %s", shape);
     if (n < min_n || n > max_n)
         return cli_usage_error("generate", "N for %s must be in [%d, %d]", shape, min_n, max_n);
     if (is_sphere)

@@ -1,5 +1,6 @@
 /* meshfmm path MESH --source I [...] --target J -o OUT (.csv or .obj):
  * the minimal geodesic from a target back to the sources (paper section 5). */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,7 +26,7 @@ static void help(FILE *out)
             "  --cost FILE             slowness F (.npy or .txt), per vertex (default) or per\n"
             "                          face (--cost-per-face)\n"
             "  --max-points N          most points the path may have (default 100000)\n"
-            CLI_START_HELP
+            CLI_START_HELP_NO_LIMIT
             "  --no-straighten         keep the traced path of section 5 (by default it is\n"
             "                          straightened inside the strip of faces it crossed)\n"
             "  -o, --output OUT        .csv (face,b0,b1,b2,x,y,z per point, with a header) or\n"
@@ -91,6 +92,10 @@ int cmd_path(int argc, char **argv)
     int c;
     opterr = 0;
     while ((c = getopt_long(argc, argv, CLI_SHARED_SHORT_OPTIONS, longopts, NULL)) != -1) {
+        if ((c == OPT_TARGET || c == OPT_TARGET_FACE) && have_target) {
+            rc = cli_usage_error("path", "one target (--target or --target-face), given twice");
+            goto done;
+        }
         if (c == OPT_TARGET) {
             int32_t v;
             if (!cli_parse_int32(optarg, &v)) {
@@ -170,6 +175,10 @@ int cmd_path(int argc, char **argv)
         cli_put_double(lf, wlen);
     }
     fputc('\n', lf);
+    if (fflush(lf) != 0 || ferror(lf)) {
+        cli_error("cannot write the path's length to %s: %s", lf == stdout ? "standard output" : "standard error", strerror(errno));
+        goto done;
+    }
     rc = CLI_OK;
 done:
     if (rc != CLI_OK && cli_interrupted()) {

@@ -62,8 +62,10 @@ int cli_sources_and_cost_opt(cli_sources_and_cost *o, int c, int argc, char **ar
         return CLI_OK;
     case OPT_PLAIN_START:
         o->exact_start_radius = 0.0;
-        return CLI_OK;
+        return cli_start_option(o->sub, 1, &o->start_given);
     case OPT_EXACT_START_RADIUS:
+        if (cli_start_option(o->sub, 2, &o->start_given) != CLI_OK)
+            return CLI_USAGE;
         return cli_parse_start_radius(o->sub, optarg, &o->exact_start_radius);
     default:
         return cli_getopt_error(o->sub, c, argv);
@@ -177,5 +179,14 @@ int cli_parse_start_radius(const char *sub, const char *arg, double *radius)
         return cli_usage_error(sub,
                                "--exact-start-radius needs 'auto' or a finite number >= 0, not '%s'",
                                arg);
+    return CLI_OK;
+}
+
+int cli_start_option(const char *sub, int which, int *given)
+{
+    *given |= which;
+    if (*given == 3)
+        return cli_usage_error(sub, "--plain-start and --exact-start-radius are two starts; "
+                                    "give one (--plain-start is --exact-start-radius 0)");
     return CLI_OK;
 }

@@ -16,7 +16,7 @@
 #include "cli.h"
 #include "io/io.h"
 
-/* The one piece of process state: set by SIGINT/SIGTERM (CLI only). */
+/* The one piece of process state: set by SIGINT/SIGTERM/SIGHUP (CLI only). */
 static volatile sig_atomic_t interrupted_flag = 0;
 
 static void on_signal(int sig)
@@ -33,6 +33,9 @@ void cli_signals_install(void)
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    /* a closed terminal or ssh session: stop as on SIGINT, leaving no
+     * temporary file */
+    sigaction(SIGHUP, &sa, NULL);
 }
 
 int cli_interrupted(void)
@@ -194,6 +197,12 @@ int cli_check_output_not_input(const char *sub, const char *out, const char *con
 
 /* ---- output ---- */
 
+#ifdef NAME_MAX
+#define CLI_NAME_MAX NAME_MAX
+#else
+#define CLI_NAME_MAX 255
+#endif
+
 int cli_output_open(cli_output *o, const char *path)
 {
     memset(o, 0, sizeof *o);
@@ -210,8 +219,15 @@ int cli_output_open(cli_output *o, const char *path)
         return -1;
     }
     memcpy(o->path, path, n + 1);
-    memcpy(o->tmp_path, path, n);
-    memcpy(o->tmp_path + n, ".XXXXXX", 8);
+    /* the temporary name: the target's with 7 characters more, its file
+     * name cut so that it stays within NAME_MAX (a valid target name of
+     * 249-255 characters made mkstemp fail) */
+    const char *slash = strrchr(path, '/');
+    size_t dir = slash ? (size_t)(slash - path) + 1 : 0, keep = n;
+    if (n - dir + 7 > CLI_NAME_MAX)
+        keep = dir + (CLI_NAME_MAX - 7);
+    memcpy(o->tmp_path, path, keep);
+    memcpy(o->tmp_path + keep, ".XXXXXX", 8);
     /* mkstemp: O_CREAT | O_EXCL, a fresh name; never follows a symlink. */
     int fd = mkstemp(o->tmp_path);
     if (fd < 0) {

@@ -90,8 +90,8 @@ else
     echo "no numpy: value checks skipped"
 fi
 
-# SIGINT / SIGTERM: exit 130, no file under the final name, no partial file
-for sig in INT TERM; do
+# SIGINT / SIGTERM / SIGHUP (a closed terminal): exit 130, no file under the final name, no partial file
+for sig in INT TERM HUP; do
     "$M" allpairs "$BIG" -o "$T/big.npy" --backend threads --threads 1 --quiet 2>/dev/null &
     pid=$!
     i=0

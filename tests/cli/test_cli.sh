@@ -246,6 +246,29 @@ kill -TERM $p; wait $p; r=$?
 [ $r -eq 130 ] && [ ! -e "$T/sig.npy" ] && ! ls "$T" | grep -q '^sig.npy.' && ok "SIGTERM: exit 130, nothing left" ||
     fail "SIGTERM: exit $r, left: $(ls "$T" | grep sig)"
 
+# A target name of 250 characters (NAME_MAX 255): its temporary's name is
+# cut to fit (mkstemp failed with "File name too long" before).
+long=$(printf 'l%.0s' $(seq 246)).txt
+expect 0 "distance -o a 250-character name" "$BIN" distance "$T/g.obj" --source "$C" -o "$T/$long" &&
+    { cmp -s "$T/$long" "$T/d.txt" && ! ls "$T" | grep -q '^lll.*\.......$' && ok "long name: complete, no temporary" ||
+      fail "long name: $(ls "$T" | grep '^lll')"; }
+
+# ---- options that conflict are refused, not resolved by the last one ----
+expect 2 "--plain-start with --exact-start-radius" "$BIN" distance "$T/g.obj" --source "$C" --plain-start --exact-start-radius 3 -o "$T/x.txt"
+expect 2 "allpairs --exact-start-radius with --plain-start" "$BIN" allpairs "$T/g.obj" --exact-start-radius 3 --plain-start -o "$T/x.npy"
+expect 2 "distance --exact with --exact-start-radius" "$BIN" distance "$T/g.obj" --source "$C" --exact --exact-start-radius 2 -o "$T/x.txt"
+expect 2 "path with two targets" "$BIN" path "$T/g.obj" --source "$C" --target "$C2" --target-face 0 0.2 0.3 0.5 -o "$T/x.csv"
+expect 2 "allpairs --source (not an abbreviation of --sources)" "$BIN" allpairs "$T/g.obj" --source 3 -o "$T/x.npy" &&
+    { grep -q "meshfmm distance --source 3" "$T/err" && ok "allpairs --source message" || fail "message: $(cat "$T/err")"; }
+expect 2 "allpairs --sources twice" "$BIN" allpairs "$T/g.obj" --sources "$T/one.txt" --sources "$T/one.txt" -o "$T/x.npy"
+expect 2 "generate grid --stretch" "$BIN" generate grid 4 --stretch 2 -o "$T/x.obj"
+expect 2 "generate sphere --radii" "$BIN" generate sphere 1 --radii 3 1 -o "$T/x.obj"
+[ ! -e "$T/x.txt" ] && [ ! -e "$T/x.npy" ] && [ ! -e "$T/x.obj" ] && ok "no output from refused runs" || fail "a refused run wrote"
+# path's length is its result on stdout: a full stdout is a failure
+if [ -w /dev/full ]; then
+    expect 1 "path with stdout full" sh -c '"$1" path "$2" --source "$3" --target "$4" -o "$5" >/dev/full' sh "$BIN" "$T/g.obj" "$C" "$C2" "$T/p.csv"
+fi
+
 # ---- an output that is an input is refused (issue 9 item 9) ----
 cp "$T/g.obj" "$T/in.obj"; cp "$T/cost.txt" "$T/incost.txt"
 ln "$T/in.obj" "$T/hard.txt"
