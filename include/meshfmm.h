@@ -439,6 +439,8 @@ MFMM_API void mfmm_path_options_init(mfmm_path_options *options);
  * Where T has no descent over faces and edges at a vertex (its value came
  * through a virtual edge, section 4.2, or straight from a point source), the
  * path follows that straight segment through the faces it crosses.
+ * MFMM_ERR_BAD_COST: options->cost has an entry not finite or not > 0
+ * (every entry is checked, as mfmm_solve does; err->index names it).
  * MFMM_ERR_UNREACHED: T(target) is +inf. MFMM_ERR_PATH_STALLED: T stopped
  * decreasing before a source (without sources: above 0), or the path needed
  * more than max_points points; never a path that ends elsewhere. */

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/check.h"
 #include "core/order.h"
 #include "core/start.h"
 #include "surface.h"
@@ -872,11 +873,13 @@ mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
         return mfmm_fail(err, o->n_sources < 0 ? MFMM_ERR_BAD_COUNT : MFMM_ERR_NULL_POINTER,
                          o->n_sources, "n_sources is %d with sources %s", (int)o->n_sources,
                          o->sources ? "given" : "NULL");
-    if (o->cost && o->cost_location != MFMM_COST_PER_VERTEX &&
-        o->cost_location != MFMM_COST_PER_FACE)
-        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, (int64_t)o->cost_location,
-                         "cost_location %d is not per vertex or per face", (int)o->cost_location);
-    mfmm_status st = validate_point(mesh, target, "target", -1, err);
+    /* the whole cost, as mfmm_solve checks it: not only the faces the path
+     * happens to cross, and named by the caller's ids, not the mesh's
+     * internal order that the walk reads */
+    mfmm_status st = mfmm_check_cost(mesh, o->cost, o->cost_location, err);
+    if (st != MFMM_OK)
+        return st;
+    st = validate_point(mesh, target, "target", -1, err);
     if (st != MFMM_OK)
         return st;
     for (int32_t i = 0; i < o->n_sources; i++) {

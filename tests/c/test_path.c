@@ -608,6 +608,27 @@ static void test_errors(void **state)
     po.cost_location = MFMM_COST_NONE;
     assert_int_equal(mfmm_trace_path(fx.mesh, fx.d, &tg, &po, fx.pts, CAP, &np, &len, &err),
                      MFMM_ERR_BAD_ARGUMENT);
+    /* the whole cost is checked, as mfmm_solve does, and the bad entry named
+     * by the caller's id: each face and each vertex in turn, crossed by the
+     * path or not (the walk read only the costs it crossed, by the mesh's
+     * internal ids) */
+    for (int per_face = 0; per_face <= 1; per_face++) {
+        int32_t n = per_face ? fx.g.nf : fx.g.nv;
+        double *cs = malloc((size_t)n * sizeof *cs);
+        assert_non_null(cs);
+        for (int32_t i = 0; i < n; i++)
+            cs[i] = 1.0;
+        po.cost = cs;
+        po.cost_location = per_face ? MFMM_COST_PER_FACE : MFMM_COST_PER_VERTEX;
+        for (int32_t i = 0; i < n; i++) {
+            cs[i] = i % 2 ? NAN : -1.0;
+            assert_int_equal(mfmm_trace_path(fx.mesh, fx.d, &tg, &po, fx.pts, CAP, &np, &len, &err),
+                             MFMM_ERR_BAD_COST);
+            assert_int_equal(err.index, i);
+            cs[i] = 1.0;
+        }
+        free(cs);
+    }
     po.cost = NULL;
 
     /* a flat field does not descend: stalled, with sources to reach */
