@@ -176,7 +176,8 @@ int cmd_path(int argc, char **argv)
     }
     fputc('\n', lf);
     if (fflush(lf) != 0 || ferror(lf)) {
-        cli_error("cannot write the path's length to %s: %s", lf == stdout ? "standard output" : "standard error", strerror(errno));
+        cli_error("cannot write the path's length to %s: %s",
+                  lf == stdout ? "standard output" : "standard error", strerror(errno));
         goto done;
     }
     rc = CLI_OK;

@@ -79,39 +79,18 @@ static int read_T(tracer *t, int32_t v, double *out)
     return 1;
 }
 
-/* Reads the cost of a vertex or face, refusing values not finite or <= 0. */
-static int read_cost(tracer *t, int32_t i, double *out)
+/* F at barycentric b of face f (1 without cost; the costs were checked
+ * when the call began, mfmm_check_cost). */
+static double cost_at(const tracer *t, int32_t f, const double b[3])
 {
-    double c = t->cost[i];
-    if (!(isfinite(c) && c > 0.0)) {
-        if (t->cost_loc == MFMM_COST_PER_VERTEX)
-            i = mfmm_vertex_out(t->m, i); /* the caller's id */
-        t->st = mfmm_fail(t->err, MFMM_ERR_BAD_COST, i, "cost[%d] = %g is not finite and > 0",
-                          (int)i, c);
-        return 0;
-    }
-    *out = c;
-    return 1;
-}
-
-/* F at barycentric b of face f (1 without cost). */
-static int cost_at(tracer *t, int32_t f, const double b[3], double *out)
-{
-    if (!t->cost) {
-        *out = 1.0;
-        return 1;
-    }
+    if (!t->cost)
+        return 1.0;
     if (t->cost_loc == MFMM_COST_PER_FACE)
-        return read_cost(t, f, out);
+        return t->cost[f];
     double s = 0.0;
-    for (int k = 0; k < 3; k++) {
-        double c;
-        if (!read_cost(t, t->m->face_records[f].v[k], &c))
-            return 0;
-        s += b[k] * c;
-    }
-    *out = s;
-    return 1;
+    for (int k = 0; k < 3; k++)
+        s += b[k] * t->cost[t->m->face_records[f].v[k]];
+    return s;
 }
 
 /* Gaussian elimination with partial pivoting; 0 when ill-conditioned. */
@@ -191,8 +170,7 @@ static int frame_build(tracer *t, int32_t f, frame *fr)
             return 0;
     }
     double b1[3] = {1.0 / 3, 1.0 / 3, 1.0 / 3};
-    if (!cost_at(t, f, b1, &fr->F))
-        return 0;
+    fr->F = cost_at(t, f, b1);
     const double *A = m->xyz + 3 * (size_t)fr->v[0], *B = m->xyz + 3 * (size_t)fr->v[1],
                  *C = m->xyz + 3 * (size_t)fr->v[2];
     double u[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]};
@@ -253,13 +231,7 @@ static int frame_build(tracer *t, int32_t f, frame *fr)
             return 1;
         unfold_far(m, fr, k, far, pts[3 + k]);
         if (t->cost) {
-            double Fg;
-            if (t->cost_loc == MFMM_COST_PER_FACE) {
-                if (!read_cost(t, g, &Fg))
-                    return 0;
-            } else if (!read_cost(t, far, &Fg)) {
-                return 0;
-            }
+            double Fg = t->cost[t->cost_loc == MFMM_COST_PER_FACE ? g : far];
             Fmin = fmin(Fmin, Fg);
             Fmax = fmax(Fmax, Fg);
         }
@@ -333,10 +305,8 @@ static double frame_T(const frame *fr, const double b[3])
 /* Appends a point; the segment to it ran through face f. */
 static int emit(tracer *t, int32_t f, const double b[3])
 {
-    double x[3], F;
+    double x[3], F = cost_at(t, f, b);
     mfmm_bary_to_xyz(t->m, f, b, x);
-    if (!cost_at(t, f, b, &F))
-        return 0;
     if (t->n > 0) {
         double d = mfmm_dist3(x, t->last_xyz);
         t->len += d;
