@@ -225,6 +225,24 @@ BAD = [
     ("matrix out strided", "m.distance_matrix([0, 1], out=np.empty((2, 32), np.float32)[:, ::2])",
      "ValueError", ["contiguous"]),
     ("matrix source out of range", "m.distance_matrix([0, 16])", "ValueError", ["16"]),
+    # yes/no options take bools only: 'no', 0 and None read as truth values
+    # passed silently (unfolding='no' ran with unfolding)
+    ("unfolding str", "m.distance(0, unfolding='no')", "TypeError", ["unfolding"]),
+    ("matrix unfolding int", "m.distance_matrix([0], unfolding=0)", "TypeError", ["unfolding"]),
+    ("matrix sparse str", "m.distance_matrix([0], sparse='no', max_distance=1)", "TypeError",
+     ["sparse"]),
+    ("path straighten str", "m.geodesic_path(m.distance(0), 15, straighten='no')", "TypeError",
+     ["straighten"]),
+    ("targets empty", "m.distance(0, targets=[])", "ValueError", ["targets"]),
+    ("memory_limit wraps", "m.distance_matrix([0], memory_limit=2**70)", "ValueError",
+     ["memory_limit"]),
+    ("memory_limit float", "m.distance_matrix([0], memory_limit=1.5)", "TypeError",
+     ["memory_limit"]),
+    ("face source -1", "m.distance(meshfmm.SurfacePoint(-1, (1/3, 1/3, 1/3)))", "ValueError",
+     ["face -1"]),
+    ("path target face -1", "m.geodesic_path(m.distance(0), meshfmm.SurfacePoint(-1, (1, 0, 0)))",
+     "ValueError", ["face -1"]),
+    ("sources dict", "m.distance({0: 1})", "TypeError", ["dict"]),
 ]
 
 SCRIPT = textwrap.dedent(

@@ -205,6 +205,27 @@ def test_bad_arguments_are_refused(hand, tmp_path):
         md.distance_matrix(hand, str(tmp_path / "x.zarr"), max_distance=-1.0, n_workers=1)
     with pytest.raises(TypeError, match="store"):
         md.distance_matrix(hand, 3, n_workers=1)
+    with pytest.raises(TypeError, match="max_distance"):
+        md.distance_matrix(hand, str(tmp_path / "x.zarr"), max_distance=True, n_workers=1)
+    with pytest.raises(TypeError, match="unfolding"):
+        md.distance_matrix(hand, str(tmp_path / "x.zarr"), unfolding="no", n_workers=1)
+    assert not (tmp_path / "x.zarr").exists()
+
+
+def test_a_bad_cost_is_refused_before_the_store_is_touched(hand, serial64, client, tmp_path):
+    """resume=False overwrites the store; a bad cost (seen before only by the
+    workers, after every task had failed and been retried) must not first
+    replace a finished job."""
+    out = str(tmp_path / "kept.zarr")
+    md.distance_matrix(hand, out, sources=SOURCES[:8], client=client, dtype="float64",
+                       backend="serial", progress=False)
+    bad = np.ones(hand.n_vertices)
+    bad[17] = -1.0
+    for cost, words in ((bad, "17"), (np.ones(5), "5 entries")):
+        with pytest.raises(ValueError, match=words):
+            md.distance_matrix(hand, out, sources=SOURCES[:8], client=client, resume=False,
+                               cost=cost, progress=False)
+    assert np.array_equal(zarr.open_array(out, mode="r")[:], serial64[:8])
 
 
 def test_command_line(tmp_path):

@@ -6,6 +6,7 @@ All foreign calls go through :mod:`meshfmm._lib`.
 from __future__ import annotations
 
 import atexit
+import collections.abc
 import contextlib
 import ctypes
 import dataclasses
@@ -106,6 +107,24 @@ def _is_int(x: Any) -> bool:
     return isinstance(x, (int, np.integer)) and not isinstance(x, (bool, np.bool_))
 
 
+def _flag(x: Any, what: str) -> bool:
+    """A yes/no option: True or False (numpy's bools too). Anything else is a
+    TypeError: 'no', 0 or None read as truth values would pass silently."""
+    if not isinstance(x, (bool, np.bool_)):
+        raise TypeError(f"{what} must be True or False, got {x!r}")
+    return bool(x)
+
+
+def _size(x: Any, what: str) -> int:
+    """A byte count for a C size_t: an integer in [0, 2**64)."""
+    if not _is_int(x):
+        raise TypeError(f"{what} must be an integer number of bytes, got {x!r}")
+    i = int(x)
+    if not (0 <= i < 2**64):
+        raise ValueError(f"{what} must be in [0, 2**64), got {i}")
+    return i
+
+
 def _as_index(x: Any, what: str) -> int:
     if not _is_int(x):
         raise TypeError(f"{what} must be an integer, got {type(x).__name__}")
@@ -149,7 +168,8 @@ def _source_records(sources: Any, what: str = "source") -> np.ndarray:
         rec["vertex"] = ids
         rec["face"] = -1
         return rec
-    if isinstance(sources, (str, bytes)) or not hasattr(sources, "__len__"):
+    if (isinstance(sources, (str, bytes, collections.abc.Mapping))
+            or not hasattr(sources, "__len__")):
         raise TypeError(
             f"{what}s must be a vertex id, a SurfacePoint or a sequence of those, "
             f"got {type(sources).__name__}"
@@ -169,7 +189,10 @@ def _source_records(sources: Any, what: str = "source") -> np.ndarray:
     rec = np.zeros(n, dtype=_lib.SOURCE_DTYPE)
     for i, s in enumerate(sources):
         if isinstance(s, SurfacePoint):
-            rec["face"][i] = _as_index(s.face, f"{what} {i}: face")
+            face = _as_index(s.face, f"{what} {i}: face")
+            if face < 0:
+                raise ValueError(f"{what} {i}: face {face} is out of range (face ids are >= 0)")
+            rec["face"][i] = face
             rec["vertex"][i] = -1
             rec["bary"][i] = _bary(s.bary, f"{what} {i}")
         elif _is_int(s):
@@ -187,6 +210,8 @@ def _target_record(target: Any) -> _lib.mfmm_source:
     if isinstance(target, SurfacePoint):
         src.vertex = -1
         src.face = _as_index(target.face, "target face")
+        if src.face < 0:
+            raise ValueError(f"target face {src.face} is out of range (face ids are >= 0)")
         b = _bary(target.bary, "target")
         src.bary[0], src.bary[1], src.bary[2] = float(b[0]), float(b[1]), float(b[2])
     elif _is_int(target):
@@ -551,6 +576,7 @@ class Mesh:
         Unreached vertices (other components, beyond max_distance) are +inf.
         Raises ValueError (bad source, barycentric coordinates, cost, ...).
         """
+        unfolding = _flag(unfolding, "unfolding")
         if method == "exact":
             if cost is not None or targets is not None or not unfolding or exact_start is not True:
                 raise ValueError("method='exact' computes geodesic distance: it takes no cost, "
@@ -577,6 +603,8 @@ class Mesh:
                 opts.max_distance = _max_distance(max_distance)
             if targets is not None:
                 t = _index_array(targets, "target")
+                if t.shape[0] == 0:
+                    raise ValueError("targets must hold at least one vertex id (None: every vertex)")
                 opts.targets = _addr(t)
                 opts.n_targets = t.shape[0]
             if not unfolding:
@@ -670,7 +698,7 @@ class Mesh:
         _lib.mfmm_path_options_init(byref(opts))
         if max_points is not None:
             opts.max_points = _as_index(max_points, "max_points")
-        opts.straighten = 1 if straighten else 0
+        opts.straighten = 1 if _flag(straighten, "straighten") else 0
         src = None
         if sources is not None:
             src = _source_records(sources)
@@ -789,6 +817,9 @@ class Mesh:
             raise ValueError(f"dtype must be float32 or float64, got {dt}")
         if not isinstance(backend, str) or backend.lower() not in _lib.BACKENDS:
             raise ValueError(f"backend must be one of {sorted(_lib.BACKENDS)}, got {backend!r}")
+        unfolding = _flag(unfolding, "unfolding")
+        sparse = _flag(sparse, "sparse")
+        symmetric = _flag(symmetric, "symmetric")
         tgt = None
         if targets is not None:
             tgt = _index_array(targets, "target")
@@ -853,9 +884,7 @@ class Mesh:
         if radius is not None:
             opts.exact_start_radius = radius
         opts.n_threads = _as_index(n_threads, "n_threads")
-        if memory_limit < 0:
-            raise ValueError("memory_limit must be >= 0")
-        opts.memory_limit = int(memory_limit)
+        opts.memory_limit = _size(memory_limit, "memory_limit")
         opts.out = _addr(out) if out.size else None
         if tgt is not None:
             opts.targets = _addr(tgt)

@@ -33,7 +33,7 @@ import numpy as np
 
 from . import __version__
 from . import _lib
-from ._mesh import Mesh, _exact_start
+from ._mesh import Mesh, _as_index, _cost_array, _exact_start, _is_int, _max_distance
 
 __all__ = ["distance_matrix", "job_description", "complete_blocks", "symmetrize", "DASK_CONFIG"]
 
@@ -394,17 +394,29 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
     if dt not in (np.float32, np.float64):
         raise ValueError(f"dtype must be float32 or float64, not {dtype}")
     if max_distance is not None:
-        if isinstance(max_distance, (str, bytes)) or not np.isscalar(max_distance):
-            raise TypeError("max_distance must be a number")
-        if not (float(max_distance) >= 0.0):
-            raise ValueError(f"max_distance must be >= 0, not {max_distance}")
-    cost_arr = None if cost is None else np.ascontiguousarray(cost, dtype=np.float64)
+        _max_distance(max_distance)  # TypeError or ValueError, as Mesh.distance
+    cost_arr = None
+    if cost is not None:
+        cost_arr, _ = _cost_array(cost, cost_location, nv, mesh.n_faces)
     radius = _start_radius(_exact_start(exact_start))
     if compression not in _CODECS:
         raise ValueError(f"compression must be one of {', '.join(map(repr, _CODECS))}, "
                          f"not {compression!r}")
     if backend not in ("auto", "threads", "serial", "opencl"):
         raise ValueError(f"backend must be auto, threads, serial or opencl, not {backend!r}")
+    if not _is_int(retries) or retries < 0:
+        raise ValueError(f"retries must be an integer >= 0, not {retries!r}")
+    if block_rows is not None and (not _is_int(block_rows) or block_rows < 1):
+        raise ValueError(f"block_rows must be an integer >= 1, not {block_rows!r}")
+    # Every option a task hands the library, checked here before the store is
+    # touched (resume=False overwrites it): one row marched to radius 0 with
+    # the job's options; the library checks the whole cost array up front.
+    # Else a bad cost failed every task on the workers, retried, and only
+    # then surfaced, after an existing store had been replaced.
+    mesh.distance_matrix(src[:1] if src is not None else [0], targets=tgt, backend="serial",
+                         dtype=dt.name, max_distance=0.0, cost=cost_arr,
+                         cost_location=cost_location, unfolding=unfolding,
+                         exact_start=exact_start, n_threads=_as_index(n_threads, "n_threads"))
     url, storage_options = _open_store(store, storage_options)
     n_rows = nv if src is None else src.shape[0]
     n_cols = nv if tgt is None else tgt.shape[0]
@@ -455,8 +467,6 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         if arr is None:
             if block_rows is None:
                 block_rows = _default_block_rows(n_rows, n_cols * dt.itemsize, dask_threads)
-            if int(block_rows) < 1:
-                raise ValueError(f"block_rows must be >= 1, not {block_rows}")
             compressors = [Crc32cCodec()]
             if _CODECS[compression] is not None:
                 cname, clevel = _CODECS[compression]
