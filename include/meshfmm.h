@@ -150,8 +150,8 @@ typedef struct mfmm_mesh_info {
     int32_t n_vertices;              /* nv as given */
     int32_t n_faces;                 /* nf as given */
     int32_t n_edges;                 /* distinct undirected edges */
-    int32_t n_boundary_edges;        /* edges with one face */
-    int32_t n_nonmanifold_edges;     /* edges with three or more faces */
+    int32_t n_boundary_edges;        /* edges with one face (copies apart) */
+    int32_t n_nonmanifold_edges;     /* edges with three or more faces (copies apart) */
     int32_t n_components;            /* edge-connected components of referenced vertices */
     int32_t n_unreferenced_vertices; /* vertices no face names (always +inf) */
     int32_t n_degenerate_faces;      /* faces of (numerically) zero area */
@@ -163,6 +163,11 @@ typedef struct mfmm_mesh_info {
     double max_edge_length;
     double mean_edge_length;
     double bbox_diagonal;            /* length of the bounding-box diagonal */
+    int32_t n_duplicate_faces;       /* faces that repeat another face's vertices (in
+                                        any order): copies, not counted in the edges'
+                                        faces (the edges are what the other faces make
+                                        them); the march updates through a copy as
+                                        through its original */
 } mfmm_mesh_info;
 
 MFMM_API mfmm_status mfmm_mesh_get_info(const mfmm_mesh *mesh, mfmm_mesh_info *info);

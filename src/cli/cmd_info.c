@@ -88,13 +88,14 @@ int cmd_info(int argc, char **argv)
         json_string(path);
         printf(", \"vertices\": %d, \"faces\": %d, \"edges\": %d, \"boundary_edges\": %d, "
                "\"nonmanifold_edges\": %d, \"components\": %d, \"unreferenced_vertices\": %d, "
-               "\"degenerate_faces\": %d, \"obtuse_corners\": %d, \"virtual_edges\": %d, "
+               "\"degenerate_faces\": %d, \"duplicate_faces\": %d, \"obtuse_corners\": %d, \"virtual_edges\": %d, "
                "\"unfold_failures\": %d, \"min_edge_length\": %.17g, "
                "\"max_edge_length\": %.17g, \"mean_edge_length\": %.17g, "
                "\"bbox_diagonal\": %.17g, \"mesh_bytes\": %.0f}\n",
                (int)m.n_vertices, (int)m.n_faces, (int)m.n_edges, (int)m.n_boundary_edges,
                (int)m.n_nonmanifold_edges, (int)m.n_components, (int)m.n_unreferenced_vertices,
-               (int)m.n_degenerate_faces, (int)m.n_obtuse_corners, (int)m.n_virtual_edges,
+               (int)m.n_degenerate_faces, (int)m.n_duplicate_faces, (int)m.n_obtuse_corners,
+               (int)m.n_virtual_edges,
                (int)m.n_unfold_failures, m.min_edge_length, m.max_edge_length,
                m.mean_edge_length, m.bbox_diagonal, (double)mesh_bytes);
     } else {
@@ -107,6 +108,7 @@ int cmd_info(int argc, char **argv)
         printf("components:            %d\n", (int)m.n_components);
         printf("unreferenced vertices: %d\n", (int)m.n_unreferenced_vertices);
         printf("degenerate faces:      %d\n", (int)m.n_degenerate_faces);
+        printf("duplicate faces:       %d\n", (int)m.n_duplicate_faces);
         printf("obtuse corners:        %d\n", (int)m.n_obtuse_corners);
         printf("virtual edges:         %d\n", (int)m.n_virtual_edges);
         printf("unfold failures:       %d\n", (int)m.n_unfold_failures);

@@ -95,21 +95,44 @@ static mfmm_status build_edges(mfmm_mesh *m)
         sum += len;
         lmin = fmin(lmin, len);
         lmax = fmax(lmax, len);
-        if (j - i == 2) {
-            m->face_neighbor[he[i].corner] = he[i + 1].corner / 3;
-            m->face_neighbor[he[i + 1].corner] = he[i].corner / 3;
+        /* copies of a face stand aside: the edge is what the other faces
+         * make it (two copies of a face made its edges walls) */
+        size_t real[2] = {0, 0}, n_real = 0;
+        for (size_t t = i; t < j; t++)
+            if (!mfmm_mesh_copy(m, he[t].corner / 3)) {
+                if (n_real < 2)
+                    real[n_real] = t;
+                n_real++;
+            }
+        if (n_real == 2) {
+            m->face_neighbor[he[real[0]].corner] = he[real[1]].corner / 3;
+            m->face_neighbor[he[real[1]].corner] = he[real[0]].corner / 3;
         } else {
             /* boundary, or non-manifold: the walk of section 4.2 stops here */
             for (size_t t = i; t < j; t++)
                 m->face_neighbor[he[t].corner] = -1;
-            if (j - i == 1)
+            if (n_real == 1)
                 n_boundary++;
             else
                 n_nonmanifold++;
         }
+        /* a copy's edge leads where its original's does */
+        for (size_t t = i; t < j; t++) {
+            int32_t f = he[t].corner / 3;
+            if (!mfmm_mesh_copy(m, f))
+                continue;
+            int32_t g = mfmm_mesh_original(m, f);
+            for (size_t s = i; s < j; s++)
+                if (he[s].corner / 3 == g)
+                    m->face_neighbor[he[t].corner] = m->face_neighbor[he[s].corner];
+        }
         i = j;
     }
     free(he);
+    int32_t n_copies = 0;
+    for (int32_t f = 1; f < m->nf; f++)
+        n_copies += mfmm_mesh_copy(m, f);
+    m->info.n_duplicate_faces = n_copies;
     m->info.n_edges = n_edges;
     m->info.n_boundary_edges = n_boundary;
     m->info.n_nonmanifold_edges = n_nonmanifold;

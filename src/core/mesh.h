@@ -123,6 +123,31 @@ static inline int mfmm_mesh_degenerate(const mfmm_mesh *mesh, int32_t f)
     return isnan(mesh->face_records[f].cosv[0]);
 }
 
+/* 1 when face f has the vertices of face f - 1, in any order: a copy, as
+ * exporters leave them. Faces are ordered by their sorted vertices
+ * (order.h), so copies follow the face they copy. A copy takes no part in
+ * the adjacency (build_edges: an edge's copies stand aside, and a copy's
+ * edges lead where its original's do) nor in the exact solver's surface;
+ * the march updates through it as through its original. */
+static inline int mfmm_mesh_copy(const mfmm_mesh *mesh, int32_t f)
+{
+    if (f <= 0)
+        return 0;
+    const int32_t *a = mesh->face_records[f].v, *b = mesh->face_records[f - 1].v;
+    for (int k = 0; k < 3; k++) /* a face's vertices are distinct (validate) */
+        if (a[k] != b[0] && a[k] != b[1] && a[k] != b[2])
+            return 0;
+    return 1;
+}
+
+/* The face that face f copies (mfmm_mesh_copy), or f. */
+static inline int32_t mfmm_mesh_original(const mfmm_mesh *mesh, int32_t f)
+{
+    while (mfmm_mesh_copy(mesh, f))
+        f--;
+    return f;
+}
+
 /* The vertex at corner c = 3 f + k: face f's vertex k. */
 static inline int32_t mfmm_mesh_corner_vertex(const mfmm_mesh *mesh, int32_t c)
 {

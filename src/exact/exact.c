@@ -112,8 +112,9 @@ static const int8_t ex_next[3] = {1, 2, 0}, ex_prev[3] = {2, 0, 1};
  * corner k+1 to k+2): its length, corner k in its frame (x along the edge,
  * y > 0), and the same edge in the face across it (3g+m, -1 at a wall) with
  * whether it runs the other way there; the corners' vertices and angles;
- * whether the face has zero area (skipped). 128 bytes, aligned to cache
- * lines. */
+ * whether it is skipped (1: zero area, its vertices pseudo-sources; 2: a
+ * copy of another face, mfmm_mesh_copy, no part of the surface). 128 bytes,
+ * aligned to cache lines. */
 typedef struct ex_face {
     double len[3], cx[3], cy[3];
     double angle[3]; /* the corners' angles */
@@ -267,17 +268,21 @@ static int ex_corner_of(const int32_t *fv, int32_t v)
 static void ex_build_fans(mfmm_exact_tables *t)
 {
     for (int32_t v = 0; v < t->nv; v++) {
-        int32_t n_c = t->vf_offset[v + 1] - t->vf_offset[v];
-        t->fan_total[v] = NAN;
-        if (n_c < 3)
-            continue;
+        /* copies (skip 2) apart; a zero-area face (skip 1) ends the fan */
+        int32_t n_c = 0, c0 = -1;
         int ok = 1;
-        for (int32_t i = t->vf_offset[v]; i < t->vf_offset[v + 1]; i++)
-            if (t->fr[ex_corner(t->vf_corner, t->face_in, i) / 3].skip)
+        t->fan_total[v] = NAN;
+        for (int32_t i = t->vf_offset[v]; i < t->vf_offset[v + 1]; i++) {
+            int32_t c = ex_corner(t->vf_corner, t->face_in, i);
+            if (t->fr[c / 3].skip == 1)
                 ok = 0;
-        if (!ok)
+            if (t->fr[c / 3].skip == 0) {
+                c0 = c0 < 0 ? c : c0;
+                n_c++;
+            }
+        }
+        if (!ok || n_c < 3)
             continue;
-        int32_t c0 = ex_corner(t->vf_corner, t->face_in, t->vf_offset[v]);
         int32_t f = c0 / 3, k = c0 % 3;
         int32_t ent = t->fr[f].v[(k + 1) % 3];
         double e = 0.0;
@@ -418,7 +423,7 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
             if (!(L > 0.0) || !(y > 0.0) || !isfinite(x) || !isfinite(y))
                 bad = 1;
         }
-        r->skip = (uint8_t)bad;
+        r->skip = (uint8_t)(bad ? 1 : mfmm_mesh_copy(mesh, (int32_t)f) ? 2 : 0);
     }
     for (size_t f = 0; f < nf; f++) {
         const int32_t *fv = F[f].v;
@@ -445,7 +450,7 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
         const ex_face *r = t->fr + f;
         const int32_t *fv = r->v;
         if (r->skip) {
-            for (int k = 0; k < 3; k++)
+            for (int k = 0; k < 3 && r->skip == 1; k++)
                 t->pseudo[fv[k]] = 1;
             continue;
         }
@@ -1039,6 +1044,8 @@ static void ex_start_vertex(mfmm_exact_ws *ws, int32_t v, double dv)
         return;
     for (int32_t i = ws->vf_offset[v]; i < ws->vf_offset[v + 1]; i++) {
         int32_t c = ex_corner(ws->vf_corner, ws->face_in, i);
+        if (ws->fr[c / 3].skip) /* a copy: the fan holds no zero-area face */
+            continue;
         double ang = ws->fr[c / 3].angle[c % 3];
         double f0 = ws->fr[c / 3].sgn[c % 3] > 0 ? ws->fan_a0[c] : ws->fan_a0[c] - ang, f1 = f0 + ang;
         for (int wrap = -1; wrap <= 1; wrap++) {
@@ -1132,10 +1139,13 @@ static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t
             ex_update(ws, s->vertex, s->value, 1);
             continue;
         }
-        const int32_t *fv = ws->mesh->face_records[s->face].v;
+        /* a point of a copy is that point of its original */
+        int32_t face = mfmm_mesh_original(ws->mesh, s->face);
+        const int32_t *fv = ws->mesh->face_records[face].v, *sv = ws->mesh->face_records[s->face].v;
         double w[3], sum = 0.0;
         for (int k = 0; k < 3; k++) {
-            w[k] = s->bary[k] > 0.0 ? s->bary[k] : 0.0;
+            int j = sv[0] == fv[k] ? 0 : sv[1] == fv[k] ? 1 : 2;
+            w[k] = s->bary[j] > 0.0 ? s->bary[j] : 0.0;
             sum += w[k];
         }
         int corner = -1;
@@ -1154,7 +1164,7 @@ static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t
             ex_update(ws, fv[corner], s->value + vdist(p, X + 3 * (size_t)fv[corner]), 1);
             continue;
         }
-        ex_start_face(ws, ws->face_in[s->face], w, s->value);
+        ex_start_face(ws, ws->face_in[face], w, s->value);
     }
     while (ws->heap_n > 0 && !ws->failed) {
         ex_entry e;
@@ -1191,7 +1201,8 @@ static mfmm_status ex_check_sources(const mfmm_exact_ws *ws, const mfmm_source *
         mfmm_status st = mfmm_check_source(ws->mesh, sources + i, i, err);
         if (st != MFMM_OK)
             return st;
-        if (sources[i].face >= 0 && ws->fr[ws->face_in[mfmm_face_in(ws->mesh, sources[i].face)]].skip)
+        if (sources[i].face >= 0 &&
+            ws->fr[ws->face_in[mfmm_face_in(ws->mesh, sources[i].face)]].skip == 1)
             return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, i,
                              "source %ld lies on face %ld, which has zero area", (long)i,
                              (long)sources[i].face);

@@ -75,6 +75,17 @@ expect 0 "info beetle.obj" "$BIN" info "$DATA/meshes/beetle.obj" &&
 expect 0 "info stanford-bunny.obj" "$BIN" info "$DATA/meshes/stanford-bunny.obj" &&
     { [ "$(value "unreferenced vertices" "$T/out")" = 1113 ] && ok "bunny unreferenced" ||
       fail "bunny unreferenced: $(cat "$T/out")"; }
+# a copied face is counted, and is no wall: vertex 3 of the unit square is
+# sqrt(2) from vertex 0 (it was 2: the copy made the diagonal non-manifold)
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nf 3 4 2\n' >"$T/copy.obj"
+expect 0 "info copied face" "$BIN" info "$T/copy.obj" &&
+    { [ "$(value "duplicate faces" "$T/out")" = 1 ] && [ "$(value "non-manifold edges" "$T/out")" = 0 ] &&
+      ok "copied face counted" || fail "copied face counts: $(cat "$T/out")"; }
+for opt in "" --exact; do
+    expect 0 "distance copied face $opt" "$BIN" distance "$T/copy.obj" --source 0 $opt -o "$T/copy.txt" &&
+        { awk 'NR == 4 { exit !($1 > 1.41421356237309 && $1 < 1.4142135623731) }' "$T/copy.txt" &&
+          ok "copied face: d(3) = sqrt 2 $opt" || fail "copied face $opt: $(cat "$T/copy.txt")"; }
+done
 
 # ---- broken files: exit 1 with a message ----
 printf '' >"$T/empty.obj"

@@ -151,6 +151,48 @@ def test_unreferenced_vertex_is_inf():
     assert np.isinf(d[-1]) and np.isfinite(d[:-1]).all()
 
 
+def test_duplicate_faces_are_copies_not_walls():
+    """Copies of faces (an export artifact: same vertices, any order, twice or
+    three times) used to make every edge of the face non-manifold, hence a
+    wall for the exact solver and the exact start: on the unit square
+    f(0,1,2) f(1,3,2) f(1,3,2), vertex 3 got 2 from vertex 0 instead of
+    sqrt(2). Now every result equals the mesh without the copies (the
+    reference) to rounding, and info counts them."""
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.0]])
+    sq = meshfmm.Mesh(V, [[0, 1, 2], [1, 3, 2], [1, 3, 2]])
+    assert sq.info.n_duplicate_faces == 1 and sq.info.n_nonmanifold_edges == 0
+    for kw in ({}, {"method": "exact"}):
+        assert sq.distance(0, **kw)[3] == pytest.approx(np.sqrt(2.0), rel=1e-15)
+
+    V, F = load("hand_lowres.obj")
+    rng = np.random.default_rng(1)
+    pick = rng.choice(len(F), 40, replace=False)
+    copies = F[pick].copy()
+    copies[::2] = copies[::2, ::-1]  # half of them the other way round
+    G = np.vstack([F, copies, F[pick[:10]][:, [1, 2, 0]]])  # and 10 third copies
+    perm = rng.permutation(len(G))
+    G = G[perm]
+    ref, m = meshfmm.Mesh(V, F), meshfmm.Mesh(V, G)
+    assert m.info.n_duplicate_faces == 50
+    for key in ("n_edges", "n_boundary_edges", "n_nonmanifold_edges", "n_unfold_failures"):
+        assert getattr(m.info, key) == getattr(ref.info, key), key
+    for s in (0, 100, 500):
+        for kw in ({}, {"exact_start": False}, {"method": "exact"}):
+            np.testing.assert_allclose(m.distance(s, **kw), ref.distance(s, **kw),
+                                       rtol=1e-14, atol=1e-15, err_msg=f"{s} {kw}")
+        p = m.geodesic_path(m.distance(s), 700, sources=[s])
+        assert p.length == pytest.approx(ref.geodesic_path(ref.distance(s), 700,
+                                                           sources=[s]).length, rel=1e-13)
+    # a point of a copy is that point of its original (the copy is reversed)
+    j = int(np.argsort(perm)[len(F)])
+    b = np.array([0.2, 0.3, 0.5])
+    for kw in ({}, {"method": "exact"}):
+        np.testing.assert_allclose(
+            m.distance(meshfmm.SurfacePoint(j, tuple(b)), **kw),
+            ref.distance(meshfmm.SurfacePoint(int(pick[0]), tuple(b[::-1])), **kw),
+            rtol=1e-14, atol=1e-15)
+
+
 # ---------------------------------------------------------- bad inputs
 # (id, code, expected exception class name, words the message must contain)
 # Each runs in one subprocess with V, F (a 3x3 grid), m = Mesh(V, F), and a

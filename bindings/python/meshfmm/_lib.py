@@ -148,6 +148,7 @@ class mfmm_mesh_info(Structure):
         ("max_edge_length", c_double),
         ("mean_edge_length", c_double),
         ("bbox_diagonal", c_double),
+        ("n_duplicate_faces", c_int32),
     ]
 
 

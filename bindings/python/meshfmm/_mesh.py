@@ -64,6 +64,7 @@ class MeshInfo:
     max_edge_length: float
     mean_edge_length: float
     bbox_diagonal: float  #: length of the bounding-box diagonal
+    n_duplicate_faces: int  #: faces repeating another's vertices (copies; not walls)
 
     def as_dict(self) -> dict:
         """The fields as a plain dict."""
@@ -316,7 +317,9 @@ class Mesh:
     Raises :class:`meshfmm.MeshError` (a ValueError) with the reason for wrong
     shapes, NaN or infinite coordinates, face indices out of range or a face
     that repeats a vertex. Boundaries, several components, unreferenced
-    vertices, non-manifold edges and degenerate faces are accepted.
+    vertices, non-manifold edges and degenerate faces are accepted; copies of
+    a face (its vertices again, in any order) are counted in ``info`` and
+    stand aside, so that they make no edge non-manifold.
 
     A Mesh may be used from several threads at once: each concurrent call
     gets its own solver workspace, and the C calls release the GIL. Free it
