@@ -116,15 +116,14 @@ static mfmm_status build_edges(mfmm_mesh *m)
             else
                 n_nonmanifold++;
         }
-        /* a copy's edge leads where its original's does */
-        for (size_t t = i; t < j; t++) {
-            int32_t f = he[t].corner / 3;
-            if (!mfmm_mesh_copy(m, f))
-                continue;
-            int32_t g = mfmm_mesh_original(m, f);
-            for (size_t s = i; s < j; s++)
-                if (he[s].corner / 3 == g)
-                    m->face_neighbor[he[t].corner] = m->face_neighbor[he[s].corner];
+        /* a copy's edge leads where its original's does: copies follow
+         * their original in face order, hence in the group (O(faces), even
+         * for a million copies of one face) */
+        for (size_t t = i, s = i; t < j; t++) {
+            if (!mfmm_mesh_copy(m, he[t].corner / 3))
+                s = t;
+            else
+                m->face_neighbor[he[t].corner] = m->face_neighbor[he[s].corner];
         }
         i = j;
     }
