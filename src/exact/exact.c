@@ -101,6 +101,8 @@
 /* a vertex this near (in edge lengths) to the pseudo-source of the path
  * that reached it starts windows all around (ex_set_in) */
 #define EX_NEAR 1e-3
+/* zero-area faces one window may pass through in a row (ex_pass) */
+#define EX_MAX_PASS 8
 /* a vertex whose angle sum exceeds 2 pi by this much is a saddle */
 #define EX_SADDLE_TOL 1e-12
 
@@ -195,6 +197,7 @@ struct mfmm_exact_solver {
     size_t fixed_bytes, memory_limit, peak_bytes;
     double max_d;
     int failed; /* MFMM_ERR_MEMORY_LIMIT or MFMM_ERR_OUT_OF_MEMORY once a growth fails */
+    int pass_depth; /* zero-area faces a window is passing through (ex_pass) */
     int64_t n_windows, n_propagated, n_pseudo, peak_windows;
 };
 
@@ -432,13 +435,15 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
             int32_t g = mesh->face_neighbor[3 * f + k];
             r->across[k] = -1;
             r->flip[k] = 0;
-            if (g < 0 || r->skip || t->fr[t->face_in[g]].skip)
+            if (g < 0 || r->skip == 2 || t->fr[t->face_in[g]].skip == 2)
                 continue;
             int32_t a = fv[(k + 1) % 3], b = fv[(k + 2) % 3];
             const int32_t *gv = F[g].v;
             for (int m = 0; m < 3; m++) {
                 if (gv[m] != a && gv[m] != b) {
-                    r->across[k] = 3 * t->face_in[g] + m;
+                    /* into a zero-area face: -2 - its half-edge (ex_pass) */
+                    int32_t hg = 3 * t->face_in[g] + m;
+                    r->across[k] = t->fr[t->face_in[g]].skip ? -2 - hg : hg;
                     r->flip[k] = gv[(m + 1) % 3] != a;
                 }
             }
@@ -460,7 +465,7 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
             double a = atan2(y * L, y * y - x * (L - x));
             t->fr[f].angle[k] = a;
             angle[fv[k]] += a;
-            if (r->across[k] < 0) {
+            if (r->across[k] < 0) { /* a wall, or a zero-area face */
                 t->pseudo[fv[(k + 1) % 3]] = 1;
                 t->pseudo[fv[(k + 2) % 3]] = 1;
             }
@@ -811,7 +816,7 @@ static void ex_set_in(mfmm_exact_ws *ws, int32_t v, int32_t c, double psi, doubl
      * away near the straight-on direction, wider than the shadow's margin
      * (a point 1e-9 beside a saddle of hand left vertices at +inf): v starts
      * windows all around, as a source does (sound: they are real paths) */
-    if (r < EX_NEAR * L)
+    if (r < EX_NEAR * L || ws->fr[c / 3].skip)
         return;
     /* a direction outside the corner (rounding at a grazing ray) is not
      * trusted: in_angle stays NaN and v starts windows all around */
@@ -856,6 +861,53 @@ static double ex_gap(double x, double s0, double s1)
     return g > 0.0 ? g : 0.0;
 }
 
+static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double ix, double iy,
+                    double sigma, int known);
+
+/* A window entering a zero-area face D through D's half-edge hd (flip: hd
+ * runs the other way from the window's frame, an edge of length L). D's
+ * corners lie on one line, so the points of the edge crossed are points of
+ * D's other edges where their spans overlap it: a T-junction closed by a
+ * needle (m on the segment ab, faces on ab one side and on am, mb the
+ * other) joins the faces on both sides along the line. The window goes on,
+ * in the same plane, from each overlap into the face across it (ex_emit):
+ * the same straight paths. Before, D was a wall, and a shortest path
+ * across the junction went round through a vertex. */
+static void ex_pass(mfmm_exact_ws *ws, int32_t hd, int flip, double L, double s0, double s1,
+                    double ix, double iy, double sigma)
+{
+    if (ws->pass_depth >= EX_MAX_PASS)
+        return;
+    if (flip) {
+        double t0 = L - s1;
+        s1 = L - s0;
+        s0 = t0;
+        ix = L - ix;
+    }
+    const ex_face *r = ws->fr + hd / 3;
+    int k = hd % 3;
+    /* D's corners on the line, in hd's frame (v[k+1] at 0, v[k+2] at L) */
+    double t[3];
+    t[ex_next[k]] = 0.0;
+    t[ex_prev[k]] = L;
+    t[k] = r->cx[k];
+    if (!isfinite(t[k]))
+        return;
+    ws->pass_depth++;
+    for (int j = 0; j < 3; j++) {
+        if (j == k)
+            continue;
+        /* half-edge 3D + j runs from its corner v[j+1] to v[j+2] */
+        double u0 = t[ex_next[j]], u1 = t[ex_prev[j]];
+        double lo = fmax(s0, fmin(u0, u1)), hi = fmin(s1, fmax(u0, u1));
+        if (!(hi > lo))
+            continue;
+        double dir = u1 >= u0 ? 1.0 : -1.0, a0 = (lo - u0) * dir, a1 = (hi - u0) * dir;
+        ex_emit(ws, hd - k + j, fmin(a0, a1), fmax(a0, a1), (ix - u0) * dir, iy, sigma, 0);
+    }
+    ws->pass_depth--;
+}
+
 /* A window on half-edge h = 3f+k in f's frame (I on f's side: iy >= 0),
  * interval [s0, s1], leaving f: updates the vertices it reaches, trims it
  * against the edge's ends, and queues it in the face across, in that face's
@@ -890,8 +942,11 @@ MFMM_INLINE void ex_emit_inline(mfmm_exact_ws *ws, int32_t h, double s0, double 
         }
     }
     int32_t g = r->across[k];
-    if (g < 0 || !(s1 - s0 > EX_MIN_WIDTH * L))
+    if (g < 0 || !(s1 - s0 > EX_MIN_WIDTH * L)) {
+        if (g < -1 && s1 - s0 > EX_MIN_WIDTH * L)
+            ex_pass(ws, -2 - g, r->flip[k], L, s0, s1, ix, iy, sigma);
         return;
+    }
 #ifdef __GNUC__
     /* the face the window will cross, read when it is popped: after a
      * march has run through the mesh its record is far from the core */
@@ -1029,6 +1084,13 @@ static void ex_start_vertex(mfmm_exact_ws *ws, int32_t v, double dv)
         for (int32_t i = ws->vf_offset[v]; i < ws->vf_offset[v + 1]; i++) {
             int32_t c = ex_corner(ws->vf_corner, ws->face_in, i);
             const ex_face *r = ws->fr + c / 3;
+            if (r->skip == 1) {
+                /* a zero-area face's edges from v: real paths (an
+                 * all-degenerate strip reached nothing) */
+                int k = c % 3;
+                ex_update(ws, r->v[ex_next[k]], dv + r->len[ex_prev[k]], 0);
+                ex_update(ws, r->v[ex_prev[k]], dv + r->len[ex_next[k]], 0);
+            }
             if (r->skip)
                 continue;
             ex_emit(ws, c, 0.0, r->len[c % 3], r->cx[c % 3], r->cy[c % 3], dv, 0);

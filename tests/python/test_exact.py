@@ -129,3 +129,47 @@ def test_cli_distance_exact(tmp_path, reference_dir):
                         "--cost", str(tmp_path / "c.npy"), "-o", str(tmp_path / "x.npy")],
                        capture_output=True, text=True)
     assert r.returncode == 2 and "--exact" in r.stderr
+
+
+def _grid_with_t_junctions(n=10, splits=((3, 4), (5, 5), (6, 2), (2, 7))):
+    """A flat n x n grid on [0,1]^2 whose diagonals at the given squares are
+    split on one side only: the diagonal's other face is cut in two at the
+    midpoint m, and a zero-area face (q, p, m) closes the T-junction, as
+    exporters and mesh repair tools leave them. The surface is still the
+    unit square, so distances are Euclidean."""
+    xs = np.linspace(0.0, 1.0, n + 1)
+    V = [(x, y, 0.0) for y in xs for x in xs]
+    F = []
+    for j in range(n):
+        for i in range(n):
+            a = j * (n + 1) + i
+            b, c, d = a + 1, a + n + 1, a + n + 2
+            if (i, j) in splits:  # faces (a, b, d) and (d, c, a) share diagonal a-d
+                m = len(V)
+                V.append(((V[a][0] + V[d][0]) / 2, (V[a][1] + V[d][1]) / 2, 0.0))
+                F += [(a, b, d), (d, c, m), (m, c, a), (d, a, m)]  # (d, a, m): the cap
+            else:
+                F += [(a, b, d), (d, c, a)]
+    return np.array(V), np.array(F, dtype=np.int32)
+
+
+def test_zero_area_faces_closing_t_junctions_are_no_walls():
+    """Zero-area faces were walls for the exact solver: across a T-junction
+    closed by a needle cap a path went round through a vertex (the square
+    split at (.5,.5), (.25,.25) gave 1.0607 for 0.7906), and on an
+    all-degenerate strip nothing was reached. Now windows pass through the
+    needle (ex_pass) and its edges are relaxed; the exact solver equals the
+    Euclidean distance on the flat grid (analytic), as does the FMM within
+    its exact start's radius."""
+    import meshfmm
+
+    V, F = _grid_with_t_junctions()
+    m = meshfmm.Mesh(V, F)
+    assert m.info.n_degenerate_faces == 4
+    for s in (0, 37, 60, 120):
+        ref = np.linalg.norm(V - V[s], axis=1)
+        np.testing.assert_allclose(m.distance(s, method="exact"), ref, rtol=1e-12, atol=1e-14)
+        near = ref < 0.3  # inside the exact start of every source here
+        np.testing.assert_allclose(m.distance(s)[near], ref[near], rtol=1e-12, atol=1e-14)
+    strip = meshfmm.Mesh([[0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0.0]], [[0, 1, 2], [1, 2, 3]])
+    np.testing.assert_array_equal(strip.distance(0, method="exact"), [0.0, 1.0, 2.0, 3.0])
