@@ -248,7 +248,10 @@ MFMM_API void mfmm_solver_destroy(mfmm_solver *solver);
 
 typedef struct mfmm_solve_options {
     size_t struct_size;              /* sizeof(mfmm_solve_options), set by the _init function */
-    const double *cost;              /* NULL: F = 1 */
+    const double *cost;              /* NULL: F = 1. Finite and > 0, and small enough that
+                                        the largest times the edges' total length stays
+                                        below DBL_MAX / 16 (else distances could overflow
+                                        to +inf, "not reached"): MFMM_ERR_BAD_COST */
     mfmm_cost_location cost_location;/* ignored when cost is NULL */
     double max_distance;             /* stop past it; vertices beyond are +inf. Default +inf;
                                         NaN or < 0: MFMM_ERR_BAD_ARGUMENT */
@@ -549,7 +552,10 @@ typedef int (*mfmm_sparse_callback)(void *user, int32_t first_row, int32_t n_row
 typedef struct mfmm_matrix_options {
     size_t struct_size;              /* sizeof(mfmm_matrix_options), set by the _init function */
     mfmm_backend backend;            /* default MFMM_BACKEND_AUTO */
-    mfmm_dtype dtype;                /* output type; arithmetic is always float64. Default float32 */
+    mfmm_dtype dtype;                /* output type; arithmetic is always float64. Default
+                                        float32, refused (MFMM_ERR_BAD_ARGUMENT) where a
+                                        distance could pass FLT_MAX: the edges' total length
+                                        times the largest cost, or max_distance if less */
     const double *cost;              /* as in mfmm_solve_options */
     mfmm_cost_location cost_location;
     double max_distance;             /* default +inf; NaN or < 0: MFMM_ERR_BAD_ARGUMENT */

@@ -1,4 +1,5 @@
 /* The checks of a solve's arguments (check.h). */
+#include <float.h>
 #include <math.h>
 
 #include "check.h"
@@ -12,12 +13,34 @@ mfmm_status mfmm_check_cost(const mfmm_mesh *mesh, const double *cost,
     if (where != MFMM_COST_PER_VERTEX && where != MFMM_COST_PER_FACE)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
                          "a cost array was given without a cost location (per vertex or per face)");
-    int32_t n = where == MFMM_COST_PER_VERTEX ? mesh->nv : mesh->nf;
-    for (int32_t i = 0; i < n; i++)
+    int32_t n = where == MFMM_COST_PER_VERTEX ? mesh->nv : mesh->nf, imax = 0;
+    for (int32_t i = 0; i < n; i++) {
         if (!isfinite(cost[i]) || !(cost[i] > 0.0))
             return mfmm_fail(err, MFMM_ERR_BAD_COST, i, "cost of %s %ld is %g; costs must be finite and > 0",
                              where == MFMM_COST_PER_VERTEX ? "vertex" : "face", (long)i, cost[i]);
+        imax = cost[i] > cost[imax] ? i : imax;
+    }
+    /* a distance overflowing to +inf would read as "not reached" */
+    double bound = mfmm_distance_bound(mesh, cost, where);
+    if (!(bound < DBL_MAX / 16))
+        return mfmm_fail(err, MFMM_ERR_BAD_COST, imax,
+                         "cost of %s %ld is %g: with edges %g long in all, distances may overflow "
+                         "(rescale the costs)",
+                         where == MFMM_COST_PER_VERTEX ? "vertex" : "face", (long)imax, cost[imax],
+                         mesh->info.mean_edge_length * mesh->info.n_edges);
     return MFMM_OK;
+}
+
+double mfmm_distance_bound(const mfmm_mesh *mesh, const double *cost, mfmm_cost_location where)
+{
+    double fmax_ = 1.0;
+    if (cost && (where == MFMM_COST_PER_VERTEX || where == MFMM_COST_PER_FACE)) {
+        int32_t n = where == MFMM_COST_PER_VERTEX ? mesh->nv : mesh->nf;
+        fmax_ = 0.0;
+        for (int32_t i = 0; i < n; i++)
+            fmax_ = cost[i] > fmax_ ? cost[i] : fmax_;
+    }
+    return fmax_ * (mesh->info.mean_edge_length * mesh->info.n_edges);
 }
 
 mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int32_t i,

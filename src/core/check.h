@@ -9,6 +9,12 @@
 mfmm_status mfmm_check_cost(const mfmm_mesh *mesh, const double *cost,
                             mfmm_cost_location where, mfmm_error *err);
 
+/* An upper bound on every finite distance a solve can give from sources of
+ * value 0 (the march's and the exact solver's values are at most those of
+ * paths along edges): the sum of the edge lengths times the largest cost
+ * (1 without one; cost checked). */
+double mfmm_distance_bound(const mfmm_mesh *mesh, const double *cost, mfmm_cost_location where);
+
 /* Checks source i: ids in range, face not degenerate, barycentric valid. */
 mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int32_t i,
                               mfmm_error *err);

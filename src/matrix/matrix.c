@@ -1,5 +1,6 @@
 /* mfmm_distance_matrix: many sources, rows handed out in blocks, on the
  * serial core (one thread or many) or on OpenCL (src/opencl_host.c). */
+#include <float.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -537,6 +538,16 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     }
     const double *cost = own_cost ? own_cost : o->cost;
     mfmm_status cst = mfmm_check_cost(mesh, cost, o->cost_location, err);
+    if (cst == MFMM_OK && o->dtype == MFMM_FLOAT32) {
+        /* a float32 entry above FLT_MAX would read as +inf, "not reached" */
+        double bound = fmin(mfmm_distance_bound(mesh, cost, o->cost_location), o->max_distance);
+        if (!(bound <= FLT_MAX))
+            cst = mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                            "distances may exceed float32's range (%g) on this mesh (its edges "
+                            "are %g long in all%s): use float64, or rescale",
+                            (double)FLT_MAX, mesh->info.mean_edge_length * mesh->info.n_edges,
+                            cost ? ", times the largest cost" : "");
+    }
     /* ids and costs in the mesh's internal order (core/order.h), after the
      * checks (whose messages name the caller's ids) */
     double *mapped_cost = NULL;

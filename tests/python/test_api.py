@@ -285,6 +285,10 @@ BAD = [
     ("path target face -1", "m.geodesic_path(m.distance(0), meshfmm.SurfacePoint(-1, (1, 0, 0)))",
      "ValueError", ["face -1"]),
     ("sources dict", "m.distance({0: 1})", "TypeError", ["dict"]),
+    # distances that would overflow to +inf, which reads as "not reached"
+    ("cost overflows", "m.distance(0, cost=np.full(len(V), 1e307))", "ValueError", ["overflow"]),
+    ("matrix float32 range", "meshfmm.Mesh(V * 1e38, F).distance_matrix([0])", "ValueError",
+     ["float32"]),
 ]
 
 SCRIPT = textwrap.dedent(
@@ -331,6 +335,19 @@ def test_bad_input(bad_results, name, code, expected, words):
     assert message.strip(), f"{code!r}: {got[0]} without a message"
     for w in words:
         assert w in message, f"{code!r}: message {message!r} does not name {w!r}"
+
+
+def test_large_values_within_range_are_kept():
+    """The overflow checks refuse only what can overflow: float64 rows of a
+    mesh 1e38 wide and costs of 1e300 on a unit grid give their values."""
+    V, F = grid(3)
+    big = meshfmm.Mesh(V * 1e38, F)
+    np.testing.assert_allclose(big.distance_matrix([0], dtype="float64")[0],
+                               big.distance(0), rtol=0)
+    assert big.distance(0)[3] == pytest.approx(1e38, rel=1e-15)
+    m = meshfmm.Mesh(V, F)
+    np.testing.assert_allclose(m.distance(0, cost=np.full(len(V), 1e300)), 1e300 * m.distance(0),
+                               rtol=1e-15)
 
 
 def test_mesh_error_is_value_error():
