@@ -52,7 +52,8 @@ static void help(FILE *out)
             "  --no-spokes         memory first: no per-vertex update records (~380 bytes\n"
             "                      per vertex, built once for the march); the same\n"
             "                      matrix, each row's march ~1.25x as long\n"
-            "  --quiet             no progress lines\n\n"
+            "  --quiet             nothing on stderr but errors (no progress, no notes, no\n"
+            "                      summary line)\n\n"
             "Environment: MESHFMM_OPENCL_DEVICE (device index or name substring),\n"
             "MESHFMM_CACHE_DIR (OpenCL program cache, default ~/.cache/meshfmm).\n"
             "SIGINT, SIGTERM or SIGHUP stop the run, remove the temporary file and exit\n"
@@ -406,7 +407,7 @@ int cmd_allpairs(int argc, char **argv)
      * delivered) when OpenCL fails or cannot keep every core busy */
     mfmm_status st = mfmm_distance_matrix(mesh, src, (int32_t)n_src, &o, &err);
     mfmm_backend used = o.backend_used;
-    if (o.fallback_reason[0] && !tgt && !sparse)
+    if (o.fallback_reason[0] && !tgt && !sparse && !quiet)
         fprintf(stderr, "meshfmm allpairs: OpenCL not used (%s); falling back to threads\n",
                 o.fallback_reason);
     if (cli_interrupted()) {
@@ -440,7 +441,8 @@ int cmd_allpairs(int argc, char **argv)
             rc = CLI_EXIT_INTERRUPTED;
         goto done;
     }
-    fprintf(stderr, "meshfmm allpairs: %lld x %lld %s%s matrix, backend %s, %.2f s, wrote %s\n",
+    if (!quiet)
+        fprintf(stderr, "meshfmm allpairs: %lld x %lld %s%s matrix, backend %s, %.2f s, wrote %s\n",
             (long long)n_src, (long long)n_cols, sparse ? "sparse " : "", o.dtype == MFMM_FLOAT64 ? "float64" : "float32",
             mfmm_backend_name(used), now() - s.t0, out_path);
     rc = CLI_OK;

@@ -34,8 +34,11 @@ for v in 0 17 400 809 3; do
     "$M" distance "$MESH" --source $v -o "$T/row_$v.npy" || fail "distance --source $v"
 done
 # the float32 default, all vertices
-"$M" allpairs "$MESH" -o "$T/all32.npy" --quiet 2> "$T/err32.txt" || { cat "$T/err32.txt"; fail "allpairs float32"; }
+"$M" allpairs "$MESH" -o "$T/all32.npy" 2> "$T/err32.txt" || { cat "$T/err32.txt"; fail "allpairs float32"; }
 grep -q "810 x 810 float32" "$T/err32.txt" || fail "summary line: $(cat "$T/err32.txt")"
+# --quiet: nothing on stderr (the OpenCL note and the summary went there too)
+"$M" allpairs "$MESH" -o "$T/q.npy" --sources "$T/src.txt" --quiet 2> "$T/errq.txt" || fail "allpairs --quiet"
+[ ! -s "$T/errq.txt" ] || fail "--quiet printed: $(cat "$T/errq.txt")"
 # float32 .npy: 128-byte header + 810*810*4 bytes
 [ "$(wc -c < "$T/all32.npy")" -eq $((128 + 810 * 810 * 4)) ] || fail "float32 file size"
 
