@@ -292,7 +292,7 @@ int cmd_allpairs(int argc, char **argv)
         case OPT_MEMORY: {
             double mb;
             if (!cli_parse_double(val, &mb) || !(mb > 0) || mb > 1e9)
-                return cli_usage_error("allpairs", "--memory needs megabytes > 0");
+                return cli_usage_error("allpairs", "--memory takes megabytes, > 0 and at most 1e9");
             o.memory_limit = (size_t)(mb * 1048576.0);
             break;
         }

@@ -108,7 +108,7 @@ int cmd_path(int argc, char **argv)
         } else if (c == OPT_TARGET_FACE) {
             if (!cli_take_face_point(optarg, argc, argv, &target)) {
                 rc = cli_usage_error("path",
-                                     "--target-face needs a face id and three barycentric weights");
+                                     "--target-face needs a face id and three barycentric weights, finite numbers");
                 goto done;
             }
             have_target = 1;

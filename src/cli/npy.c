@@ -479,7 +479,7 @@ int cli_txt_read_vector(const char *path, double **values, int64_t *n)
     if (cli_read_file(path, &d, &size))
         return -1;
     if (memchr(d, '\0', size)) {
-        cli_error("%s: NUL byte in a text file", path);
+        cli_error("%s: a binary file (NUL byte), not text; give a .npy file or one number per line", path);
         free(d);
         return -1;
     }

@@ -48,7 +48,7 @@ int cli_sources_and_cost_opt(cli_sources_and_cost *o, int c, int argc, char **ar
     case OPT_FACE_SOURCE:
         if (!cli_take_face_point(optarg, argc, argv, &o->src[o->n_src]))
             return cli_usage_error(o->sub,
-                                   "--face-source needs a face id and three barycentric weights");
+                                   "--face-source needs a face id and three barycentric weights, finite numbers");
         o->n_src++;
         return CLI_OK;
     case OPT_COST:

@@ -462,11 +462,11 @@ static mfmm_status validate(const double *vertices, int32_t nv, const int32_t *f
         for (int k = 0; k < 3; k++)
             if (t[k] < 0 || t[k] >= nv)
                 return mfmm_fail(err, MFMM_ERR_INDEX_OUT_OF_RANGE, f,
-                                 "face %lld names vertex %ld, outside [0, %ld)", (long long)f,
+                                 "face %lld names vertex %ld, outside [0, %ld) (ids count from 0)", (long long)f,
                                  (long)t[k], (long)nv);
         if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
             return mfmm_fail(err, MFMM_ERR_REPEATED_VERTEX, f,
-                             "face %lld names a vertex twice (%ld, %ld, %ld)", (long long)f,
+                             "face %lld names a vertex twice (%ld, %ld, %ld; ids count from 0)", (long long)f,
                              (long)t[0], (long)t[1], (long)t[2]);
     }
     return MFMM_OK;
@@ -576,9 +576,8 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
             hi[k] = fmax(hi[k], m->xyz[3 * (size_t)v + k]);
         }
     }
-    m->info.bbox_diagonal = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) +
-                                 (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                 (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    /* hypot: squares of 1e-200 underflow to 0 */
+    m->info.bbox_diagonal = hypot(hypot(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
     /* below this, squared lengths underflow and every edge would measure 0 */
     if (!(m->info.bbox_diagonal >= MFMM_MIN_DIAGONAL)) {
         double diag = m->info.bbox_diagonal;

@@ -382,8 +382,10 @@ mfmm_status mfmm_io_parse_ply(const char *data, size_t size, mfmm_io_result *out
                 int64_t item = h.format == F_ASCII ? 2 : type_size[pr->type];
                 if (n < 0 || n > (int64_t)((size_t)(r.end - r.p) / (size_t)item) + 1) {
                     st = mfmm_fail(err, MFMM_ERR_PARSE, i,
-                                   "%s %lld: bad list length %lld", elem_label(e),
-                                   (long long)i, (long long)n);
+                                   n < 0 ? "%s %lld: bad list length %lld"
+                                         : "%s %lld: a list of %lld values runs past the end of "
+                                           "the file (truncated?)",
+                                   elem_label(e), (long long)i, (long long)n);
                     goto fail;
                 }
                 if (e->role[k] != 3) {
@@ -453,8 +455,9 @@ mfmm_status mfmm_io_parse_ply(const char *data, size_t size, mfmm_io_result *out
             continue;
         truncated:
             st = mfmm_fail(err, MFMM_ERR_PARSE, i,
-                           r.p >= r.end ? "%s %lld: unexpected end of file"
-                                        : "%s %lld: malformed value",
+                           r.p >= r.end || h.format != F_ASCII
+                               ? "%s %lld: unexpected end of file (truncated?)"
+                               : "%s %lld: malformed value",
                            elem_label(e), (long long)i);
             goto fail;
         }
