@@ -499,6 +499,13 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
         for (int32_t j = t->vf_offset[v]; j < t->vf_offset[v + 1]; j++) {
             int32_t c = ex_corner(t->vf_corner, t->face_in, j);
             const ex_face *r = t->fr + c / 3;
+            if (r->skip == 1) {
+                /* a path may reach v along a zero-area face's edge, or
+                 * through it from a face that has v on an edge (ex_pass):
+                 * no height bounds its last segment */
+                h = 0.0;
+                break;
+            }
             if (!r->skip && r->cy[c % 3] < h)
                 h = r->cy[c % 3];
         }
@@ -1090,6 +1097,10 @@ static void ex_start_vertex(mfmm_exact_ws *ws, int32_t v, double dv)
                 int k = c % 3;
                 ex_update(ws, r->v[ex_next[k]], dv + r->len[ex_prev[k]], 0);
                 ex_update(ws, r->v[ex_prev[k]], dv + r->len[ex_next[k]], 0);
+                /* v on the opposite edge (a needle's middle): v lies on the
+                 * edge of the face across it, and starts windows there */
+                if (r->cx[k] >= 0.0 && r->cx[k] <= r->len[k])
+                    ex_emit(ws, c, 0.0, r->len[k], r->cx[k], 0.0, dv, 0);
             }
             if (r->skip)
                 continue;
