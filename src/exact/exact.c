@@ -61,7 +61,10 @@
  * Sources: a vertex source is a pseudo-source with its value; a point in a
  * face (on an edge too) starts a window on each edge of its face; a point
  * within 1e-12 of a corner is that corner. Boundary and non-manifold edges
- * (face_neighbor -1) and edges of zero-area faces are walls. max_distance
+ * (face_neighbor -1) are walls; copies of a face are no part of the surface
+ * (skip 2); a zero-area face (skip 1, its corners on one line) is passed
+ * through along that line (ex_pass), its edges relax their ends, and a
+ * vertex on its longest edge starts windows across that edge. max_distance
  * (and the radius of mfmm_exact_patch) drops every window and event beyond
  * it, so the work grows with the area reached.
  *
