@@ -20,9 +20,9 @@ mfmm_status mfmm_check_cost(const mfmm_mesh *mesh, const double *cost,
                              where == MFMM_COST_PER_VERTEX ? "vertex" : "face", (long)i, cost[i]);
         imax = cost[i] > cost[imax] ? i : imax;
     }
-    /* a distance overflowing to +inf would read as "not reached" */
-    double bound = mfmm_distance_bound(mesh, cost, where);
-    if (!(bound < DBL_MAX / 16))
+    /* a distance overflowing to +inf would read as "not reached" (the
+     * bound of mfmm_distance_bound) */
+    if (!(cost[imax] * (mesh->info.mean_edge_length * mesh->info.n_edges) < DBL_MAX / 16))
         return mfmm_fail(err, MFMM_ERR_BAD_COST, imax,
                          "cost of %s %ld is %g: with edges %g long in all, distances may overflow "
                          "(rescale the costs)",

@@ -462,12 +462,12 @@ static mfmm_status validate(const double *vertices, int32_t nv, const int32_t *f
         for (int k = 0; k < 3; k++)
             if (t[k] < 0 || t[k] >= nv)
                 return mfmm_fail(err, MFMM_ERR_INDEX_OUT_OF_RANGE, f,
-                                 "face %lld names vertex %ld, outside [0, %ld) (ids count from 0)", (long long)f,
-                                 (long)t[k], (long)nv);
+                                 "face %lld names vertex %ld, outside [0, %ld) (ids count from 0)",
+                                 (long long)f, (long)t[k], (long)nv);
         if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
             return mfmm_fail(err, MFMM_ERR_REPEATED_VERTEX, f,
-                             "face %lld names a vertex twice (%ld, %ld, %ld; ids count from 0)", (long long)f,
-                             (long)t[0], (long)t[1], (long)t[2]);
+                             "face %lld names a vertex twice (%ld, %ld, %ld; ids count from 0)",
+                             (long long)f, (long)t[0], (long)t[1], (long)t[2]);
     }
     return MFMM_OK;
 }
