@@ -344,9 +344,7 @@ class Mesh:
                 )
             V, F = V.vertices, V.faces
         self._max_unfold_steps = max_unfold_steps
-        if not isinstance(spokes, (bool, np.bool_)):
-            raise TypeError(f"spokes must be True or False, got {spokes!r}")
-        self._spokes = bool(spokes)
+        self._spokes = _flag(spokes, "spokes")
         self._lock = threading.Lock()
         self._active = 0
         self._solvers: List[int] = []
