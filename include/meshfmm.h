@@ -320,9 +320,12 @@ MFMM_API mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources,
  * only in their shadow; see src/exact/exact.c). Equal to Kirsanov's MMP
  * (igl.exact_geodesic, gdist) to rounding (about 1e-14 relative), several
  * times faster than gdist. Boundaries and non-manifold edges are walls a
- * path may run along but not cross; paths may pass through saddle,
- * boundary and non-manifold vertices; zero-area faces are skipped (a vertex
- * on no other face is +inf). Not for a cost: see mfmm_solve. */
+ * path may run along but not cross (at a non-manifold edge an upper
+ * bound: README, "Imperfect meshes"); paths may pass through saddle,
+ * boundary and non-manifold vertices; a zero-area face is passed through
+ * along its line (a T-junction closed by a needle joins both sides);
+ * copies of a face are no part of the surface. Not for a cost: see
+ * mfmm_solve. */
 typedef struct mfmm_exact_solver mfmm_exact_solver;
 
 /* A workspace for one mesh and one thread: per-vertex state (about 45
