@@ -53,6 +53,12 @@ enum {
     OPT_SOURCES, OPT_THREADS, OPT_MEMORY, OPT_TARGETS, OPT_PLAIN_START, OPT_EXACT_START_RADIUS,
     OPT_NO_SPOKES
 };
+/* Refuses a value option given a second time, which getopt_long would let
+ * win silently (`-o a.npy -o b.npy`): call it with every code getopt_long
+ * returns; *seen (0 at first) records the value options met. Flags and the
+ * repeatable --source/--face-source pass. CLI_OK, or CLI_USAGE with the
+ * error printed. */
+int cli_once(const char *sub, int c, uint32_t *seen);
 /* Prints the usage error for getopt_long's '?' or ':' (opterr is 0; the
  * optstring starts with ':'); returns CLI_USAGE. */
 int cli_getopt_error(const char *sub, int c, char **argv);

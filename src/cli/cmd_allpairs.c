@@ -204,7 +204,7 @@ int cmd_allpairs(int argc, char **argv)
     mfmm_backend backend = MFMM_BACKEND_AUTO;
     mfmm_mesh_options mo;
     mfmm_mesh_options_init(&mo);
-    int quiet = 0, start_given = 0;
+    int quiet = 0, start_given = 0, threads_given = 0;
     static const struct option longopts[] = {
         {"help", no_argument, NULL, 'h'},
         {"output", required_argument, NULL, 'o'},
@@ -227,8 +227,11 @@ int cmd_allpairs(int argc, char **argv)
         {NULL, 0, NULL, 0}};
     int c;
     opterr = 0;
+    uint32_t seen = 0;
     while ((c = getopt_long(argc, argv, ":ho:q", longopts, NULL)) != -1) {
         const char *val = optarg;
+        if (cli_once("allpairs", c, &seen) != CLI_OK)
+            return CLI_USAGE;
         switch (c) {
         case 'h':
             help(stdout);
@@ -255,8 +258,6 @@ int cmd_allpairs(int argc, char **argv)
             return cli_usage_error("allpairs", "takes its rows' sources as --sources FILE (one "
                                                 "source: meshfmm distance --source %s)", val);
         case OPT_SOURCES:
-            if (sources_path)
-                return cli_usage_error("allpairs", "--sources given twice");
             sources_path = val;
             break;
         case OPT_TARGETS:
@@ -275,6 +276,7 @@ int cmd_allpairs(int argc, char **argv)
         case OPT_THREADS:
             if (!cli_parse_int32(val, &o.n_threads) || o.n_threads < 0)
                 return cli_usage_error("allpairs", "--threads needs a count >= 0 (0: all cores)");
+            threads_given = 1;
             break;
         case OPT_PLAIN_START:
             if (cli_start_option("allpairs", 1, &start_given) != CLI_OK)
@@ -319,6 +321,11 @@ int cmd_allpairs(int argc, char **argv)
                                "pairs within R); without it the matrix is dense: use .npy");
     if (cost_per_face && !cost_path)
         return cli_usage_error("allpairs", "--cost-per-face needs --cost");
+    if (threads_given && (backend == MFMM_BACKEND_SERIAL || backend == MFMM_BACKEND_OPENCL))
+        return cli_usage_error("allpairs", "--threads is for the threads backend (and auto's "
+                               "fallback to it); --backend %s does not use it",
+                               backend == MFMM_BACKEND_SERIAL ? "serial (one thread)"
+                                                              : "opencl (the device's cores)");
     const char *inputs[4] = {path, sources_path, cost_path, targets_path};
     if (cli_check_output_not_input("allpairs", out_path, inputs, 4) != CLI_OK)
         return CLI_USAGE;

@@ -92,7 +92,10 @@ int cmd_distance(int argc, char **argv)
         return CLI_FAIL;
     int c;
     opterr = 0;
+    uint32_t seen = 0;
     while ((c = getopt_long(argc, argv, CLI_SHARED_SHORT_OPTIONS, longopts, NULL)) != -1) {
+        if ((rc = cli_once("distance", c, &seen)) != CLI_OK)
+            goto done;
         if (c == OPT_MAX_DISTANCE) {
             if (!cli_parse_double(optarg, &opt.max_distance) || !(opt.max_distance >= 0)) {
                 rc = cli_usage_error("distance", "--max-distance needs a number >= 0");

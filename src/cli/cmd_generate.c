@@ -52,7 +52,10 @@ int cmd_generate(int argc, char **argv)
         {NULL, 0, NULL, 0}};
     int c;
     opterr = 0;
+    uint32_t seen = 0;
     while ((c = getopt_long(argc, argv, ":ho:", longopts, NULL)) != -1) {
+        if (cli_once("generate", c, &seen) != CLI_OK)
+            return CLI_USAGE;
         if (c == 'h') {
             help(stdout);
             return CLI_OK;

@@ -46,7 +46,10 @@ int cmd_info(int argc, char **argv)
         {NULL, 0, NULL, 0}};
     int c;
     opterr = 0;
+    uint32_t seen = 0;
     while ((c = getopt_long(argc, argv, ":h", longopts, NULL)) != -1) {
+        if (cli_once("info", c, &seen) != CLI_OK)
+            return CLI_USAGE;
         if (c == 'h') {
             help(stdout);
             return CLI_OK;

@@ -91,7 +91,10 @@ int cmd_path(int argc, char **argv)
         return CLI_FAIL;
     int c;
     opterr = 0;
+    uint32_t seen = 0;
     while ((c = getopt_long(argc, argv, CLI_SHARED_SHORT_OPTIONS, longopts, NULL)) != -1) {
+        if ((rc = cli_once("path", c, &seen)) != CLI_OK)
+            goto done;
         if ((c == OPT_TARGET || c == OPT_TARGET_FACE) && have_target) {
             rc = cli_usage_error("path", "one target (--target or --target-face), given twice");
             goto done;

@@ -64,6 +64,37 @@ int cli_usage_error(const char *sub, const char *fmt, ...)
     return CLI_USAGE;
 }
 
+int cli_once(const char *sub, int c, uint32_t *seen)
+{
+    /* the value options, each with its bit */
+    static const struct {
+        int code;
+        const char *name;
+    } once[] = {{'o', "-o/--output"},
+                {OPT_COST, "--cost"},
+                {OPT_MAX_DISTANCE, "--max-distance"},
+                {OPT_EXACT_START_RADIUS, "--exact-start-radius"},
+                {OPT_MAX_POINTS, "--max-points"},
+                {OPT_MAX_UNFOLD_STEPS, "--max-unfold-steps"},
+                {OPT_STRETCH, "--stretch"},
+                {OPT_RADII, "--radii"},
+                {OPT_DTYPE, "--dtype"},
+                {OPT_BACKEND, "--backend"},
+                {OPT_SOURCES, "--sources"},
+                {OPT_TARGETS, "--targets"},
+                {OPT_THREADS, "--threads"},
+                {OPT_MEMORY, "--memory"}};
+    for (unsigned i = 0; i < sizeof once / sizeof once[0]; i++) {
+        if (once[i].code != c)
+            continue;
+        if (*seen & (UINT32_C(1) << i))
+            return cli_usage_error(sub, "%s given twice; give it once", once[i].name);
+        *seen |= UINT32_C(1) << i;
+        return CLI_OK;
+    }
+    return CLI_OK;
+}
+
 int cli_getopt_error(const char *sub, int c, char **argv)
 {
     const char *arg = optind > 0 ? argv[optind - 1] : "?";

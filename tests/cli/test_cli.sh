@@ -272,9 +272,24 @@ expect 2 "path with two targets" "$BIN" path "$T/g.obj" --source "$C" --target "
 expect 2 "allpairs --source (not an abbreviation of --sources)" "$BIN" allpairs "$T/g.obj" --source 3 -o "$T/x.npy" &&
     { grep -q "meshfmm distance --source 3" "$T/err" && ok "allpairs --source message" || fail "message: $(cat "$T/err")"; }
 expect 2 "allpairs --sources twice" "$BIN" allpairs "$T/g.obj" --sources "$T/one.txt" --sources "$T/one.txt" -o "$T/x.npy"
+# a value option given twice: getopt_long would let the last win silently
+expect 2 "allpairs -o twice" "$BIN" allpairs "$T/g.obj" -o "$T/x.npy" --output "$T/y.npy" &&
+    { grep -q -- "-o/--output given twice" "$T/err" && ok "-o twice message" || fail "message: $(cat "$T/err")"; }
+expect 2 "distance --max-distance twice" "$BIN" distance "$T/g.obj" --source "$C" --max-distance 1 --max-distance 2 -o "$T/x.txt"
+expect 2 "distance --exact-start-radius twice" "$BIN" distance "$T/g.obj" --source "$C" --exact-start-radius 1 --exact-start-radius 2 -o "$T/x.txt"
+expect 2 "path --cost twice" "$BIN" path "$T/g.obj" --source "$C" --target "$C2" --cost "$T/cost.txt" --cost "$T/cost.txt" -o "$T/x.csv"
+expect 2 "path --max-points twice" "$BIN" path "$T/g.obj" --source "$C" --target "$C2" --max-points 9 --max-points 10 -o "$T/x.csv"
+expect 2 "generate -o twice" "$BIN" generate grid 4 -o "$T/x.obj" -o "$T/y.obj"
+expect 2 "info --max-unfold-steps twice" "$BIN" info "$T/g.obj" --max-unfold-steps 3 --max-unfold-steps 4
+expect 2 "allpairs --backend twice" "$BIN" allpairs "$T/g.obj" --backend serial --backend threads -o "$T/x.npy"
+expect 0 "distance --source twice (several sources)" "$BIN" distance "$T/g.obj" --source "$C" --source "$C2" -o "$T/two.txt"
+# --threads sizes the threads backend only
+expect 2 "allpairs --threads with --backend serial" "$BIN" allpairs "$T/g.obj" --threads 2 --backend serial -o "$T/x.npy"
+expect 2 "allpairs --threads with --backend opencl" "$BIN" allpairs "$T/g.obj" --backend opencl --threads 1 -o "$T/x.npy"
 expect 2 "generate grid --stretch" "$BIN" generate grid 4 --stretch 2 -o "$T/x.obj"
 expect 2 "generate sphere --radii" "$BIN" generate sphere 1 --radii 3 1 -o "$T/x.obj"
-[ ! -e "$T/x.txt" ] && [ ! -e "$T/x.npy" ] && [ ! -e "$T/x.obj" ] && ok "no output from refused runs" || fail "a refused run wrote"
+[ ! -e "$T/x.txt" ] && [ ! -e "$T/x.npy" ] && [ ! -e "$T/x.obj" ] && [ ! -e "$T/y.npy" ] &&
+    [ ! -e "$T/y.obj" ] && [ ! -e "$T/x.csv" ] && ok "no output from refused runs" || fail "a refused run wrote"
 # path's length is its result on stdout: a full stdout is a failure
 if [ -w /dev/full ]; then
     expect 1 "path with stdout full" sh -c '"$1" path "$2" --source "$3" --target "$4" -o "$5" >/dev/full' sh "$BIN" "$T/g.obj" "$C" "$C2" "$T/p.csv"

@@ -244,6 +244,16 @@ def test_command_line(tmp_path):
                           mesh.distance_matrix([0, 5, 9], backend="serial", dtype="float64"))
 
 
+@pytest.mark.parametrize("twice", [["-o", "b.zarr"], ["--dtype", "float32"], ["--workers", "2"]])
+def test_command_line_refuses_a_value_option_twice(tmp_path, twice):
+    # argparse let the last one win silently; the C command line refuses it
+    with pytest.raises(SystemExit) as e:
+        md.cli_allpairs_zarr([str(MESHES / "hand_lowres.obj"), "-o", str(tmp_path / "a.zarr"),
+                              "--workers", "1", "--dtype", "float64", *twice])
+    assert e.value.code == 2
+    assert not (tmp_path / "a.zarr").exists() and not (tmp_path / "b.zarr").exists()
+
+
 def test_progress_rate_counts_only_rows_computed_now(hand, client, tmp_path, capsys):
     # a resumed job's skipped rows are not work done in this run: before, they
     # entered the rate (a resumed job showed ~1e8 rows/s and 0 s left)

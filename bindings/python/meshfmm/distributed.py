@@ -19,6 +19,7 @@ Needs ``dask[distributed]`` and ``zarr>=3``.
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import ctypes
 import hashlib
@@ -575,33 +576,49 @@ def _read_ids(path: str, what: str) -> np.ndarray:
     return a
 
 
+class _Once(argparse.Action):
+    """A value option that may be given once: argparse would keep the last of
+    several silently (``-o a.zarr -o b.zarr``); the C command line refuses
+    them too (cli_once)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        given = namespace.__dict__.setdefault("_given", set())
+        if self.dest in given:
+            parser.error(f"{'/'.join(self.option_strings)} given twice; give it once")
+        given.add(self.dest)
+        setattr(namespace, self.dest, values)
+
+
 def cli_allpairs_zarr(argv: Sequence[str]) -> int:
     """``meshfmm allpairs MESH -o OUT.zarr [--scheduler ADDRESS | --workers N]
     [--resume] ...``: the distributed all-pairs job from the command line."""
-    import argparse
-
+    once = _Once  # every value option: given once
     ap = argparse.ArgumentParser(prog="meshfmm allpairs",
                                  description="All-pairs geodesic distances on a Dask cluster, "
                                              "written into a Zarr v3 array.")
     ap.add_argument("mesh")
-    ap.add_argument("-o", "--output", required=True, help="OUT.zarr (a directory or fsspec URL)")
+    ap.add_argument("-o", "--output", required=True, action=once,
+                    help="OUT.zarr (a directory or fsspec URL)")
     g = ap.add_mutually_exclusive_group()
-    g.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:port)")
-    g.add_argument("--workers", type=int, help="worker processes of a local cluster (default: cores)")
+    g.add_argument("--scheduler", action=once,
+                   help="address of a running Dask scheduler (tcp://host:port)")
+    g.add_argument("--workers", type=int, action=once,
+                   help="worker processes of a local cluster (default: cores)")
     ap.add_argument("--resume", action="store_true",
                     help="go on with a job already in OUT (default: start over)")
-    ap.add_argument("--dtype", choices=["float32", "float64"], default="float32")
-    ap.add_argument("--sources", help="vertex ids (.npy or .txt)")
-    ap.add_argument("--targets", help="vertex ids for the columns (.npy or .txt)")
-    ap.add_argument("--max-distance", type=float)
-    ap.add_argument("--cost", help="per-vertex or per-face cost (.npy or .txt)")
-    ap.add_argument("--backend", choices=["threads", "serial", "opencl", "auto"], default="threads")
+    ap.add_argument("--dtype", choices=["float32", "float64"], default="float32", action=once)
+    ap.add_argument("--sources", help="vertex ids (.npy or .txt)", action=once)
+    ap.add_argument("--targets", help="vertex ids for the columns (.npy or .txt)", action=once)
+    ap.add_argument("--max-distance", type=float, action=once)
+    ap.add_argument("--cost", help="per-vertex or per-face cost (.npy or .txt)", action=once)
+    ap.add_argument("--backend", choices=["threads", "serial", "opencl", "auto"], default="threads",
+                    action=once)
     st = ap.add_mutually_exclusive_group()
-    st.add_argument("--exact-start-radius", type=float, metavar="R",
+    st.add_argument("--exact-start-radius", type=float, metavar="R", action=once,
                     help="radius of the exact start in mean edge lengths (default: the library's)")
     st.add_argument("--plain-start", action="store_true", help="the paper's plain start")
-    ap.add_argument("--block-rows", type=int)
-    ap.add_argument("--compression", choices=list(_CODECS), default="lz4",
+    ap.add_argument("--block-rows", type=int, action=once)
+    ap.add_argument("--compression", choices=list(_CODECS), default="lz4", action=once,
                     help="Blosc lz4 or zstd (bit shuffle), or none (default: lz4)")
     ap.add_argument("--no-progress", action="store_true")
     ap.add_argument("--no-spokes", action="store_true",
