@@ -437,7 +437,9 @@ MFMM_API void mfmm_path_options_init(mfmm_path_options *options);
  * neighbours, the face's linear gradient where that fit is ill-posed, and
  * Euler steps at sonic points.
  *   distances: (nv,) from mfmm_solve.
- *   target:    a vertex (face == -1) or a point in a face (value ignored).
+ *   target:    a vertex (face == -1) or a point in a face (value ignored);
+ *              not in a zero-area face (MFMM_ERR_DEGENERATE_SOURCE, as for a
+ *              source: give the point in a face beside it).
  *   options:   NULL for defaults.
  *   points:    caller buffer of `capacity` points (NULL when capacity is 0);
  *              receives the polyline from the target to the source: the

@@ -780,6 +780,14 @@ static int validate_point(const mfmm_mesh *m, const mfmm_source *s, const char *
     if (s->face < 0 || s->face >= m->nf)
         return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, idx, "%s face %d is out of range [0, %d)", what,
                          (int)s->face, (int)m->nf);
+    /* as mfmm_solve refuses a source there: the walk reads T in the face's
+     * plane, which a zero-area face does not span (a target there went round
+     * through a corner: 1.20 long where the straight path is 0.86) */
+    if (mfmm_mesh_degenerate(m, mfmm_face_in(m, s->face)))
+        return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, idx,
+                         "%s lies on face %d, which has zero area: give the same point on a face "
+                         "beside it",
+                         what, (int)s->face);
     double sum = 0.0;
     for (int k = 0; k < 3; k++) {
         if (!isfinite(s->bary[k]) || s->bary[k] < 0.0)

@@ -520,6 +520,37 @@ static void test_ends(void **state)
     tm_fixture_free(&fx);
 }
 
+/* A target in a zero-area face is refused, as a source there is (the walk
+ * reads T in the face's plane: it went round through a corner, 1.20 long);
+ * the same point in the face beside it gets the straight path. The unit
+ * square with a T-junction: (.25, .25) on the diagonal edge 0-4 of face 0,
+ * closed by the needle face 5 (0, 4, 5). */
+static void test_target_in_zero_area_face(void **state)
+{
+    (void)state;
+    const double V[6 * 3] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0.5, 0.5, 0, 0.25, 0.25, 0};
+    const int32_t F[6 * 3] = {0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 5, 3, 5, 4, 0, 4, 5};
+    mfmm_mesh *mesh = NULL;
+    mfmm_solver *solver = NULL;
+    assert_int_equal(mfmm_mesh_create(V, 6, F, 6, NULL, &mesh, NULL), MFMM_OK);
+    assert_int_equal(mfmm_solver_create(mesh, &solver), MFMM_OK);
+    double d[6], len = 0.0;
+    mfmm_source src = tm_vertex_source(1);
+    assert_int_equal(mfmm_solve(solver, &src, 1, NULL, d, NULL), MFMM_OK);
+    mfmm_surface_point pts[64];
+    int32_t np = 0;
+    mfmm_error err;
+    mfmm_source in_needle = {0, 5, {0.6, 0.2, 0.2}, 0.0}; /* (.15, .15) */
+    assert_int_equal(mfmm_trace_path(mesh, d, &in_needle, NULL, pts, 64, &np, &len, &err),
+                     MFMM_ERR_DEGENERATE_SOURCE);
+    assert_non_null(strstr(err.message, "zero area"));
+    mfmm_source beside = {0, 0, {0.7, 0.0, 0.3}, 0.0}; /* (.15, .15) in face 0 */
+    assert_int_equal(mfmm_trace_path(mesh, d, &beside, NULL, pts, 64, &np, &len, NULL), MFMM_OK);
+    tm_assert_close(len, sqrt(0.85 * 0.85 + 0.15 * 0.15), 1e-12);
+    mfmm_solver_destroy(solver);
+    mfmm_mesh_destroy(mesh);
+}
+
 /* Every bad input returns its status with a message; nothing is written past
  * the capacity. */
 static void test_errors(void **state)
@@ -767,6 +798,7 @@ int main(void)
         cmocka_unit_test(test_snell),
         cmocka_unit_test(test_torus_sides),
         cmocka_unit_test(test_ends),
+        cmocka_unit_test(test_target_in_zero_area_face),
         cmocka_unit_test(test_errors),
         cmocka_unit_test(test_shared_mesh_reproducers),
     };
