@@ -592,33 +592,32 @@ class _Once(argparse.Action):
 def cli_allpairs_zarr(argv: Sequence[str]) -> int:
     """``meshfmm allpairs MESH -o OUT.zarr [--scheduler ADDRESS | --workers N]
     [--resume] ...``: the distributed all-pairs job from the command line."""
-    once = _Once  # every value option: given once
     ap = argparse.ArgumentParser(prog="meshfmm allpairs",
                                  description="All-pairs geodesic distances on a Dask cluster, "
                                              "written into a Zarr v3 array.")
     ap.add_argument("mesh")
-    ap.add_argument("-o", "--output", required=True, action=once,
+    ap.add_argument("-o", "--output", required=True, action=_Once,
                     help="OUT.zarr (a directory or fsspec URL)")
     g = ap.add_mutually_exclusive_group()
-    g.add_argument("--scheduler", action=once,
+    g.add_argument("--scheduler", action=_Once,
                    help="address of a running Dask scheduler (tcp://host:port)")
-    g.add_argument("--workers", type=int, action=once,
+    g.add_argument("--workers", type=int, action=_Once,
                    help="worker processes of a local cluster (default: cores)")
     ap.add_argument("--resume", action="store_true",
                     help="go on with a job already in OUT (default: start over)")
-    ap.add_argument("--dtype", choices=["float32", "float64"], default="float32", action=once)
-    ap.add_argument("--sources", help="vertex ids (.npy or .txt)", action=once)
-    ap.add_argument("--targets", help="vertex ids for the columns (.npy or .txt)", action=once)
-    ap.add_argument("--max-distance", type=float, action=once)
-    ap.add_argument("--cost", help="per-vertex or per-face cost (.npy or .txt)", action=once)
+    ap.add_argument("--dtype", choices=["float32", "float64"], default="float32", action=_Once)
+    ap.add_argument("--sources", help="vertex ids (.npy or .txt)", action=_Once)
+    ap.add_argument("--targets", help="vertex ids for the columns (.npy or .txt)", action=_Once)
+    ap.add_argument("--max-distance", type=float, action=_Once)
+    ap.add_argument("--cost", help="per-vertex or per-face cost (.npy or .txt)", action=_Once)
     ap.add_argument("--backend", choices=["threads", "serial", "opencl", "auto"], default="threads",
-                    action=once)
+                    action=_Once)
     st = ap.add_mutually_exclusive_group()
-    st.add_argument("--exact-start-radius", type=float, metavar="R", action=once,
+    st.add_argument("--exact-start-radius", type=float, metavar="R", action=_Once,
                     help="radius of the exact start in mean edge lengths (default: the library's)")
     st.add_argument("--plain-start", action="store_true", help="the paper's plain start")
-    ap.add_argument("--block-rows", type=int, action=once)
-    ap.add_argument("--compression", choices=list(_CODECS), default="lz4", action=once,
+    ap.add_argument("--block-rows", type=int, action=_Once)
+    ap.add_argument("--compression", choices=list(_CODECS), default="lz4", action=_Once,
                     help="Blosc lz4 or zstd (bit shuffle), or none (default: lz4)")
     ap.add_argument("--no-progress", action="store_true")
     ap.add_argument("--no-spokes", action="store_true",
