@@ -319,11 +319,12 @@ MFMM_API mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources,
  * (Chen & Han with the pruning of Xin & Wang, "ICH"; saddles start windows
  * only in their shadow; see src/exact/exact.c). Equal to Kirsanov's MMP
  * (igl.exact_geodesic, gdist) to rounding (about 1e-14 relative), several
- * times faster than gdist. Boundaries and non-manifold edges are walls a
- * path may run along but not cross (at a non-manifold edge an upper
- * bound: README, "Imperfect meshes"); paths may pass through saddle,
- * boundary and non-manifold vertices; a zero-area face is passed through
- * along its line (a T-junction closed by a needle joins both sides);
+ * times faster than gdist. Boundaries are walls a path may run along but not
+ * cross; a non-manifold edge joins every face on it to every other (a path
+ * crosses from any into any; on degenerate fans, past a budget of windows,
+ * they are walls again: info->nonmanifold_walls); paths may pass through
+ * saddle, boundary and non-manifold vertices; a zero-area face is passed
+ * through along its line (a T-junction closed by a needle joins both sides);
  * copies of a face are no part of the surface. Not for a cost: see
  * mfmm_solve. */
 typedef struct mfmm_exact_solver mfmm_exact_solver;
@@ -367,6 +368,10 @@ typedef struct mfmm_exact_info {
                                  started windows */
     int64_t peak_windows;     /* most windows queued at once */
     size_t peak_bytes;        /* most bytes the solver held (tables + queue) */
+    int32_t nonmanifold_walls; /* 1: the windows crossing non-manifold edges passed
+                                  their budget (degenerate folded fans) and the solve
+                                  was redone with those edges as walls, where values
+                                  are then upper bounds; 0: they were crossed */
 } mfmm_exact_info;
 
 /* Exact geodesic distances from the sources to every vertex.

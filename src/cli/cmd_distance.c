@@ -63,13 +63,18 @@ static double *solve_exact(const mfmm_mesh *mesh, const cli_sources_and_cost *o,
     mfmm_exact_options eo;
     mfmm_exact_options_init(&eo);
     eo.max_distance = max_d;
-    st = mfmm_solve_exact(solver, o->src, o->n_src, &eo, dist, NULL, &err);
+    mfmm_exact_info info;
+    st = mfmm_solve_exact(solver, o->src, o->n_src, &eo, dist, &info, &err);
     mfmm_exact_solver_destroy(solver);
     if (st != MFMM_OK) {
         cli_error("%s", err.message);
         free(dist);
         return NULL;
     }
+    if (info.nonmanifold_walls)
+        fprintf(stderr, "meshfmm distance: note: windows across the non-manifold edges passed "
+                        "their budget (degenerate folded fans); those edges were walls, where "
+                        "distances are upper bounds\n");
     return dist;
 }
 

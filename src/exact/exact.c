@@ -60,8 +60,11 @@
  *
  * Sources: a vertex source is a pseudo-source with its value; a point in a
  * face (on an edge too) starts a window on each edge of its face; a point
- * within 1e-12 of a corner is that corner. Boundary and non-manifold edges
- * (face_neighbor -1) are walls; copies of a face are no part of the surface
+ * within 1e-12 of a corner is that corner. Boundary edges are walls; a
+ * window reaching a non-manifold edge goes on into every other face on it
+ * (ex_fan_out), each unfolded across the edge and trimmed against the
+ * windows that entered that face there before (ex_dominate), and the edge's
+ * ends are pseudo-sources; copies of a face are no part of the surface
  * (skip 2); a zero-area face (skip 1, its corners on one line) is passed
  * through along that line (ex_pass), its edges relax their ends, and a
  * vertex on its longest edge starts windows across that edge. max_distance
@@ -75,8 +78,11 @@
  * Memory: per-mesh tables (a 128-byte record per face with its edges'
  * lengths, each corner in the frame of the opposite edge, the edges across
  * and the vertices; corner and fan angles: about 160 bytes per face; per
- * vertex its flags, angle sum and least height, 17 bytes), and the queue's entries (windows and vertex events, 56 bytes
- * each), grown by doubling within memory_limit. No recursion. */
+ * vertex its flags, angle sum and least height, 17 bytes; 8 bytes per
+ * half-edge of a non-manifold edge), the queue's entries (windows and vertex
+ * events, 56 bytes each) and the windows kept at non-manifold edges (48
+ * bytes each, ex_keep), grown by doubling within memory_limit. No
+ * recursion. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -140,6 +146,14 @@ typedef struct ex_entry {
     int32_t next;    /* the next entry in its bucket or in the free list */
 } ex_entry;
 
+/* A window queued into a face through a non-manifold edge (ex_fan_out),
+ * kept to trim the later ones there (ex_dominate): its function and the
+ * interval it crosses with, in that half-edge's frame. */
+typedef struct ex_rec {
+    double b0, b1, px, py, sigma;
+    int32_t slot, next;
+} ex_rec;
+
 /* The read-only tables of a mesh (exact.h): built once, shared by the
  * workspaces of any number of threads. Faces are laid out in the order of
  * their least (internal, Morton-ordered: core/order.c) vertex, so that a
@@ -166,6 +180,11 @@ struct mfmm_exact_tables {
     /* (nv,) a vertex's least height over the opposite edges of its faces
      * (+inf with none): the patch's free ring (mfmm_exact_patch) */
     double *height;
+    /* the half-edges of non-manifold edges (flip 2 in their record), sorted,
+     * each with the next half-edge of the same edge (a cycle through the
+     * edge's faces; ex_fan_out): n_nm of them */
+    int32_t *nm_he, *nm_next;
+    int32_t n_nm;
     double inv_w;      /* 1 / bucket width */
     size_t bytes;
 };
@@ -180,6 +199,8 @@ struct mfmm_exact_solver {
     const ex_face *fr;
     const uint8_t *pseudo;
     const double *fan_a0, *fan_total, *height;
+    const int32_t *nm_he, *nm_next;
+    int32_t n_nm;
     double inv_w;
     double *in_angle;  /* (nv,) direction (fan angle) back along the path that gave d */
     double *d;         /* (nv,) best distance so far, +inf untouched */
@@ -201,7 +222,15 @@ struct mfmm_exact_solver {
     double max_d;
     int failed; /* MFMM_ERR_MEMORY_LIMIT or MFMM_ERR_OUT_OF_MEMORY once a growth fails */
     int pass_depth; /* zero-area faces a window is passing through (ex_pass) */
+    /* with non-manifold edges crossed, windows past a budget (over_budget):
+     * the run is redone with those edges as walls (walls; ex_run) */
+    int over_budget, walls;
     int64_t n_windows, n_propagated, n_pseudo, peak_windows;
+    /* the windows fanned out at non-manifold edges, by nm_he slot: (n_nm,)
+     * heads of lists in rec, -1: none */
+    int32_t *nm_head;
+    ex_rec *rec;
+    int32_t rec_n, rec_cap;
 };
 
 /* ------------------------------------------------------------- workspace */
@@ -227,6 +256,8 @@ void mfmm_exact_tables_destroy(mfmm_exact_tables *t)
     free(t->fan_a0);
     free(t->fan_total);
     free(t->height);
+    free(t->nm_he);
+    free(t->nm_next);
     free(t);
 }
 
@@ -242,6 +273,8 @@ void mfmm_exact_ws_destroy(mfmm_exact_ws *ws)
     free(ws->in_patch);
     free(ws->heap);
     free(ws->bhead);
+    free(ws->nm_head);
+    free(ws->rec);
     free(ws);
 }
 
@@ -266,6 +299,103 @@ static int32_t ex_corner(const int32_t *vf_corner, const int32_t *face_in, int32
 static int ex_corner_of(const int32_t *fv, int32_t v)
 {
     return fv[0] == v ? 0 : fv[1] == v ? 1 : fv[2] == v ? 2 : -1;
+}
+
+/* A half-edge at a wall, by its edge's vertices (ex_link_nonmanifold). */
+typedef struct ex_wall {
+    int32_t lo, hi, h;
+} ex_wall;
+
+static int ex_wall_cmp(const void *pa, const void *pb)
+{
+    const ex_wall *a = pa, *b = pb;
+    if (a->lo != b->lo)
+        return a->lo < b->lo ? -1 : 1;
+    if (a->hi != b->hi)
+        return a->hi < b->hi ? -1 : 1;
+    return (a->h > b->h) - (a->h < b->h);
+}
+
+static int ex_i32_pair_cmp(const void *pa, const void *pb)
+{
+    const int32_t *a = pa, *b = pb;
+    return (a[0] > b[0]) - (a[0] < b[0]);
+}
+
+/* Non-manifold edges (three or more faces, copies aside) join every face on
+ * them: a shortest path may cross from any of them into any other. Their
+ * half-edges (across -1) get flip 2 and a place in a cycle per edge
+ * (nm_he, nm_next), which ex_fan_out walks. Before, they were walls, and a
+ * path through one bent at a vertex (beetle: up to 0.03, 5 %, too long). 0, or
+ * -1 when out of memory. */
+static int ex_link_nonmanifold(mfmm_exact_tables *t)
+{
+    size_t n = 0;
+    for (int32_t f = 0; f < t->nf; f++)
+        for (int k = 0; k < 3; k++)
+            n += t->fr[t->face_in[f]].across[k] == -1 && !mfmm_mesh_copy(t->mesh, f);
+    if (n == 0)
+        return 0;
+    ex_wall *w = malloc(n * sizeof *w);
+    if (!w)
+        return -1;
+    n = 0;
+    /* copies aside, zero-area ones too (skip 1 then), as build_edges has it */
+    for (int32_t f = 0; f < t->nf; f++) {
+        const ex_face *r = t->fr + t->face_in[f];
+        for (int k = 0; k < 3; k++) {
+            if (r->across[k] != -1 || mfmm_mesh_copy(t->mesh, f))
+                continue;
+            int32_t a = r->v[ex_next[k]], b = r->v[ex_prev[k]];
+            w[n].lo = a < b ? a : b;
+            w[n].hi = a < b ? b : a;
+            w[n].h = 3 * t->face_in[f] + k;
+            n++;
+        }
+    }
+    qsort(w, n, sizeof *w, ex_wall_cmp);
+    size_t n_nm = 0;
+    for (size_t i = 0, j; i < n; i = j) {
+        for (j = i + 1; j < n && w[j].lo == w[i].lo && w[j].hi == w[i].hi; j++)
+            ;
+        if (j - i > 1)
+            n_nm += j - i;
+    }
+    if (n_nm == 0) { /* boundary edges only */
+        free(w);
+        return 0;
+    }
+    int32_t *pairs = malloc(2 * n_nm * sizeof *pairs);
+    t->nm_he = malloc(n_nm * sizeof *t->nm_he);
+    t->nm_next = malloc(n_nm * sizeof *t->nm_next);
+    if (!pairs || !t->nm_he || !t->nm_next) {
+        free(w);
+        free(pairs);
+        return -1;
+    }
+    size_t q = 0;
+    for (size_t i = 0, j; i < n; i = j) {
+        for (j = i + 1; j < n && w[j].lo == w[i].lo && w[j].hi == w[i].hi; j++)
+            ;
+        if (j - i < 2)
+            continue;
+        for (size_t u = i; u < j; u++) {
+            pairs[2 * q] = w[u].h;
+            pairs[2 * q + 1] = w[u + 1 < j ? u + 1 : i].h;
+            q++;
+            t->fr[w[u].h / 3].flip[w[u].h % 3] = 2;
+        }
+    }
+    free(w);
+    qsort(pairs, n_nm, 2 * sizeof *pairs, ex_i32_pair_cmp);
+    for (size_t i = 0; i < n_nm; i++) {
+        t->nm_he[i] = pairs[2 * i];
+        t->nm_next[i] = pairs[2 * i + 1];
+    }
+    free(pairs);
+    t->n_nm = (int32_t)n_nm;
+    t->bytes += 2 * n_nm * sizeof(int32_t);
+    return 0;
 }
 
 /* Walks the fan of every vertex through the faces across its edges, giving
@@ -478,6 +608,10 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
         if (angle[v] > EX_TWO_PI + EX_SADDLE_TOL)
             t->pseudo[v] = 1;
     free(angle);
+    if (ex_link_nonmanifold(t) != 0) {
+        mfmm_exact_tables_destroy(t);
+        return MFMM_ERR_OUT_OF_MEMORY;
+    }
     double sum_len = 0.0;
     size_t n_len = 0;
     for (size_t hh = 0; hh < nh; hh++) {
@@ -541,6 +675,9 @@ mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *t, mfmm_exact_w
     ws->fan_a0 = t->fan_a0;
     ws->fan_total = t->fan_total;
     ws->height = t->height;
+    ws->nm_he = t->nm_he;
+    ws->nm_next = t->nm_next;
+    ws->n_nm = t->n_nm;
     ws->inv_w = t->inv_w;
     ws->d = malloc((nv ? nv : 1) * sizeof *ws->d);
     ws->emitted = malloc((nv ? nv : 1) * sizeof *ws->emitted);
@@ -549,8 +686,9 @@ mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *t, mfmm_exact_w
     ws->in_angle = malloc((nv ? nv : 1) * sizeof *ws->in_angle);
     ws->in_patch = calloc(nv ? nv : 1, sizeof *ws->in_patch);
     ws->bhead = malloc(3 * EX_NB * sizeof *ws->bhead);
+    ws->nm_head = malloc((ws->n_nm ? (size_t)ws->n_nm : 1) * sizeof *ws->nm_head);
     if (!ws->d || !ws->emitted || !ws->touched || !ws->patch_d || !ws->in_angle ||
-        !ws->in_patch || !ws->bhead) {
+        !ws->in_patch || !ws->bhead || !ws->nm_head) {
         mfmm_exact_ws_destroy(ws);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
@@ -561,8 +699,10 @@ mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *t, mfmm_exact_w
     }
     for (int32_t i = 0; i < 3 * EX_NB; i++)
         ws->bhead[i] = -1;
+    for (int32_t i = 0; i < ws->n_nm; i++)
+        ws->nm_head[i] = -1;
     /* memory_limit counts the tables too, shared or not */
-    ws->fixed_bytes = t->bytes + mfmm_exact_ws_bytes(t->mesh);
+    ws->fixed_bytes = t->bytes + mfmm_exact_ws_bytes(t->mesh) + (size_t)ws->n_nm * sizeof(int32_t);
     ws->max_d = INFINITY;
     ws->peak_bytes = ws->fixed_bytes;
     *out = ws;
@@ -620,7 +760,8 @@ mfmm_status mfmm_exact_solver_create(const mfmm_mesh *mesh, mfmm_exact_solver **
 
 static size_t ex_bytes(const mfmm_exact_ws *ws, int32_t heap_cap)
 {
-    return ws->fixed_bytes + (size_t)heap_cap * sizeof(ex_entry);
+    return ws->fixed_bytes + (size_t)heap_cap * sizeof(ex_entry) +
+           (size_t)ws->rec_cap * sizeof(ex_rec);
 }
 
 /* Grows the entries by doubling, within memory_limit. */
@@ -918,6 +1059,52 @@ static void ex_pass(mfmm_exact_ws *ws, int32_t hd, int flip, double L, double s0
     ws->pass_depth--;
 }
 
+/* ex_emit_inline's last step: the window [s0, s1] of an edge va -> vb of
+ * length L (pseudo-source (ix, iy), iy >= 0), queued to cross the face of
+ * half-edge g (fl: g runs from vb to va), trimmed against the edge's
+ * ends. */
+MFMM_INLINE void ex_enqueue(mfmm_exact_ws *ws, int32_t g, int fl, int32_t va, int32_t vb,
+                            double L, double s0, double s1, double ix, double iy, double sigma)
+{
+    double iy2 = iy * iy;
+#ifdef __GNUC__
+    /* the face the window will cross, read when it is popped: after a
+     * march has run through the mesh its record is far from the core */
+    __builtin_prefetch((const char *)(ws->fr + g / 3));
+    __builtin_prefetch((const char *)(ws->fr + g / 3) + 64);
+#endif
+    /* the least distance: at the foot of I, or at the nearer end. Taken
+     * before the trims, which can only raise it: the key is then a lower
+     * bound, as good for the queue's order and the cut at max_d (taking it
+     * again after the quarter of windows that are trimmed cost 4 % of a
+     * patch, for the same windows) */
+    double dx = ex_gap(ix, s0, s1);
+    double key = sigma + (dx > 0.0 ? sqrt(dx * dx + iy2) : iy);
+    if (key > ws->max_d)
+        return;
+    /* pruning against the ends of the edge */
+    if (!ex_trim(ix, -iy, sigma, L, ws->d[va], ws->d[vb], &s0, &s1))
+        return;
+    int32_t wi = ex_new(ws);
+    if (wi < 0)
+        return;
+    ex_entry *w = ws->heap + wi;
+    /* the edge as the face across sees it (selected, not branched on) */
+    double e0[2] = {s0, L - s1}, e1[2] = {s1, L - s0}, ex[2] = {ix, L - ix};
+    w->b0 = e0[fl];
+    w->b1 = e1[fl];
+    w->px = ex[fl];
+    w->py = -iy;
+    w->sigma = sigma;
+    w->he = g;
+    w->key = key;
+    ex_queue(ws, wi);
+    ws->n_windows++;
+}
+
+static void ex_fan_out(mfmm_exact_ws *ws, int32_t h, int32_t va, int32_t vb, double L,
+                       double s0, double s1, double ix, double iy, double sigma);
+
 /* A window on half-edge h = 3f+k in f's frame (I on f's side: iy >= 0),
  * interval [s0, s1], leaving f: updates the vertices it reaches, trims it
  * against the edge's ends, and queues it in the face across, in that face's
@@ -955,42 +1142,204 @@ MFMM_INLINE void ex_emit_inline(mfmm_exact_ws *ws, int32_t h, double s0, double 
     if (g < 0 || !(s1 - s0 > EX_MIN_WIDTH * L)) {
         if (g < -1 && s1 - s0 > EX_MIN_WIDTH * L)
             ex_pass(ws, -2 - g, r->flip[k], L, s0, s1, ix, iy, sigma);
+        else if (r->flip[k] == 2 && s1 - s0 > EX_MIN_WIDTH * L)
+            ex_fan_out(ws, h, va, vb, L, s0, s1, ix, iy, sigma);
         return;
     }
-#ifdef __GNUC__
-    /* the face the window will cross, read when it is popped: after a
-     * march has run through the mesh its record is far from the core */
-    __builtin_prefetch((const char *)(ws->fr + g / 3));
-    __builtin_prefetch((const char *)(ws->fr + g / 3) + 64);
-#endif
-    /* the least distance: at the foot of I, or at the nearer end. Taken
-     * before the trims, which can only raise it: the key is then a lower
-     * bound, as good for the queue's order and the cut at max_d (taking it
-     * again after the quarter of windows that are trimmed cost 4 % of a
-     * patch, for the same windows) */
-    double dx = ex_gap(ix, s0, s1);
-    double key = sigma + (dx > 0.0 ? sqrt(dx * dx + iy2) : iy);
-    if (key > ws->max_d)
+    ex_enqueue(ws, g, r->flip[k], va, vb, L, s0, s1, ix, iy, sigma);
+}
+
+/* D(x) - D'(x) of two windows on one edge, in units of the edge */
+static double ex_diff(double x, double px, double py, double dsig, double pa, double qa)
+{
+    return dsig + sqrt((x - px) * (x - px) + py * py) - sqrt((x - pa) * (x - pa) + qa * qa);
+}
+
+/* Trims the window [*s0, *s1] (pseudo-source (px, py), sigma; the frame of
+ * a half-edge of length L) against the windows kept at that half-edge's
+ * slot: the part where a kept window gives no more is dropped, as MMP does
+ * with the windows of an edge (Surazhsky et al. 2005, section 3.3), here
+ * only from the ends, so that it stays one interval. Sound in any order:
+ * kept windows are never removed, and a kept window trimmed later against
+ * a vertex is beaten there by a path through that vertex. Returns 0 when
+ * nothing is left. Without it, folded fans of 5-8 faces on one edge passed
+ * windows round without bound (fuzz input nonmanifold-fans-window-blowup). */
+static int ex_dominate(const mfmm_exact_ws *ws, int32_t slot, double L, double *s0p,
+                       double *s1p, double px, double py, double sigma)
+{
+    double il = 1.0 / L, s0 = *s0p * il, s1 = *s1p * il;
+    double pw = px * il, qw = py * il;
+    for (int32_t i = ws->nm_head[slot]; i >= 0; i = ws->rec[i].next) {
+        const ex_rec *a = ws->rec + i;
+        double a0 = a->b0 * il, a1 = a->b1 * il;
+        int left = a0 <= s0, right = a1 >= s1;
+        if (!left && !right)
+            continue; /* inside the new window: its ends stay */
+        double lo = left ? s0 : a0, hi = right ? s1 : a1;
+        if (!(hi > lo))
+            continue;
+        double pa = a->px * il, qa = a->py * il, ds = (sigma - a->sigma) * il;
+        double k0 = INFINITY, k1 = -INFINITY;
+        /* |D - D_a| <= |ds| + |pw - pa| + |qw - qa| everywhere: windows
+         * alike to rounding (the same window come round a fan of folded
+         * faces, which otherwise went round without end) are ties, and the
+         * kept one stays */
+        if (fabs(ds) + fabs(pw - pa) + fabs(qw - qa) <=
+            EX_TIE * (1.0 + fabs(sigma * il) + fabs(pw) + fabs(qw)))
+            goto trim;
+        /* D = D_a squared twice: a quadratic whose roots hold the zeros of
+         * D - D_a, which keeps its sign between them */
+        double al = 2.0 * (pw - pa), be = pa * pa - pw * pw + qa * qa - qw * qw + ds * ds;
+        double d4 = 4.0 * ds * ds;
+        double A = d4 - al * al, B = -2.0 * (d4 * pa + al * be);
+        double C = d4 * (pa * pa + qa * qa) - be * be;
+        double r[2];
+        int nr = 0;
+        double disc = B * B - 4.0 * A * C;
+        if (A != 0.0 && disc >= 0.0) {
+            double q = -0.5 * (B + (B >= 0.0 ? sqrt(disc) : -sqrt(disc)));
+            r[nr++] = q / A;
+            if (q != 0.0)
+                r[nr++] = C / q;
+        } else if (A == 0.0 && B != 0.0) {
+            r[nr++] = -C / B;
+        }
+        double x[4];
+        int n = 0;
+        x[n++] = lo;
+        for (int j = 0; j < nr; j++) {
+            /* Newton on D - D_a itself: the squared form loses digits when
+             * the two windows are alike */
+            double t = r[j];
+            for (int it = 0; it < 2; it++) {
+                double rw = sqrt((t - pw) * (t - pw) + qw * qw);
+                double ra = sqrt((t - pa) * (t - pa) + qa * qa);
+                double tn = t - (ds + rw - ra) / ((t - pw) / rw - (t - pa) / ra);
+                if (!(fabs(tn - t) < 1.0))
+                    break;
+                t = tn;
+            }
+            if (t > lo && t < hi) {
+                if (n == 2 && t < x[1]) {
+                    x[2] = x[1];
+                    x[1] = t;
+                    n = 3;
+                } else {
+                    x[n++] = t;
+                }
+            }
+        }
+        x[n++] = hi;
+        /* the hull of the part of [lo, hi] where the new window is shorter */
+        for (int j = 0; j + 1 < n; j++) {
+            if (!(ex_diff(0.5 * (x[j] + x[j + 1]), pw, qw, ds, pa, qa) >= 0.0)) {
+                if (k0 > x[j])
+                    k0 = x[j];
+                k1 = x[j + 1];
+            }
+        }
+    trim:
+        if (left && right) {
+            if (!(k1 >= k0))
+                return 0;
+            s0 = k0;
+            s1 = k1;
+        } else if (left) {
+            s0 = k1 >= k0 ? k0 : hi;
+        } else {
+            s1 = k1 >= k0 ? k1 : lo;
+        }
+        if (!(s1 - s0 > EX_MIN_WIDTH))
+            return 0;
+    }
+    *s0p = s0 * L;
+    *s1p = s1 * L;
+    return 1;
+}
+
+/* Keeps a fanned-out window at its slot for ex_dominate, while memory
+ * allows (one not kept only trims nothing). */
+static void ex_keep(mfmm_exact_ws *ws, int32_t slot, double b0, double b1, double px, double py,
+                    double sigma)
+{
+    if (ws->rec_n == ws->rec_cap) {
+        int32_t cap = ws->rec_cap;
+        if (cap >= INT32_MAX / 2)
+            return;
+        int32_t ncap = cap ? 2 * cap : 256;
+        if (ws->memory_limit &&
+            ex_bytes(ws, ws->heap_cap) + (size_t)(ncap - cap) * sizeof(ex_rec) > ws->memory_limit)
+            return;
+        ex_rec *p = realloc(ws->rec, (size_t)ncap * sizeof *p);
+        if (!p)
+            return;
+        ws->rec = p;
+        ws->rec_cap = ncap;
+        if (ex_bytes(ws, ws->heap_cap) > ws->peak_bytes)
+            ws->peak_bytes = ex_bytes(ws, ws->heap_cap);
+    }
+    ex_rec *r = ws->rec + ws->rec_n;
+    r->b0 = b0;
+    r->b1 = b1;
+    r->px = px;
+    r->py = py;
+    r->sigma = sigma;
+    r->slot = slot;
+    r->next = ws->nm_head[slot];
+    ws->nm_head[slot] = ws->rec_n++;
+}
+
+/* The slot of half-edge g in nm_he (binary search), -1 if none. */
+static int32_t ex_nm_slot(const mfmm_exact_ws *ws, int32_t g)
+{
+    int32_t lo = 0, hi = ws->n_nm - 1;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (ws->nm_he[mid] < g)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return ws->n_nm > 0 && ws->nm_he[lo] == g ? lo : -1;
+}
+
+/* A window on half-edge h (edge va -> vb, in h's face's frame) of a
+ * non-manifold edge: it goes on into every other face on the edge, each
+ * unfolded across the edge (ex_link_nonmanifold), trimmed against the
+ * windows that went that way before (ex_dominate). */
+static void ex_fan_out(mfmm_exact_ws *ws, int32_t h, int32_t va, int32_t vb, double L,
+                       double s0, double s1, double ix, double iy, double sigma)
+{
+    /* (I on an end of the edge, within rounding: its rays run along the
+     * edge, and carry nothing into the other faces; such windows went round
+     * a folded fan without end) */
+    double tol = EX_POS_TOL * L;
+    if (ws->walls || (iy <= tol && (fabs(ix) <= tol || fabs(ix - L) <= tol)))
         return;
-    /* pruning against the ends of the edge */
-    if (!ex_trim(ix, -iy, sigma, L, ws->d[va], ws->d[vb], &s0, &s1))
-        return;
-    int32_t wi = ex_new(ws);
-    if (wi < 0)
-        return;
-    ex_entry *w = ws->heap + wi;
-    /* the edge as the face across sees it (selected, not branched on) */
-    int fl = r->flip[k];
-    double e0[2] = {s0, L - s1}, e1[2] = {s1, L - s0}, ex[2] = {ix, L - ix};
-    w->b0 = e0[fl];
-    w->b1 = e1[fl];
-    w->px = ex[fl];
-    w->py = -iy;
-    w->sigma = sigma;
-    w->he = g;
-    w->key = key;
-    ex_queue(ws, wi);
-    ws->n_windows++;
+    int32_t i = ex_nm_slot(ws, h);
+    for (int32_t n = 0; i >= 0 && n < ws->n_nm; n++) {
+        int32_t g = ws->nm_next[i];
+        if (g == h)
+            return;
+        i = ex_nm_slot(ws, g);
+        const ex_face *q = ws->fr + g / 3;
+        int fl = q->v[ex_next[g % 3]] != va;
+        if (q->skip == 1) {
+            /* (not from within a pass: zero-area faces meeting at such
+             * edges would pass a window round among themselves) */
+            if (ws->pass_depth == 0)
+                ex_pass(ws, g, fl, L, s0, s1, ix, iy, sigma);
+            continue;
+        }
+        if (i < 0)
+            return;
+        /* in g's frame (its ends swapped when it runs from vb to va) */
+        double n0 = fl ? L - s1 : s0, n1 = fl ? L - s0 : s1, npx = fl ? L - ix : ix;
+        if (!ex_dominate(ws, i, L, &n0, &n1, npx, -iy, sigma))
+            continue;
+        ex_keep(ws, i, n0, n1, npx, -iy, sigma);
+        ex_enqueue(ws, g, fl, va, vb, L, fl ? L - n1 : n0, fl ? L - n0 : n1, ix, iy, sigma);
+    }
 }
 
 /* ex_emit_inline as a call, for the starts (ex_propagate inlines its own) */
@@ -1175,6 +1524,9 @@ static void ex_reset(mfmm_exact_ws *ws)
         ws->in_patch[v] = 0;
     }
     ws->n_touched = 0;
+    for (int32_t i = 0; i < ws->rec_n; i++)
+        ws->nm_head[ws->rec[i].slot] = -1;
+    ws->rec_n = 0;
     /* a run that emptied its queue left every bucket empty: only a failed
      * one (out of memory) needs them cleared (48 KB, a patch uses ~30) */
     if (ws->heap_n != 0)
@@ -1188,14 +1540,26 @@ static void ex_reset(mfmm_exact_ws *ws)
     ws->cur = -((int64_t)1 << 62);
     ws->redist = ws->cur;
     ws->failed = 0;
+    ws->over_budget = 0;
     ws->n_windows = ws->n_propagated = ws->n_pseudo = ws->peak_windows = 0;
     ws->peak_bytes = ex_bytes(ws, ws->heap_cap);
 }
 
 /* The propagation from checked sources; d[] holds the result for touched
  * vertices (values > max_d are not final). */
-static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t n_sources,
-                          double max_d, size_t memory_limit)
+/* Whether the windows created so far are past what the vertices reached
+ * so far can need: 64 (1 + sqrt(n) / 8) a vertex, n vertices reached (plus
+ * 4096), 12-20 times what a solve needs on camelhead (78 windows a vertex)
+ * and beetle (17). Past it, windows are going round without getting
+ * farther, which degenerate folded fans (coincident vertices) allowed. */
+static int ex_over_budget(const mfmm_exact_ws *ws)
+{
+    double n = (double)ws->n_touched;
+    return (double)ws->n_windows > 4096.0 + 64.0 * n * (1.0 + sqrt(n) / 8.0);
+}
+
+static mfmm_status ex_run_once(mfmm_exact_ws *ws, const mfmm_source *sources,
+                               int32_t n_sources, double max_d, size_t memory_limit)
 {
     ex_reset(ws);
     ws->max_d = max_d;
@@ -1207,6 +1571,9 @@ static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t
         free(ws->heap);
         ws->heap = NULL;
         ws->heap_cap = 0;
+        free(ws->rec);
+        ws->rec = NULL;
+        ws->rec_cap = 0;
         ws->peak_bytes = ex_bytes(ws, 0);
     }
     for (int32_t i = 0; i < n_sources; i++) {
@@ -1242,7 +1609,11 @@ static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t
         }
         ex_start_face(ws, ws->face_in[face], w, s->value);
     }
-    while (ws->heap_n > 0 && !ws->failed) {
+    for (int64_t n = 1; ws->heap_n > 0 && !ws->failed; n++) {
+        if (!(n & 4095) && ws->n_nm > 0 && !ws->walls && ex_over_budget(ws)) {
+            ws->over_budget = 1;
+            break;
+        }
         ex_entry e;
         ex_pop(ws, &e);
         if (e.he < 0) {
@@ -1258,6 +1629,22 @@ static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t
     return ws->failed ? (mfmm_status)ws->failed : MFMM_OK;
 }
 
+/* ex_run_once across non-manifold edges; where its windows pass their
+ * budget (ex_over_budget), again with those edges as walls: upper bounds
+ * there, the solver's behaviour before it crossed them (mfmm_exact_info's
+ * nonmanifold_walls says which). */
+static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t n_sources,
+                          double max_d, size_t memory_limit)
+{
+    ws->walls = 0;
+    mfmm_status st = ex_run_once(ws, sources, n_sources, max_d, memory_limit);
+    if (st == MFMM_OK && ws->over_budget) {
+        ws->walls = 1;
+        st = ex_run_once(ws, sources, n_sources, max_d, memory_limit);
+    }
+    return st;
+}
+
 static void ex_fill_info(const mfmm_exact_ws *ws, mfmm_exact_info *info)
 {
     if (!info)
@@ -1267,6 +1654,7 @@ static void ex_fill_info(const mfmm_exact_ws *ws, mfmm_exact_info *info)
     info->n_pseudo_sources = ws->n_pseudo;
     info->peak_windows = ws->peak_windows;
     info->peak_bytes = ws->peak_bytes;
+    info->nonmanifold_walls = ws->walls;
 }
 
 /* Sources as mfmm_solve checks them, and not in a face this solver skips. */

@@ -488,8 +488,12 @@ static void test_max_distance(void **state)
 
 /* Two components and a non-manifold edge: a unit square cut along its
  * diagonal (1,0)-(0,1), and a fin on that diagonal, and a copy of the
- * square far away. The diagonal, shared by three faces, is a wall: from
- * (0,0) the far corner is reached round an end of the wall. */
+ * square far away. The diagonal, shared by three faces, joins each to the
+ * other two: from (0,0) the far corner is straight across it (it was a wall
+ * until session 22: 2, round an end), the fin's apex (0.5, 0.5, 1), 1 above
+ * the diagonal's middle, is sqrt(1/2) + 1 away (the fin unfolded across
+ * it), and from the fin's point (0.5, 0.5, 0.5) both corners off the
+ * diagonal are 0.5 + sqrt(1/2) away (analytic). */
 static void test_nonmanifold_components(void **state)
 {
     (void)state;
@@ -505,8 +509,8 @@ static void test_nonmanifold_components(void **state)
     tm_assert_close(fx.d[0], 0.0, 0.0);
     tm_assert_close(fx.d[1], 1.0, 1e-15);
     tm_assert_close(fx.d[2], 1.0, 1e-15);
-    tm_assert_close(fx.d[3], 2.0, 1e-15);
-    tm_assert_close(fx.d[4], 1.0 + sqrt(1.5), 1e-15);
+    tm_assert_close(fx.d[3], sqrt(2.0), 1e-15);
+    tm_assert_close(fx.d[4], 1.0 + sqrt(0.5), 1e-15);
     for (int v = 5; v < 9; v++)
         assert_true(isinf(fx.d[v]) && fx.d[v] > 0);
     /* a source inside the fin */
@@ -514,7 +518,8 @@ static void test_nonmanifold_components(void **state)
     ex_solve(&fx, &fs, 1, NULL);
     double p[3] = {0.25 + 0.25, 0.25 + 0.25, 0.5};
     tm_assert_close(fx.d[1], dist3(p, V + 3), 1e-15);
-    tm_assert_close(fx.d[0], dist3(p, V + 3) + 1.0, 1e-15);
+    tm_assert_close(fx.d[0], 0.5 + sqrt(0.5), 1e-15);
+    tm_assert_close(fx.d[3], 0.5 + sqrt(0.5), 1e-15);
     for (int v = 5; v < 9; v++)
         assert_true(isinf(fx.d[v]));
     ex_free(&fx);

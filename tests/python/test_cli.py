@@ -117,3 +117,23 @@ def test_info_json_mesh_bytes(cli, tmp_path):
     want = sum(meshfmm.Mesh.from_file(path).memory().values())
     assert got["mesh_bytes"] == want
     assert got["vertices"] == 810
+
+
+def test_exact_notes_nonmanifold_walls(cli, tmp_path):
+    """`distance --exact` says when the exact solver fell back to walls at
+    non-manifold edges (its budget of windows passed on degenerate folded
+    fans, test_exact.py), and only then; values equal the Python API's."""
+    from test_exact import fuzz_exact_mesh
+
+    V, F, _, _ = fuzz_exact_mesh("nonmanifold-coincident-fans-window-cycle")
+    F = F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 0] != F[:, 2])]
+    path = tmp_path / "fans.obj"
+    path.write_text("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in V.tolist())
+                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in F.tolist()))
+    out = tmp_path / "d.npy"
+    proc = run(cli, "distance", path, "--source", 0, "--exact", "-o", out)
+    assert "non-manifold edges passed their budget" in proc.stderr
+    assert np.load(out).tobytes() == meshfmm.Mesh(V, F).distance(0, method="exact").tobytes()
+    need_data()
+    proc = run(cli, "distance", MESHES / "beetle.obj", "--source", 0, "--exact", "-o", out)
+    assert "budget" not in proc.stderr

@@ -173,3 +173,161 @@ def test_zero_area_faces_closing_t_junctions_are_no_walls():
         np.testing.assert_allclose(m.distance(s)[near], ref[near], rtol=1e-12, atol=1e-14)
     strip = meshfmm.Mesh([[0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0.0]], [[0, 1, 2], [1, 2, 3]])
     np.testing.assert_array_equal(strip.distance(0, method="exact"), [0.0, 1.0, 2.0, 3.0])
+
+
+def _book(n, pages=((0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0.6, 0.8))):
+    """Unit square pages, each an n x n grid, hinged on the segment [0,1] of
+    the x axis and sharing its vertices: every hinge edge is non-manifold
+    (one face per page). The surface is the pages joined at the hinge, so a
+    shortest path from a point (x0, y0) of page 0 to the point at height z
+    above the hinge on another page is straight once that page is unfolded
+    across the hinge: length hypot(x - x0, y0 + z) (analytic)."""
+    V, ids = [], {}
+
+    def vertex(key, p):
+        if key not in ids:
+            ids[key] = len(V)
+            V.append(p)
+        return ids[key]
+
+    F = []
+    for j, d in enumerate(pages):
+        for a in range(n + 1):
+            for b in range(n + 1):
+                key = ("hinge", a) if b == 0 else (j, a, b)
+                vertex(key, (a / n, b / n * d[1], b / n * d[2]))
+        at = lambda a, b: ids[("hinge", a) if b == 0 else (j, a, b)]  # noqa: E731
+        for a in range(n):
+            for b in range(n):
+                F += [(at(a, b), at(a + 1, b), at(a + 1, b + 1)),
+                      (at(a, b), at(a + 1, b + 1), at(a, b + 1))]
+    V = np.array(V, dtype=np.float64)
+    page = np.zeros(len(V), dtype=np.int64)
+    for key, i in ids.items():  # -1: the hinge
+        page[i] = -1 if key[0] == "hinge" else key[0]
+    return V, np.array(F, dtype=np.int32), page
+
+
+def test_non_manifold_edges_are_no_walls():
+    """Non-manifold edges were walls for the exact solver: a path from one
+    page of a book to another bent at a hinge vertex (n = 8, three pages:
+    0.011 too long; beetle.obj's 47 such edges: up to 0.030 above the length
+    of a real path, a Steiner-graph Dijkstra bound). Now a window reaching a
+    non-manifold edge goes on into every other face on it (ex_fan_out), and
+    the exact solver equals the unfolded distance (analytic), from vertices
+    of a page and of the hinge; the FMM takes those values within its exact
+    start."""
+    import meshfmm
+
+    # eight pages at 90, -90, 0, 37, 143, 10, 170 and -20 degrees: folded
+    # fans, where windows are trimmed against the earlier ones of a hinge face
+    folded = tuple((0.0, float(np.cos(a)), float(np.sin(a)))
+                   for a in np.deg2rad([90, -90, 0, 37, 143, 10, 170, -20]))
+    for pages in ((0, 1, 0), (0, -1, 0), (0, 0, 1)), \
+            ((0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0.6, 0.8)), folded:
+        V, F, page = _book(8, pages=pages)
+        m = meshfmm.Mesh(V, F)
+        assert m.info.n_nonmanifold_edges == 8
+        for s in np.flatnonzero(page == 0)[[3, 20, 41]].tolist() + [int(np.flatnonzero(page == -1)[5])]:
+            x0, y0 = V[s, 0], np.linalg.norm(V[s, 1:])
+            height = np.linalg.norm(V[:, 1:], axis=1)
+            same = (page == page[s]) | (page == -1) if page[s] >= 0 else np.ones(len(V), bool)
+            ref = np.where(same & (page[s] >= 0),
+                           np.linalg.norm(V - V[s], axis=1),
+                           np.hypot(V[:, 0] - x0, y0 + height))
+            np.testing.assert_allclose(m.distance(s, method="exact"), ref, rtol=1e-12,
+                                       atol=1e-14)
+            near = ref < 0.5  # inside the exact start (7 edges of 1/8)
+            np.testing.assert_allclose(m.distance(s)[near], ref[near], rtol=1e-12, atol=1e-14)
+
+
+def _steiner_bound(V, F, k, source):
+    """Lengths of real paths from vertex source: Dijkstra on a Steiner graph
+    (each edge cut in k, every two boundary points of a face joined by their
+    segment), an upper bound on the geodesic distance of every vertex."""
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import dijkstra
+
+    E = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+    key = np.sort(E, axis=1)
+    edges, inv = np.unique(key, axis=0, return_inverse=True)
+    inv = inv.ravel()
+    t = np.arange(1, k) / k
+    P = np.concatenate([V, (V[edges[:, 0], None] * (1 - t)[:, None]
+                            + V[edges[:, 1], None] * t[:, None]).reshape(-1, 3)])
+    inner = len(V) + inv[:, None] * (k - 1) + np.arange(k - 1)  # from key[:, 0]
+    inner = np.where((E[:, 0] == key[:, 0])[:, None], inner, inner[:, ::-1])
+    nf = len(F)
+    ring = np.concatenate([np.concatenate([E[j * nf:(j + 1) * nf, :1],
+                                           inner[j * nf:(j + 1) * nf]], axis=1)
+                           for j in range(3)], axis=1)  # (nf, 3k) points of a face
+    r = np.repeat(ring, ring.shape[1], axis=1).ravel()
+    c = np.tile(ring, (1, ring.shape[1])).ravel()
+    w = np.linalg.norm(P[r] - P[c], axis=1)
+    G = sp.csr_matrix((w, (r, c)), shape=(len(P), len(P)))  # duplicates: summed, so
+    G.data = np.linalg.norm(P[G.indices] - P[np.repeat(np.arange(len(P)), np.diff(G.indptr))],
+                            axis=1)  # the lengths again
+    return dijkstra(G, indices=source)[:len(V)]
+
+
+def test_beetle_nonmanifold_edges_crossed():
+    """beetle.obj has 47 non-manifold edges. With them as walls the exact
+    solver was up to 0.030 above the length of a real path across them;
+    now it crosses them (its budget not reached: nonmanifold_walls 0) and no
+    value lies above a real path's length (a Steiner-graph bound)."""
+    import meshfmm
+
+    need_data()
+    V, F = meshfmm.load_mesh(MESHES / "beetle.obj")
+    for s in (0, 100, 1147):
+        st, d, info, err = _solve_exact(V, F, _lib.mfmm_source(s, -1, (0.0, 0.0, 0.0), 0.0))
+        assert st == 0, err.message
+        assert info.nonmanifold_walls == 0
+        bound = _steiner_bound(V, F, 6, s)
+        finite = np.isfinite(bound)
+        np.testing.assert_array_equal(np.isfinite(d), finite)
+        assert np.all(d[finite] <= bound[finite] + 1e-12)
+
+
+def fuzz_exact_mesh(name):
+    """The mesh of tests/fuzz/regressions/exact/NAME as tests/fuzz/fuzz_exact.c
+    decodes it: V (nv, 3), F (nf, 3; faces may repeat a vertex), the input's
+    bytes and the offset of its source bytes."""
+    from pathlib import Path
+
+    data = (Path(__file__).resolve().parents[1] / "fuzz" / "regressions" / "exact"
+            / name).read_bytes() + bytes(4096)
+    nv, nf = 3 + data[0] % 64, 1 + data[1] % 128
+    V = np.frombuffer(data[4:4 + 3 * nv], dtype=np.int8).astype(np.float64).reshape(nv, 3) / 8
+    F = (np.frombuffer(data[4 + 3 * nv:4 + 3 * nv + 3 * nf], dtype=np.uint8) % nv)
+    return V, F.astype(np.int32).reshape(nf, 3), data, 4 + 3 * nv + 3 * nf
+
+
+def test_degenerate_fans_fall_back_to_walls():
+    """A fuzzed mesh (tests/fuzz/regressions/exact/
+    nonmanifold-coincident-fans-window-cycle: coincident vertices, folded
+    fans of non-manifold edges) where windows crossing those edges went
+    round without getting farther, forever. Past its budget of windows the
+    solve is redone with the non-manifold edges as walls, and says so."""
+    V, F, data, at = fuzz_exact_mesh("nonmanifold-coincident-fans-window-cycle")
+    nv, nf = len(V), len(F)
+    at = 4 + 3 * nv + 3 * nf  # flags 8: two sources, the second with a value
+    assert data[2] & 8
+    sources = (_lib.mfmm_source * 2)(_lib.mfmm_source(data[at] % nv, -1, (0.0, 0.0, 0.0), 0.0),
+                                     _lib.mfmm_source(data[at + 1] % nv, -1, (0.0, 0.0, 0.0),
+                                                      (data[at + 2] % 8) / 8))
+    err, info = _lib.mfmm_error(), _lib.mfmm_exact_info()
+    mesh, solver = ctypes.c_void_p(), ctypes.c_void_p()
+    assert _lib.mfmm_mesh_create(V.ctypes.data, nv, F.ctypes.data, nf, None, ctypes.byref(mesh),
+                                 ctypes.byref(err)) == 0, err.message
+    d = np.empty(nv)
+    try:
+        assert _lib.mfmm_exact_solver_create(mesh, ctypes.byref(solver)) == 0
+        assert _lib.mfmm_solve_exact(solver, sources, 2, None, d.ctypes.data,
+                                     ctypes.byref(info), ctypes.byref(err)) == 0, err.message
+    finally:
+        _lib.mfmm_exact_solver_destroy(solver)
+        _lib.mfmm_mesh_destroy(mesh)
+    assert info.nonmanifold_walls == 1
+    source = sources[0].vertex
+    assert d[source] == 0.0 and not np.any(np.isnan(d)) and np.all(d >= 0)

@@ -191,6 +191,7 @@ class mfmm_exact_info(Structure):
         ("n_pseudo_sources", c_int64),
         ("peak_windows", c_int64),
         ("peak_bytes", c_size_t),
+        ("nonmanifold_walls", c_int32),
     ]
 
 
