@@ -204,3 +204,23 @@ def test_meshio_one_liner_in_usage():
     m = meshio.read(MESHES / "spot.obj")
     mesh = meshfmm.Mesh(m.points, m.cells_dict["triangle"])
     assert mesh.n_faces == load("spot.obj")[1].shape[0]
+
+
+def test_meshfmm_library_wins(monkeypatch, tmp_path):
+    """$MESHFMM_LIBRARY names the library to load even when the package
+    carries one (it used to be ignored then, silently), and a path that is
+    no file is an ImportError that names it."""
+    from meshfmm import _lib as lib
+
+    inside = tmp_path / "inside.so"
+    inside.write_bytes(b"")
+    monkeypatch.setattr(lib, "_candidates", lambda: [inside])
+    mine = tmp_path / "mine.so"
+    mine.write_bytes(b"")
+    monkeypatch.setenv("MESHFMM_LIBRARY", str(mine))
+    assert lib._find_library() == str(mine)
+    monkeypatch.setenv("MESHFMM_LIBRARY", str(tmp_path / "missing.so"))
+    with pytest.raises(ImportError, match="missing.so.*is not a file"):
+        lib._find_library()
+    monkeypatch.delenv("MESHFMM_LIBRARY")
+    assert lib._find_library() == str(inside)

@@ -305,12 +305,17 @@ def _candidates() -> list:
 
 
 def _find_library() -> str:
+    # MESHFMM_LIBRARY, when set, wins (it was ignored, silently, whenever the
+    # package carried a library of its own)
     env = os.environ.get("MESHFMM_LIBRARY")
+    if env:
+        if not Path(env).is_file():
+            raise ImportError(f"meshfmm: MESHFMM_LIBRARY={env!r} is not a file (unset it to "
+                              "load the library inside the package)")
+        return env
     for path in _candidates():
         if path.is_file():
             return str(path)
-    if env:
-        return env
     raise ImportError(
         "meshfmm: the shared library libmeshfmm was not found inside the package "
         f"({Path(__file__).resolve().parent}); install the package with `pip install .` "
