@@ -1545,8 +1545,6 @@ static void ex_reset(mfmm_exact_ws *ws)
     ws->peak_bytes = ex_bytes(ws, ws->heap_cap);
 }
 
-/* The propagation from checked sources; d[] holds the result for touched
- * vertices (values > max_d are not final). */
 /* Whether the windows created so far are past what the vertices reached
  * so far can need: 64 (1 + sqrt(n) / 8) a vertex, n vertices reached (plus
  * 4096), 12-20 times what a solve needs on camelhead (78 windows a vertex)
@@ -1558,6 +1556,8 @@ static int ex_over_budget(const mfmm_exact_ws *ws)
     return (double)ws->n_windows > 4096.0 + 64.0 * n * (1.0 + sqrt(n) / 8.0);
 }
 
+/* The propagation from checked sources; d[] holds the result for touched
+ * vertices (values > max_d are not final). */
 static mfmm_status ex_run_once(mfmm_exact_ws *ws, const mfmm_source *sources,
                                int32_t n_sources, double max_d, size_t memory_limit)
 {

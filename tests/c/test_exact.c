@@ -489,8 +489,8 @@ static void test_max_distance(void **state)
 /* Two components and a non-manifold edge: a unit square cut along its
  * diagonal (1,0)-(0,1), and a fin on that diagonal, and a copy of the
  * square far away. The diagonal, shared by three faces, joins each to the
- * other two: from (0,0) the far corner is straight across it (it was a wall
- * until session 22: 2, round an end), the fin's apex (0.5, 0.5, 1), 1 above
+ * other two: from (0,0) the far corner is straight across it (as a wall,
+ * it gave 2, round an end), the fin's apex (0.5, 0.5, 1), 1 above
  * the diagonal's middle, is sqrt(1/2) + 1 away (the fin unfolded across
  * it), and from the fin's point (0.5, 0.5, 0.5) both corners off the
  * diagonal are 0.5 + sqrt(1/2) away (analytic). */
