@@ -40,8 +40,13 @@ int cli_parse_double(const char *s, double *out);
 int cli_has_ext(const char *path, const char *ext);
 
 /* Loads a mesh file and builds an mfmm_mesh; prints the error and returns
- * NULL on failure. */
-mfmm_mesh *cli_load_mesh(const char *path, const mfmm_mesh_options *options);
+ * NULL on failure. in_no_face (may be NULL): set to (nv,) flags, 1 for the
+ * vertices no face names (malloc'ed), or NULL when there are none. */
+mfmm_mesh *cli_load_mesh(const char *path, const mfmm_mesh_options *options,
+                         uint8_t **in_no_face);
+/* The note for `count` vertex sources on vertices in no face (the first
+ * one: `first`): each reaches only itself. */
+void cli_note_sources_in_no_face(const char *sub, int64_t count, int32_t first);
 
 /* ---- getopt_long (util.c) ---- */
 
@@ -184,6 +189,10 @@ int cli_sources_and_cost_check_output(const cli_sources_and_cost *o, const char 
  * with the error printed. */
 int cli_sources_and_cost_load(cli_sources_and_cost *o, const mfmm_mesh *mesh,
                               int hint_per_face, mfmm_solve_options *opt);
+/* cli_note_sources_in_no_face for o's vertex sources (in range: after a
+ * solve took them) flagged in in_no_face (cli_load_mesh; NULL: none). */
+void cli_sources_and_cost_note_in_no_face(const cli_sources_and_cost *o,
+                                          const uint8_t *in_no_face);
 /* Distances from o's sources to every vertex (malloc'ed), or NULL with the
  * error printed. */
 double *cli_solve_distances(const mfmm_mesh *mesh, const cli_sources_and_cost *o,

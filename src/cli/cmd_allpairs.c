@@ -338,7 +338,8 @@ int cmd_allpairs(int argc, char **argv)
     run_state s;
     memset(&s, 0, sizeof s);
     cli_signals_install();
-    mfmm_mesh *mesh = cli_load_mesh(path, &mo);
+    uint8_t *in_no_face = NULL;
+    mfmm_mesh *mesh = cli_load_mesh(path, &mo, &in_no_face);
     if (!mesh)
         return CLI_FAIL;
     int32_t nv = mfmm_mesh_vertex_count(mesh);
@@ -387,6 +388,14 @@ int cmd_allpairs(int argc, char **argv)
             }
         o.targets = tgt;
         o.n_targets = (int32_t)n_tgt;
+    }
+    if (in_no_face && !quiet) {
+        int64_t count = 0;
+        int32_t first = -1;
+        for (int64_t i = 0; i < n_src; i++)
+            if (in_no_face[src[i]] && count++ == 0)
+                first = src[i];
+        cli_note_sources_in_no_face("allpairs", count, first);
     }
     int64_t n_cols = tgt ? n_tgt : nv;
     if (cli_interrupted())
@@ -461,6 +470,7 @@ done:
     free(src);
     free(tgt);
     free(cost);
+    free(in_no_face);
     mfmm_mesh_destroy(mesh);
     return rc;
 }

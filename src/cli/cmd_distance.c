@@ -93,6 +93,7 @@ int cmd_distance(int argc, char **argv)
     cli_sources_and_cost o;
     double *dist = NULL;
     mfmm_mesh *mesh = NULL;
+    uint8_t *in_no_face = NULL;
     if (cli_sources_and_cost_init(&o, "distance", help, argc))
         return CLI_FAIL;
     int c;
@@ -128,13 +129,14 @@ int cmd_distance(int argc, char **argv)
     rc = CLI_FAIL;
     cli_signals_install();
 
-    mesh = cli_load_mesh(o.mesh_path, NULL);
+    mesh = cli_load_mesh(o.mesh_path, NULL, &in_no_face);
     if (!mesh || cli_sources_and_cost_load(&o, mesh, 1, &opt))
         goto done;
     int32_t nv = mfmm_mesh_vertex_count(mesh);
     dist = exact ? solve_exact(mesh, &o, opt.max_distance) : cli_solve_distances(mesh, &o, &opt);
     if (!dist || cli_interrupted())
         goto done;
+    cli_sources_and_cost_note_in_no_face(&o, in_no_face);
     if (!is_txt) {
         cli_npy_writer w;
         if (cli_npy_open(&w, o.out_path, "<f8", nv, -1))
@@ -156,6 +158,7 @@ done:
     }
     mfmm_mesh_destroy(mesh);
     free(dist);
+    free(in_no_face);
     cli_sources_and_cost_free(&o);
     return rc;
 }

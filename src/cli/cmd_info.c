@@ -70,7 +70,7 @@ int cmd_info(int argc, char **argv)
     if (!path)
         return cli_usage_error("info", "no mesh file given");
 
-    mfmm_mesh *mesh = cli_load_mesh(path, &opt);
+    mfmm_mesh *mesh = cli_load_mesh(path, &opt, NULL);
     if (!mesh)
         return CLI_FAIL;
     mfmm_mesh_info m;

@@ -87,6 +87,7 @@ int cmd_path(int argc, char **argv)
     double *dist = NULL;
     mfmm_surface_point *pts = NULL;
     mfmm_mesh *mesh = NULL;
+    uint8_t *in_no_face = NULL;
     if (cli_sources_and_cost_init(&o, "path", help, argc))
         return CLI_FAIL;
     int c;
@@ -139,7 +140,7 @@ int cmd_path(int argc, char **argv)
     rc = CLI_FAIL;
     cli_signals_install();
 
-    mesh = cli_load_mesh(o.mesh_path, NULL);
+    mesh = cli_load_mesh(o.mesh_path, NULL, &in_no_face);
     mfmm_solve_options opt;
     mfmm_solve_options_init(&opt);
     if (!mesh || cli_sources_and_cost_load(&o, mesh, 0, &opt))
@@ -152,6 +153,7 @@ int cmd_path(int argc, char **argv)
     dist = cli_solve_distances(mesh, &o, &opt);
     if (!dist)
         goto done;
+    cli_sources_and_cost_note_in_no_face(&o, in_no_face);
     mfmm_path_options po;
     mfmm_path_options_init(&po);
     double wlen = 0.0, len = 0.0;
@@ -191,6 +193,7 @@ done:
     }
     mfmm_mesh_destroy(mesh);
     free(pts);
+    free(in_no_face);
     free(dist);
     cli_sources_and_cost_free(&o);
     return rc;

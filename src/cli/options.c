@@ -30,6 +30,17 @@ void cli_sources_and_cost_free(cli_sources_and_cost *o)
     o->cost = NULL;
 }
 
+void cli_sources_and_cost_note_in_no_face(const cli_sources_and_cost *o,
+                                          const uint8_t *in_no_face)
+{
+    int64_t count = 0;
+    int32_t first = -1;
+    for (int32_t i = 0; in_no_face && i < o->n_src; i++)
+        if (o->src[i].face < 0 && in_no_face[o->src[i].vertex] && count++ == 0)
+            first = o->src[i].vertex;
+    cli_note_sources_in_no_face(o->sub, count, first);
+}
+
 int cli_sources_and_cost_opt(cli_sources_and_cost *o, int c, int argc, char **argv)
 {
     switch (c) {

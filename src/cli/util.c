@@ -351,11 +351,14 @@ int cli_put_double(FILE *f, double x)
     return fputs(buf, f);
 }
 
-mfmm_mesh *cli_load_mesh(const char *path, const mfmm_mesh_options *options)
+mfmm_mesh *cli_load_mesh(const char *path, const mfmm_mesh_options *options,
+                         uint8_t **in_no_face)
 {
     double *V = NULL;
     int32_t *F = NULL, nv = 0, nf = 0;
     mfmm_error err;
+    if (in_no_face)
+        *in_no_face = NULL;
     mfmm_status st = mfmm_load_mesh(path, &V, &nv, &F, &nf, &err);
     if (st != MFMM_OK) {
         cli_error("%s", err.message);
@@ -363,6 +366,23 @@ mfmm_mesh *cli_load_mesh(const char *path, const mfmm_mesh_options *options)
     }
     mfmm_mesh *mesh = NULL;
     st = mfmm_mesh_create(V, nv, F, nf, options, &mesh, &err);
+    mfmm_mesh_info info;
+    if (st == MFMM_OK && in_no_face && mfmm_mesh_get_info(mesh, &info) == MFMM_OK &&
+        info.n_unreferenced_vertices > 0) {
+        /* (F's ids are in range: the mesh was built from it) */
+        uint8_t *flag = malloc((size_t)nv);
+        if (!flag) {
+            mfmm_mesh_destroy(mesh);
+            mesh = NULL;
+            st = MFMM_ERR_OUT_OF_MEMORY;
+            snprintf(err.message, sizeof err.message, "out of memory");
+        } else {
+            memset(flag, 1, (size_t)nv);
+            for (int64_t i = 0; i < 3 * (int64_t)nf; i++)
+                flag[F[i]] = 0;
+            *in_no_face = flag;
+        }
+    }
     mfmm_free(V);
     mfmm_free(F);
     if (st != MFMM_OK) {
@@ -370,4 +390,15 @@ mfmm_mesh *cli_load_mesh(const char *path, const mfmm_mesh_options *options)
         return NULL;
     }
     return mesh;
+}
+
+void cli_note_sources_in_no_face(const char *sub, int64_t count, int32_t first)
+{
+    if (count == 1)
+        fprintf(stderr, "meshfmm %s: note: source vertex %ld is in no face: it reaches only "
+                        "itself (0 there, +inf elsewhere)\n", sub, (long)first);
+    else if (count > 1)
+        fprintf(stderr, "meshfmm %s: note: %lld source vertices are in no face (the first: "
+                        "%ld): each reaches only itself (0 there, +inf elsewhere)\n", sub,
+                (long long)count, (long)first);
 }

@@ -119,6 +119,41 @@ def test_info_json_mesh_bytes(cli, tmp_path):
     assert got["vertices"] == 810
 
 
+def test_notes_sources_in_no_face(cli, tmp_path):
+    """A source on a vertex no face names reaches only itself: distance,
+    allpairs and path say so (stanford-bunny.obj has 1,113 such vertices),
+    and only for such sources; its row is 0 there and +inf elsewhere."""
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [5, 5, 5], [1, 1, 0]], dtype=float)
+    F = np.array([[0, 1, 2], [1, 4, 2]])
+    path = tmp_path / "lonely.obj"
+    path.write_text("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in V.tolist())
+                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in F.tolist()))
+    out = tmp_path / "d.npy"
+    proc = run(cli, "distance", path, "--source", 3, "--source", 0, "-o", out)
+    assert "source vertex 3 is in no face: it reaches only itself" in proc.stderr
+    d = np.load(out)
+    assert d[3] == 0.0 and d.tobytes() == meshfmm.Mesh(V, F).distance([3, 0]).tobytes()
+    proc = run(cli, "distance", path, "--source", 0, "-o", out)
+    assert "no face" not in proc.stderr
+    m = tmp_path / "m.npy"
+    proc = run(cli, "allpairs", path, "-o", m, "--backend", "serial")
+    assert "source vertex 3 is in no face" in proc.stderr
+    row = np.load(m)[3]
+    assert row[3] == 0.0 and np.all(np.isinf(np.delete(row, 3)))
+    assert "no face" not in run(cli, "allpairs", path, "-o", m, "--backend", "serial",
+                                "--quiet").stderr
+    proc = subprocess.run([cli, "path", str(path), "--source", "3", "--target", "0", "-o",
+                           str(tmp_path / "p.csv")], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 1 and "source vertex 3 is in no face" in proc.stderr
+    assert "not reached" in proc.stderr
+    need_data()
+    src = tmp_path / "src.txt"
+    src.write_text("7 8 9 16 17\n")  # 8 and 16 are in no face in this file
+    proc = run(cli, "allpairs", MESHES / "stanford-bunny.obj", "--sources", src, "-o", m,
+               "--backend", "serial", "--max-distance", 0.001)
+    assert "2 source vertices are in no face (the first: 8)" in proc.stderr
+
+
 def test_exact_notes_nonmanifold_walls(cli, tmp_path):
     """`distance --exact` says when the exact solver fell back to walls at
     non-manifold edges (its budget of windows passed on degenerate folded
