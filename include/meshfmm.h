@@ -131,7 +131,11 @@ MFMM_API void mfmm_mesh_options_init(mfmm_mesh_options *options);
  * (MFMM_ERR_BAD_ARGUMENT: rescale), indices out of
  * range, a face that repeats a vertex. Results do not depend on the mesh's
  * scale (a mesh scaled by s gives distances scaled by s). Accepted: boundaries, several components,
- * unreferenced vertices, non-manifold edges, zero-area and needle faces.
+ * unreferenced vertices, non-manifold edges, zero-area and needle faces. A
+ * T-junction closed by a zero-area needle A-M-B (M inside edge AB of face
+ * A-B-C) is closed inside: A-B-C is split at M and the needle dropped, so
+ * distances and paths cross it as the surface does; face ids, per-face
+ * costs and points stay the caller's (README, "Imperfect meshes").
  * Inside, vertices are renumbered along a space-filling curve (for memory
  * locality); every function takes and returns the caller's vertex ids and
  * per-vertex arrays in the caller's order, and faces keep their ids, so
@@ -149,12 +153,16 @@ MFMM_API void mfmm_mesh_destroy(mfmm_mesh *mesh);
 typedef struct mfmm_mesh_info {
     int32_t n_vertices;              /* nv as given */
     int32_t n_faces;                 /* nf as given */
-    int32_t n_edges;                 /* distinct undirected edges */
+    int32_t n_edges;                 /* distinct undirected edges (this and the counts
+                                        below but n_degenerate_faces and
+                                        n_duplicate_faces: of the surface built, its
+                                        T-junctions closed, mfmm_mesh_create) */
     int32_t n_boundary_edges;        /* edges with one face (copies apart) */
     int32_t n_nonmanifold_edges;     /* edges with three or more faces (copies apart) */
     int32_t n_components;            /* edge-connected components of referenced vertices */
     int32_t n_unreferenced_vertices; /* vertices no face names (always +inf) */
-    int32_t n_degenerate_faces;      /* faces of (numerically) zero area */
+    int32_t n_degenerate_faces;      /* faces of (numerically) zero area, as given
+                                        (needles closing a T-junction included) */
     int32_t n_obtuse_corners;        /* corners with an angle > 90 degrees */
     int32_t n_virtual_edges;         /* obtuse corners split by a virtual edge */
     int32_t n_unfold_failures;       /* obtuse corners whose walk failed (boundary,

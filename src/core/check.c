@@ -13,7 +13,7 @@ mfmm_status mfmm_check_cost(const mfmm_mesh *mesh, const double *cost,
     if (where != MFMM_COST_PER_VERTEX && where != MFMM_COST_PER_FACE)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
                          "a cost array was given without a cost location (per vertex or per face)");
-    int32_t n = where == MFMM_COST_PER_VERTEX ? mesh->nv : mesh->nf, imax = 0;
+    int32_t n = where == MFMM_COST_PER_VERTEX ? mesh->nv : mesh->nf_in, imax = 0;
     for (int32_t i = 0; i < n; i++) {
         if (!isfinite(cost[i]) || !(cost[i] > 0.0))
             return mfmm_fail(err, MFMM_ERR_BAD_COST, i, "cost of %s %ld is %g; costs must be finite and > 0",
@@ -35,7 +35,7 @@ double mfmm_distance_bound(const mfmm_mesh *mesh, const double *cost, mfmm_cost_
 {
     double fmax_ = 1.0;
     if (cost && (where == MFMM_COST_PER_VERTEX || where == MFMM_COST_PER_FACE)) {
-        int32_t n = where == MFMM_COST_PER_VERTEX ? mesh->nv : mesh->nf;
+        int32_t n = where == MFMM_COST_PER_VERTEX ? mesh->nv : mesh->nf_in;
         fmax_ = 0.0;
         for (int32_t i = 0; i < n; i++)
             fmax_ = cost[i] > fmax_ ? cost[i] : fmax_;
@@ -56,13 +56,9 @@ mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int
                              (long)src->vertex, (long)mesh->nv);
         return MFMM_OK;
     }
-    if (src->face >= mesh->nf)
+    if (src->face >= mesh->nf_in)
         return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, i, "source %ld: face %ld is outside [0, %ld)",
-                         (long)i, (long)src->face, (long)mesh->nf);
-    if (mfmm_mesh_degenerate(mesh, mfmm_face_in(mesh, src->face)))
-        return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, i,
-                         "source %ld lies on face %ld, which has zero area", (long)i,
-                         (long)src->face);
+                         (long)i, (long)src->face, (long)mesh->nf_in);
     double sum = 0.0;
     for (int k = 0; k < 3; k++) {
         double w = src->bary[k];
@@ -75,5 +71,9 @@ mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int
     if (fabs(sum - 1.0) > 1e-9)
         return mfmm_fail(err, MFMM_ERR_BAD_BARYCENTRIC, i,
                          "source %ld: barycentric coordinates sum to %.17g, not 1", (long)i, sum);
+    if (mfmm_order_point_degenerate(mesh, src->face, src->bary))
+        return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, i,
+                         "source %ld lies on face %ld, which has zero area", (long)i,
+                         (long)src->face);
     return MFMM_OK;
 }

@@ -32,6 +32,8 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh->to_external);
     free(mesh->face_to_internal);
     free(mesh->face_to_external);
+    free(mesh->piece_next);
+    free(mesh->piece_bary);
     free(mesh->xyz);
     free(mesh->face_neighbor);
     free(mesh->vertex_face_offset);
@@ -504,7 +506,22 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
     mfmm_status st = validate(vertices, nv, faces, nf, err);
     if (st != MFMM_OK)
         return st;
+    mfmm_mesh *m = NULL;
+    st = mfmm_mesh_build(vertices, nv, faces, nf, &opt, &m, err);
+    if (st == MFMM_OK && m->info.n_degenerate_faces > 0)
+        st = mfmm_mesh_close_t_junctions(&m, vertices, nv, faces, nf, &opt, err);
+    if (st != MFMM_OK)
+        return st;
+    *out = m;
+    return MFMM_OK;
+}
 
+mfmm_status mfmm_mesh_build(const double *vertices, int32_t nv, const int32_t *faces,
+                            int32_t nf, const mfmm_mesh_options *options, mfmm_mesh **out,
+                            mfmm_error *err)
+{
+    mfmm_mesh_options opt = *options;
+    mfmm_status st;
     mfmm_mesh *m = calloc(1, sizeof *m);
     if (!m)
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
@@ -514,6 +531,7 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
     }
     m->nv = nv;
     m->nf = nf;
+    m->nf_in = nf;
     m->spokes_allowed = opt.spokes;
     size_t nc = (size_t)nf * 3;
     m->xyz = malloc((size_t)nv * 3 * sizeof *m->xyz);
@@ -606,7 +624,7 @@ int32_t mfmm_mesh_vertex_count(const mfmm_mesh *mesh)
 
 int32_t mfmm_mesh_face_count(const mfmm_mesh *mesh)
 {
-    return mesh ? mesh->nf : 0;
+    return mesh ? mesh->nf_in : 0;
 }
 
 void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_location,
@@ -650,7 +668,8 @@ int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, i
         {"face_neighbor", nc * sizeof(int32_t)},
         {"vertex_face (CSR)", (nv + 1 + nc) * sizeof(int32_t)},
         {"to_internal/to_external", 2 * nv * sizeof(int32_t)},
-        {"face_to_internal/external", 2 * nf * sizeof(int32_t)},
+        {"face_to_internal/external", ((size_t)mesh->nf_in + nf) * sizeof(int32_t) +
+                                          (mesh->piece_next ? nf * (sizeof(int32_t) + 9 * sizeof(double)) : 0)},
         {"face records", nf * sizeof(mfmm_face)},
         {"virtual edges", (size_t)mesh->n_virts * sizeof(mfmm_virt) + (nv + 1) * sizeof(int32_t)},
         {"strip", n_steps * sizeof(int32_t)},

@@ -32,15 +32,25 @@ typedef struct mfmm_corner_full {
 } mfmm_corner_full;
 
 struct mfmm_mesh {
-    int32_t nv, nf;
+    /* nf: the faces built; nf_in: the faces as given (info.n_faces). They
+     * differ where T-junctions were closed (tjunction.c): a zero-area needle
+     * dropped, the face across its long edge split in two. */
+    int32_t nv, nf, nf_in;
     /* Vertices are numbered internally along a space-filling curve, faces
      * by their least internal vertex (order.h): every per-vertex and
      * per-face array below, and the vertex ids in the face records, are in that order;
      * a face keeps its corner order. */
     int32_t *to_internal;      /* (nv,) internal id of each input vertex */
     int32_t *to_external;      /* (nv,) input id of each internal vertex */
-    int32_t *face_to_internal; /* (nf,) internal id of each input face */
+    int32_t *face_to_internal; /* (nf_in,) internal id of each input face (its
+                                  first piece; -1: a needle dropped, tjunction.c) */
     int32_t *face_to_external; /* (nf,) input id of each internal face */
+    /* Only where T-junctions were closed (tjunction.c), else NULL: piece_next
+     * (nf,) the next internal face cut from the same input face, -1 after
+     * the last; piece_bary (nf, 3, 3): corner j of internal face f in the
+     * barycentric coordinates of its input face, piece_bary[9 f + 3 j + i]. */
+    int32_t *piece_next;
+    double *piece_bary;
     double *xyz;               /* (nv, 3) */
     int32_t *face_neighbor;    /* (nf, 3): face across the edge opposite corner k,
                                   -1 at a boundary or non-manifold edge */
@@ -108,6 +118,26 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
  * made with mfmm_mesh_options.spokes = 0). */
 mfmm_status mfmm_mesh_spokes_of(const mfmm_mesh *mesh, const int32_t **offset,
                                 const mfmm_spoke **spokes);
+
+/* Builds a mesh from checked arrays (mfmm_mesh_create's work, without its
+ * argument checks and without closing T-junctions): *out, or an error. */
+mfmm_status mfmm_mesh_build(const double *vertices, int32_t nv, const int32_t *faces,
+                            int32_t nf, const mfmm_mesh_options *opt, mfmm_mesh **out,
+                            mfmm_error *err);
+
+/* Closes the T-junctions of *mesh, built from (vertices, nv, faces, nf), in
+ * place (tjunction.c): where a zero-area face is a needle A-M-B with M
+ * inside edge AB and one face A-B-C across AB, the needle stands for M
+ * lying on AB, and the march (no triangle update through zero area) and the
+ * paths would go round through A or B. The needle is dropped and A-B-C
+ * split at M into two pieces that keep its corner order, rebuilding the
+ * mesh until no such needle is left; input face ids, per-face costs,
+ * points and paths map through face_to_internal/external and the pieces
+ * (order.h). A mesh with none is left as it is. MFMM_OK or an error (the
+ * mesh then destroyed and *mesh NULL). */
+mfmm_status mfmm_mesh_close_t_junctions(mfmm_mesh **mesh, const double *vertices, int32_t nv,
+                                        const int32_t *faces, int32_t nf,
+                                        const mfmm_mesh_options *opt, mfmm_error *err);
 
 /* Finds the virtual edge of every obtuse corner by unfolding (section 4.2);
  * fills full[].virt, virt_len, virt_cos_a, virt_cos_b, strip_at, strip_n, the

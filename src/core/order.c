@@ -160,8 +160,65 @@ mfmm_status mfmm_order_faces(const int32_t *faces, int32_t nf, int32_t **to_inte
 
 void mfmm_order_points_out(const mfmm_mesh *mesh, mfmm_surface_point *points, int32_t n)
 {
-    for (int32_t i = 0; i < n; i++)
-        points[i].face = mesh->face_to_external[points[i].face];
+    for (int32_t i = 0; i < n; i++) {
+        int32_t f = points[i].face;
+        points[i].face = mesh->face_to_external[f];
+        if (!mesh->piece_bary)
+            continue;
+        const double *K = mesh->piece_bary + 9 * (size_t)f, *b = points[i].bary;
+        double out[3];
+        for (int c = 0; c < 3; c++)
+            out[c] = b[0] * K[c] + b[1] * K[3 + c] + b[2] * K[6 + c];
+        memcpy(points[i].bary, out, sizeof out);
+    }
+}
+
+int32_t mfmm_order_point_in(const mfmm_mesh *mesh, int32_t f, const double b[3], double out[3])
+{
+    int32_t g = mesh->face_to_internal[f];
+    if (!mesh->piece_bary || g < 0 || mesh->piece_next[g] < 0) {
+        if (out != b)
+            memcpy(out, b, 3 * sizeof *out);
+        return g;
+    }
+    /* b = beta K (K's rows: the piece's corners in f's coordinates), solved
+     * by the adjugate of K; the piece where min(beta) is largest */
+    int32_t best = -1;
+    double best_beta[3] = {0.0, 0.0, 0.0}, best_min = -INFINITY;
+    for (int32_t p = g; p >= 0; p = mesh->piece_next[p]) {
+        const double *K = mesh->piece_bary + 9 * (size_t)p;
+        double adj[9];
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++) {
+                int r1 = (r + 1) % 3, r2 = (r + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+                /* inverse's (c, r) entry, times det */
+                adj[3 * c + r] = K[3 * r1 + c1] * K[3 * r2 + c2] - K[3 * r1 + c2] * K[3 * r2 + c1];
+            }
+        double det = K[0] * adj[0] + K[1] * adj[3] + K[2] * adj[6];
+        double beta[3];
+        for (int j = 0; j < 3; j++)
+            beta[j] = (b[0] * adj[j] + b[1] * adj[3 + j] + b[2] * adj[6 + j]) / det;
+        double lo = fmin(beta[0], fmin(beta[1], beta[2]));
+        if (best < 0 || lo > best_min) {
+            best = p;
+            best_min = lo;
+            memcpy(best_beta, beta, sizeof beta);
+        }
+    }
+    /* on a cut between pieces, rounding may leave -1e-17: none below 0 */
+    double sum = 0.0;
+    for (int j = 0; j < 3; j++)
+        sum += (best_beta[j] = fmax(best_beta[j], 0.0));
+    for (int j = 0; j < 3; j++)
+        out[j] = best_beta[j] / sum;
+    return best;
+}
+
+int mfmm_order_point_degenerate(const mfmm_mesh *mesh, int32_t f, const double b[3])
+{
+    double inner[3];
+    int32_t g = mfmm_order_point_in(mesh, f, b, inner);
+    return g < 0 || mfmm_mesh_degenerate(mesh, g);
 }
 
 void mfmm_order_face_values_in(const mfmm_mesh *mesh, const double *in, double *out)
@@ -228,7 +285,7 @@ mfmm_status mfmm_order_map_args(const mfmm_mesh *mesh, const mfmm_source *source
             if (s[i].face < 0)
                 s[i].vertex = mesh->to_internal[s[i].vertex];
             else
-                s[i].face = mesh->face_to_internal[s[i].face];
+                s[i].face = mfmm_order_point_in(mesh, s[i].face, s[i].bary, s[i].bary);
         a->sources = s;
         at += b_src;
     }

@@ -28,11 +28,24 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_interna
 mfmm_status mfmm_order_faces(const int32_t *faces, int32_t nf, int32_t **to_internal,
                              int32_t **to_external);
 
-/* Internal id of input face f (checked to be in range). */
+/* Internal id of input face f (checked to be in range): its first piece
+ * where it was split at a T-junction, -1 for a needle dropped there
+ * (mesh.h); points map with mfmm_order_point_in. */
 static inline int32_t mfmm_face_in(const mfmm_mesh *mesh, int32_t f)
 {
     return mesh->face_to_internal[f];
 }
+
+/* The internal face holding the point of barycentric coordinates b in input
+ * face f (checked to be in range), and its coordinates there in out (out
+ * may be b): f's internal face, or where f was split at T-junctions the
+ * piece the point lies in (the one it lies deepest in); -1 for a needle
+ * dropped there (zero area). */
+int32_t mfmm_order_point_in(const mfmm_mesh *mesh, int32_t f, const double b[3], double out[3]);
+
+/* 1 when the point b of input face f lies in no face with an area: f is a
+ * zero-area face (mfmm_mesh_degenerate), or a needle dropped. */
+int mfmm_order_point_degenerate(const mfmm_mesh *mesh, int32_t f, const double b[3]);
 
 /* Input id of internal face f. */
 static inline int32_t mfmm_face_out(const mfmm_mesh *mesh, int32_t f)
@@ -41,7 +54,8 @@ static inline int32_t mfmm_face_out(const mfmm_mesh *mesh, int32_t f)
 }
 
 /* The face ids of n surface points (a path) from internal to input ids, in
- * place. */
+ * place, and their barycentric coordinates to the input face's where it
+ * was split at a T-junction. */
 void mfmm_order_points_out(const mfmm_mesh *mesh, mfmm_surface_point *points, int32_t n);
 
 /* Per-face values (nf,) from input order to internal order (out != in). */

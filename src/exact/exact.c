@@ -1665,8 +1665,10 @@ static mfmm_status ex_check_sources(const mfmm_exact_ws *ws, const mfmm_source *
         mfmm_status st = mfmm_check_source(ws->mesh, sources + i, i, err);
         if (st != MFMM_OK)
             return st;
+        double b[3];
         if (sources[i].face >= 0 &&
-            ws->fr[ws->face_in[mfmm_face_in(ws->mesh, sources[i].face)]].skip == 1)
+            ws->fr[ws->face_in[mfmm_order_point_in(ws->mesh, sources[i].face, sources[i].bary, b)]]
+                    .skip == 1)
             return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, i,
                              "source %ld lies on face %ld, which has zero area", (long)i,
                              (long)sources[i].face);

@@ -527,7 +527,7 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     int cost_location = o->cost ? (int)o->cost_location : 0;
     double *own_cost = NULL;
     if (o->cost && (o->cost_location == MFMM_COST_PER_VERTEX || o->cost_location == MFMM_COST_PER_FACE)) {
-        size_t n = o->cost_location == MFMM_COST_PER_VERTEX ? (size_t)nv : (size_t)mesh->nf;
+        size_t n = o->cost_location == MFMM_COST_PER_VERTEX ? (size_t)nv : (size_t)mesh->nf_in;
         own_cost = malloc(n * sizeof *own_cost);
         if (!own_cost) {
             free(own_sources);

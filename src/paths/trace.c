@@ -777,17 +777,9 @@ static int validate_point(const mfmm_mesh *m, const mfmm_source *s, const char *
                              what, (int)s->vertex, (int)m->nv);
         return MFMM_OK;
     }
-    if (s->face < 0 || s->face >= m->nf)
+    if (s->face < 0 || s->face >= m->nf_in)
         return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, idx, "%s face %d is out of range [0, %d)", what,
-                         (int)s->face, (int)m->nf);
-    /* as mfmm_solve refuses a source there: the walk reads T in the face's
-     * plane, which a zero-area face does not span (a target there went round
-     * through a corner: 1.20 long where the straight path is 0.86) */
-    if (mfmm_mesh_degenerate(m, mfmm_face_in(m, s->face)))
-        return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, idx,
-                         "%s lies on face %d, which has zero area: give the same point on a face "
-                         "beside it",
-                         what, (int)s->face);
+                         (int)s->face, (int)m->nf_in);
     double sum = 0.0;
     for (int k = 0; k < 3; k++) {
         if (!isfinite(s->bary[k]) || s->bary[k] < 0.0)
@@ -799,6 +791,14 @@ static int validate_point(const mfmm_mesh *m, const mfmm_source *s, const char *
     if (fabs(sum - 1.0) > 1e-9)
         return mfmm_fail(err, MFMM_ERR_BAD_BARYCENTRIC, idx,
                          "%s barycentric coordinates sum to %.17g, not 1", what, sum);
+    /* as mfmm_solve refuses a source there: the walk reads T in the face's
+     * plane, which a zero-area face does not span (a target there went round
+     * through a corner: 1.20 long where the straight path is 0.86) */
+    if (mfmm_order_point_degenerate(m, s->face, s->bary))
+        return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, idx,
+                         "%s lies on face %d, which has zero area: give the same point on a face "
+                         "beside it",
+                         what, (int)s->face);
     return MFMM_OK;
 }
 
@@ -875,7 +875,7 @@ mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
     if (target_in.face == -1)
         target_in.vertex = mfmm_vertex_in(mesh, target_in.vertex);
     else
-        target_in.face = mfmm_face_in(mesh, target_in.face);
+        target_in.face = mfmm_order_point_in(mesh, target_in.face, target_in.bary, target_in.bary);
     if (mfmm_order_map_args(mesh, o->sources, o->n_sources, NULL, 0, o->cost,
                             o->cost ? (int)o->cost_location : 0, distances, &mapped) != MFMM_OK)
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "no memory for the distances");

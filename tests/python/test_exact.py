@@ -131,12 +131,14 @@ def test_cli_distance_exact(tmp_path, reference_dir):
     assert r.returncode == 2 and "--exact" in r.stderr
 
 
-def _grid_with_t_junctions(n=10, splits=((3, 4), (5, 5), (6, 2), (2, 7))):
+def _grid_with_t_junctions(n=10, splits=((3, 4), (5, 5), (6, 2), (2, 7)), resolved=False):
     """A flat n x n grid on [0,1]^2 whose diagonals at the given squares are
     split on one side only: the diagonal's other face is cut in two at the
     midpoint m, and a zero-area face (q, p, m) closes the T-junction, as
     exporters and mesh repair tools leave them. The surface is still the
-    unit square, so distances are Euclidean."""
+    unit square, so distances are Euclidean. resolved: the same surface
+    without the junctions, face (a, b, d) cut at m too (as the library
+    splits it: (m, b, d) and (a, b, m)) and no cap."""
     xs = np.linspace(0.0, 1.0, n + 1)
     V = [(x, y, 0.0) for y in xs for x in xs]
     F = []
@@ -147,7 +149,10 @@ def _grid_with_t_junctions(n=10, splits=((3, 4), (5, 5), (6, 2), (2, 7))):
             if (i, j) in splits:  # faces (a, b, d) and (d, c, a) share diagonal a-d
                 m = len(V)
                 V.append(((V[a][0] + V[d][0]) / 2, (V[a][1] + V[d][1]) / 2, 0.0))
-                F += [(a, b, d), (d, c, m), (m, c, a), (d, a, m)]  # (d, a, m): the cap
+                if resolved:
+                    F += [(m, b, d), (a, b, m), (d, c, m), (m, c, a)]
+                else:
+                    F += [(a, b, d), (d, c, m), (m, c, a), (d, a, m)]  # (d, a, m): the cap
             else:
                 F += [(a, b, d), (d, c, a)]
     return np.array(V), np.array(F, dtype=np.int32)
@@ -173,6 +178,29 @@ def test_zero_area_faces_closing_t_junctions_are_no_walls():
         np.testing.assert_allclose(m.distance(s)[near], ref[near], rtol=1e-12, atol=1e-14)
     strip = meshfmm.Mesh([[0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0.0]], [[0, 1, 2], [1, 2, 3]])
     np.testing.assert_array_equal(strip.distance(0, method="exact"), [0.0, 1.0, 2.0, 3.0])
+
+
+def test_t_junctions_are_closed_for_the_march():
+    """The march takes no triangle update through a zero-area face, so
+    beyond its exact start it crossed a T-junction's needle only along
+    edges, through the junction's ends (the square split at (.5, .5):
+    1.0607 for 0.7906 from the plain start). The library now splits the
+    face across the needle at its middle vertex and drops the needle: every
+    row equals the same surface given resolved (reference: the serial core
+    on that mesh) bit for bit, plain and exact start, and the counts stay
+    the input's."""
+    import meshfmm
+
+    V, F = _grid_with_t_junctions()
+    Vr, Fr = _grid_with_t_junctions(resolved=True)
+    m, r = meshfmm.Mesh(V, F), meshfmm.Mesh(Vr, Fr)
+    assert m.info.n_faces == len(F) and m.n_faces == len(F)
+    assert m.info.n_degenerate_faces == 4 and r.info.n_degenerate_faces == 0
+    for start in (False, "auto"):
+        np.testing.assert_array_equal(m.distance_matrix(np.arange(len(V)), exact_start=start,
+                                                        dtype="float64"),
+                                      r.distance_matrix(np.arange(len(V)), exact_start=start,
+                                                        dtype="float64"))
 
 
 def _book(n, pages=((0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0.6, 0.8))):
