@@ -110,8 +110,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         mfmm_source isrc = src[0]; /* the patch API takes internal ids (core/order.h) */
         if (isrc.face < 0)
             isrc.vertex = mfmm_vertex_in(mesh, isrc.vertex);
-        else /* faces are numbered internally too */
-            isrc.face = mfmm_face_in(mesh, isrc.face);
+        else /* faces are numbered internally too, and split at T-junctions */
+            isrc.face = mfmm_order_point_in(mesh, isrc.face, isrc.bary, isrc.bary);
         if (mfmm_exact_patch(ex, &isrc, 1, R, 0, &n, &pv, &pd, NULL) == MFMM_OK) {
             int32_t inside = 0, in_r = 0;
             for (int32_t v = 0; v < nv; v++)
