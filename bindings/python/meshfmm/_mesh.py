@@ -51,12 +51,12 @@ class MeshInfo:
 
     n_vertices: int  #: vertices as given
     n_faces: int  #: faces as given
-    n_edges: int  #: distinct undirected edges
+    n_edges: int  #: distinct undirected edges (of the surface built: T-junctions closed)
     n_boundary_edges: int  #: edges with one face
     n_nonmanifold_edges: int  #: edges with three or more faces
     n_components: int  #: edge-connected components of referenced vertices
     n_unreferenced_vertices: int  #: vertices no face names (always +inf)
-    n_degenerate_faces: int  #: faces of (numerically) zero area
+    n_degenerate_faces: int  #: faces of (numerically) zero area, as given (needles included)
     n_obtuse_corners: int  #: corners with an angle > 90 degrees
     n_virtual_edges: int  #: obtuse corners split by a virtual edge (unfolding)
     n_unfold_failures: int  #: obtuse corners whose unfolding walk failed
@@ -319,7 +319,11 @@ class Mesh:
     that repeats a vertex. Boundaries, several components, unreferenced
     vertices, non-manifold edges and degenerate faces are accepted; copies of
     a face (its vertices again, in any order) are counted in ``info`` and
-    stand aside, so that they make no edge non-manifold.
+    stand aside, so that they make no edge non-manifold. A T-junction closed
+    by a zero-area needle face is closed inside (the face across the needle
+    split at its middle vertex), so distances and paths cross it; face ids,
+    per-face costs and points stay the ones given (README, "Imperfect
+    meshes").
 
     A Mesh may be used from several threads at once: each concurrent call
     gets its own solver workspace, and the C calls release the GIL. Free it
