@@ -187,8 +187,9 @@ def test_t_junctions_are_closed_for_the_march():
     1.0607 for 0.7906 from the plain start). The library now splits the
     face across the needle at its middle vertex and drops the needle: every
     row equals the same surface given resolved (reference: the serial core
-    on that mesh) bit for bit, plain and exact start, and the counts stay
-    the input's."""
+    on that mesh) bit for bit, plain and exact start, and with a per-face
+    cost given per input face on the serial, threads and OpenCL backends;
+    the counts stay the input's."""
     import meshfmm
 
     V, F = _grid_with_t_junctions()
@@ -201,6 +202,28 @@ def test_t_junctions_are_closed_for_the_march():
                                                         dtype="float64"),
                                       r.distance_matrix(np.arange(len(V)), exact_start=start,
                                                         dtype="float64"))
+    # a per-face cost of the input faces (the caps' entries unused): the
+    # resolved mesh's pieces take their face's, on every backend; faces come
+    # 2 per square, 4 where split ((a,b,d) first; resolved: its two pieces)
+    rng = np.random.default_rng(3)
+    cost = rng.uniform(1.0, 3.0, len(F))
+    cost_r, i = [], 0
+    for j in range(10):  # the generator's squares, in its order (n = 10)
+        for k in range(10):
+            split = (k, j) in ((3, 4), (5, 5), (6, 2), (2, 7))
+            cost_r += [cost[i], cost[i], cost[i + 1], cost[i + 2]] if split else [cost[i], cost[i + 1]]
+            i += 4 if split else 2
+    assert len(cost_r) == len(Fr)
+    src = np.arange(0, len(V), 7)
+    want = r.distance_matrix(src, dtype="float64", cost=np.array(cost_r), cost_location="face",
+                             backend="serial")
+    for backend in ("serial", "threads", "opencl"):
+        try:
+            got = m.distance_matrix(src, dtype="float64", cost=cost, cost_location="face",
+                                    backend=backend)
+        except meshfmm.OpenCLError:
+            continue  # no device here: the other backends still ran
+        np.testing.assert_array_equal(got, want)
 
 
 def _book(n, pages=((0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0.6, 0.8))):
