@@ -84,12 +84,13 @@ static void test_patch_is_exact(void **state)
             int32_t n = 0;
             const int32_t *pv = NULL;
             const double *pd = NULL;
-            /* the patch API is internal: internal vertex and face ids (core/order.h) */
+            /* the patch API is internal: internal vertex ids, and a face
+             * point in the piece that holds it (core/order.h) */
             mfmm_source isrc = src;
             if (isrc.face < 0)
                 isrc.vertex = mfmm_vertex_in(mesh, isrc.vertex);
             else
-                isrc.face = mfmm_face_in(mesh, isrc.face);
+                isrc.face = mfmm_order_point_in(mesh, isrc.face, isrc.bary, isrc.bary);
             assert_int_equal(mfmm_exact_patch(ws, &isrc, 1, R, 0, &n, &pv, &pd, NULL), MFMM_OK);
             assert_true(n >= 10);
             /* every vertex within R, and a ring beyond it (exact.c) */
