@@ -133,7 +133,8 @@ MFMM_API void mfmm_mesh_options_init(mfmm_mesh_options *options);
  * scale (a mesh scaled by s gives distances scaled by s). Accepted: boundaries, several components,
  * unreferenced vertices, non-manifold edges, zero-area and needle faces. A
  * T-junction closed by a zero-area needle A-M-B (M inside edge AB of face
- * A-B-C) is closed inside: A-B-C is split at M and the needle dropped, so
+ * A-B-C, or of every face on a non-manifold AB) is closed inside: the
+ * faces on AB are split at M and the needle dropped, so
  * distances and paths cross it as the surface does; face ids, per-face
  * costs and points stay the caller's (README, "Imperfect meshes").
  * Inside, vertices are renumbered along a space-filling curve (for memory

@@ -6,7 +6,9 @@
  * junction only along edges, through A or B (the unit square split at
  * (.5, .5) with M = (.25, .25): 1.06 where the surface gives 0.79), and so
  * did paths. The needle stands for M lying on AB: here A-B-C is split at M
- * into the faces it would have had, and the needle dropped. */
+ * into the faces it would have had, and the needle dropped; on a
+ * non-manifold AB every face on it is (a book with a needle: the march had
+ * a page's far vertex at 4.20 for 3.24). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,6 +20,9 @@
  * input, plan_round); needles left after it stay zero-area faces, as
  * before. */
 #define MAX_ROUNDS 64
+/* At most this many faces across a needle's long edge (a non-manifold
+ * edge's pages); a needle with more stays. */
+#define MAX_PAGES 16
 
 /* The faces a mesh is built from: vertex ids as given, and for each face
  * the input face it was cut from and its corners' barycentric coordinates
@@ -103,29 +108,43 @@ static int32_t plan_round(const mfmm_mesh *m, const face_list *l, uint8_t *actio
         if (!(s > 0.0 && s < 1.0) || !(fr->len[(km + 1) % 3] > 0.0) ||
             !(fr->len[(km + 2) % 3] > 0.0))
             continue;
-        int32_t g = m->face_neighbor[3 * (size_t)f + km];
-        /* one face with an area across AB, without copies (a copy left
-         * whole would overlap the pieces) */
-        if (g < 0 || mfmm_mesh_degenerate(m, g) || mfmm_mesh_copy(m, g) ||
-            (g + 1 < m->nf && mfmm_mesh_copy(m, g + 1)))
-            continue;
-        int32_t wg = m->face_to_external[g];
-        if (action[wg] != KEEP)
-            continue; /* split once a round */
-        int ja = -1, jb = -1;
-        for (int j = 0; j < 3; j++) {
-            ja = m->face_records[g].v[j] == a ? j : ja;
-            jb = m->face_records[g].v[j] == b ? j : jb;
+        /* the faces across AB: one, or the pages of a non-manifold edge (M
+         * lies on AB in each of them, as the exact solver's fan-out has
+         * it); each with an area, none a copy (a copy left whole would
+         * overlap the pieces), none split this round already. Copies of
+         * the needle go with it. */
+        int32_t across[MAX_PAGES];
+        int8_t ja[MAX_PAGES], jb[MAX_PAGES];
+        int n_across = 0, ok = 1;
+        for (int32_t i = m->vertex_face_offset[a]; i < m->vertex_face_offset[a + 1] && ok; i++) {
+            int32_t g = MFMM_WEDGE_FACE(m->vertex_wedge[i]);
+            const int32_t *gv = m->face_records[g].v;
+            int jb_g = gv[0] == b ? 0 : gv[1] == b ? 1 : gv[2] == b ? 2 : -1;
+            if (g == f || jb_g < 0 || mfmm_mesh_original(m, g) == f)
+                continue;
+            if (n_across == MAX_PAGES || mfmm_mesh_degenerate(m, g) || mfmm_mesh_copy(m, g) ||
+                action[m->face_to_external[g]] != KEEP) {
+                ok = 0;
+                break;
+            }
+            across[n_across] = g;
+            ja[n_across] = (int8_t)(gv[0] == a ? 0 : gv[1] == a ? 1 : 2);
+            jb[n_across++] = (int8_t)jb_g;
         }
-        if (ja < 0 || jb < 0)
+        for (int q = 0; q < n_across && ok; q++) /* a face copied later */
+            ok = !(across[q] + 1 < m->nf && mfmm_mesh_copy(m, across[q] + 1));
+        if (!ok || n_across == 0)
             continue;
         action[w] = DROP;
-        action[wg] = SPLIT;
-        plan[wg].m = m->to_external[mv];
-        plan[wg].ja = (int8_t)ja;
-        plan[wg].jb = (int8_t)jb;
-        plan[wg].s = s;
-        n_split++;
+        for (int q = 0; q < n_across; q++) {
+            int32_t wg = m->face_to_external[across[q]];
+            action[wg] = SPLIT;
+            plan[wg].m = m->to_external[mv];
+            plan[wg].ja = ja[q];
+            plan[wg].jb = jb[q];
+            plan[wg].s = s;
+            n_split++;
+        }
     }
     return n_split;
 }
@@ -199,6 +218,7 @@ mfmm_status mfmm_mesh_close_t_junctions(mfmm_mesh **mesh, const double *vertices
     face_list l = {0}, next = {0};
     uint8_t *action = calloc((size_t)nf, sizeof *action);
     split_plan *plan = malloc((size_t)nf * sizeof *plan);
+    int32_t cap = nf; /* action's and plan's length */
     mfmm_status st = MFMM_OK;
     if (!action || !plan) {
         st = MFMM_ERR_OUT_OF_MEMORY;
@@ -219,6 +239,19 @@ mfmm_status mfmm_mesh_close_t_junctions(mfmm_mesh **mesh, const double *vertices
     }
     for (int round = 0; round < MAX_ROUNDS; round++) {
         if (round > 0) {
+            if (l.n > cap) { /* a needle on a non-manifold edge splits each page */
+                uint8_t *na = realloc(action, (size_t)l.n * sizeof *action);
+                if (na)
+                    action = na;
+                split_plan *np = realloc(plan, (size_t)l.n * sizeof *plan);
+                if (np)
+                    plan = np;
+                if (!na || !np) {
+                    st = MFMM_ERR_OUT_OF_MEMORY;
+                    goto done;
+                }
+                cap = l.n;
+            }
             memset(action, 0, (size_t)l.n);
             if (plan_round(m, &l, action, plan) == 0)
                 break;
@@ -232,7 +265,6 @@ mfmm_status mfmm_mesh_close_t_junctions(mfmm_mesh **mesh, const double *vertices
         memset(&next, 0, sizeof next);
         mfmm_mesh_destroy(m);
         m = NULL;
-        /* the lists only shrink or keep their size: action and plan fit */
         st = mfmm_mesh_build(vertices, nv, l.v, l.n, opt, &m, err);
         if (st != MFMM_OK)
             goto done;

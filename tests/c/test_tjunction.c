@@ -36,6 +36,14 @@ static const int32_t F_CH[8 * 3] = {0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 5,
 static const int32_t H_CH[8 * 3] = {0, 1, 5, 5, 1, 6, 6, 1, 4, 1, 2, 4,
                                     2, 3, 4, 3, 0, 5, 3, 5, 6, 3, 6, 4};
 
+/* A needle 1 (0, 1, 2) on a non-manifold edge 0-2 with two pages, 4 flat
+ * and 6 upright, a face (0, 3, 1) below and (0, 4, 5) beyond page 4: every
+ * page is split at 1 (tests/python/test_exact.py has its distances). */
+static const double VB[7 * 3] = {0, 0, 0, 1, 0, 0, 2, 0, 0, 3, -1, 0,
+                                 1, 1, 0, -0.5, 1.5, 0, 1, 0, 1};
+static const int32_t F_BK[5 * 3] = {0, 3, 1, 0, 1, 2, 0, 2, 4, 0, 4, 5, 0, 6, 2};
+static const int32_t H_BK[6 * 3] = {0, 3, 1, 0, 1, 4, 1, 2, 4, 0, 4, 5, 0, 6, 1, 1, 6, 2};
+
 static mfmm_mesh *make(const double *v, int32_t nv, const int32_t *f, int32_t nf)
 {
     mfmm_mesh *m = NULL;
@@ -83,6 +91,7 @@ static void test_rows_equal_the_resolved_mesh(void **state)
     (void)state;
     check_rows(V, 6, F_SQ, 6, H_SQ, 6, 1);
     check_rows(VC, 7, F_CH, 8, H_CH, 8, 2);
+    check_rows(VB, 7, F_BK, 5, H_BK, 6, 1);
     /* the case of the module's comment: vertex 1 to M */
     mfmm_mesh *m = make(V, 6, F_SQ, 6);
     mfmm_solve_options o;
@@ -143,6 +152,21 @@ static void test_per_face_cost(void **state)
     assert_int_equal(mfmm_solve(solver, &src, 1, &o, a, &err), MFMM_ERR_BAD_COST);
     assert_int_equal(err.index, 5);
     mfmm_solver_destroy(solver);
+    mfmm_mesh_destroy(m);
+    mfmm_mesh_destroy(r);
+    /* the book: more pieces than input faces (both pages split) */
+    m = make(VB, 7, F_BK, 5);
+    r = make(VB, 7, H_BK, 6);
+    const double cost_b[5] = {1.5, 1000.0, 2.0, 1.25, 3.0};
+    const double cost_bh[6] = {1.5, 2.0, 2.0, 1.25, 3.0, 3.0};
+    o.cost = cost_b;
+    oh.cost = cost_bh;
+    for (int32_t s = 0; s < 7; s++) {
+        mfmm_source src7 = tm_vertex_source(s);
+        solve(m, &src7, &o, a);
+        solve(r, &src7, &oh, b);
+        assert_memory_equal(a, b, sizeof(double) * 7);
+    }
     mfmm_mesh_destroy(m);
     mfmm_mesh_destroy(r);
 }

@@ -180,28 +180,46 @@ def test_zero_area_faces_closing_t_junctions_are_no_walls():
     np.testing.assert_array_equal(strip.distance(0, method="exact"), [0.0, 1.0, 2.0, 3.0])
 
 
-def test_needle_middle_vertex_on_a_non_manifold_edge_starts_its_whole_fan():
-    """A needle A-M-B whose long edge AB has two pages besides (so it stays:
-    only a needle with one face across is closed) lets M start windows on
-    AB. Such a window's I lies on the edge, so its interval holds
-    directions, not points; the windows that reached AB first from the
-    source, shorter at every point of AM, cut away its whole left sector,
-    and E, reached only by bending at M, took a path through A: 4.7434 for
-    sqrt(5) + sqrt(4.5) = 4.3574 (a fuzzed mesh found it, as a broken
-    triangle inequality). Analytic: the plane z = 0, the source S below AM,
-    crossing AB only on AM; page Q stands upright on AB."""
+def test_needle_on_a_non_manifold_edge():
+    """A needle A-M-B whose long edge AB has two pages besides. Analytic:
+    the plane z = 0, the source S below AM, crossing AB only on AM; page Q
+    stands upright on AB; E is reached only by bending at M, at
+    sqrt(5) + sqrt(4.5), through A it is sqrt(10) + sqrt(2.5).
+
+    Closed (both pages split at M, as one face across is): the rows from
+    every vertex, plain and exact start, equal the mesh given resolved; the
+    march had C at 4.1985 for 3.2361 (no triangle update through the
+    needle) and the path to E went through A, 4.7434.
+
+    Left as it is (a page with a copy): the exact solver starts M's windows
+    on AB with I on the edge, whose interval holds directions, not points;
+    the windows that reached AB first, shorter at every point of AM, cut
+    away M's whole left sector, and E took the path through A, 4.7434 (a
+    fuzzed mesh found it, as a broken triangle inequality)."""
     import meshfmm
 
     V = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [3, -1, 0], [1, 1, 0], [-0.5, 1.5, 0],
                   [1, 0, 1]], dtype=np.float64)
     A, M, B, S, C, E, D = range(7)
     F = np.array([[A, S, M], [A, M, B], [A, B, C], [A, C, E], [A, D, B]], dtype=np.int32)
-    m = meshfmm.Mesh(V, F)
-    assert (m.info.n_nonmanifold_edges, m.info.n_degenerate_faces) == (1, 1)
     dm = np.sqrt(5.0)  # S to M along their edge
     ref = np.array([np.sqrt(10.0), dm, dm + 1, 0.0, dm + 1, dm + np.sqrt(4.5), dm + 1])
+    m = meshfmm.Mesh(V, F)
+    assert (m.info.n_nonmanifold_edges, m.info.n_degenerate_faces) == (1, 1)
+    resolved = meshfmm.Mesh(V, [[A, S, M], [A, M, C], [M, B, C], [A, C, E], [A, D, M],
+                                [M, D, B]])
+    for s in range(len(V)):
+        for exact_start in (True, False):
+            np.testing.assert_array_equal(m.distance(s, exact_start=exact_start),
+                                          resolved.distance(s, exact_start=exact_start))
     np.testing.assert_allclose(m.distance(S, method="exact"), ref, rtol=1e-12, atol=1e-14)
-    np.testing.assert_allclose(m.distance(S), ref, rtol=1e-12, atol=1e-14)  # all in the exact start
+    path = m.geodesic_path(m.distance(S), E)
+    assert path.length == pytest.approx(ref[E], rel=1e-12)
+
+    copied = meshfmm.Mesh(V, np.concatenate([F, F[-1:]]))
+    assert copied.info.n_duplicate_faces == 1
+    np.testing.assert_allclose(copied.distance(S, method="exact"), ref, rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(copied.distance(S), ref, rtol=1e-12, atol=1e-14)  # exact start
 
 
 def test_t_junctions_are_closed_for_the_march():

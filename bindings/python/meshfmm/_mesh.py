@@ -320,8 +320,9 @@ class Mesh:
     vertices, non-manifold edges and degenerate faces are accepted; copies of
     a face (its vertices again, in any order) are counted in ``info`` and
     stand aside, so that they make no edge non-manifold. A T-junction closed
-    by a zero-area needle face is closed inside (the face across the needle
-    split at its middle vertex), so distances and paths cross it; face ids,
+    by a zero-area needle face is closed inside (the faces across the needle,
+    every page of a non-manifold edge, split at its middle vertex), so
+    distances and paths cross it; face ids,
     per-face costs and points stay the ones given (README, "Imperfect
     meshes").
 
