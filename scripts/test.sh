@@ -8,7 +8,8 @@
 # clone's library. The clone's builds are the only builds (no duplicate in
 # place). Outside a git checkout it runs in place.
 # Last, a short run of every libFuzzer harness (tests/fuzz; a crash fails
-# the run).
+# the run; a fixed seed, so that a red run is reproduced by running it again:
+# tests/fuzz/run.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 repo=$PWD
