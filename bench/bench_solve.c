@@ -10,6 +10,12 @@
  * Usage:
  *   bench_solve [--repeats R] [--sources S] [--exact-start R] MESH...
  * The march starts plain (the paper's start) unless --exact-start R > 0.
+ * Each repeat runs every source in turn, as the rows of a job alternate.
+ * One source repeated back to back (before session 29) ran small meshes
+ * faster than any job sees them: hand 0.029 ms (Dijkstra 0.017) against
+ * 0.050 (0.028) in turn, spot 0.175 against 0.199, camelhead equal (likely
+ * the branch predictor learning the repeated march: hand's arrays fit in L2
+ * either way). From Python over alternating sources: 0.053 ms.
  * With no MESH, the larger meshes of tests/data/meshes and generated spheres. */
 #include <math.h>
 #include <stdio.h>
@@ -151,14 +157,13 @@ static double time_runs(const mfmm_mesh *mesh, int repeats, int n_sources, timed
     double med = NAN;
     if (bench_state_alloc(&s, (size_t)mesh->nv)) {
         int k = 0;
-        for (int q = 0; q < n_sources; q++) {
-            int32_t v = mesh->to_internal[((int64_t)mesh->nv * (2 * q + 1)) / (2 * n_sources)];
-            for (int r = 0; r < repeats; r++) {
+        for (int r = 0; r < repeats; r++)
+            for (int q = 0; q < n_sources; q++) {
+                int32_t v = mesh->to_internal[((int64_t)mesh->nv * (2 * q + 1)) / (2 * n_sources)];
                 double t1 = now();
                 run(ctx, &s, v);
                 times[k++] = now() - t1;
             }
-        }
         qsort(times, (size_t)k, sizeof *times, cmp_double);
         med = times[k / 2];
         *min_out = times[0];
@@ -227,18 +232,16 @@ static void bench(const char *name, const double *V, int32_t nv, const int32_t *
         opt.exact_start_radius = exact_start; /* 0: the march alone, as the ceiling */
         int k = 0;
         int32_t settled = 0;
-        for (int s = 0; s < n_sources; s++) {
-            int32_t v = (int32_t)(((int64_t)nv * (2 * s + 1)) / (2 * n_sources));
-            mfmm_source src = {v, -1, {0, 0, 0}, 0.0};
-            for (int r = 0; r < repeats; r++) {
+        for (int r = 0; r < repeats; r++)
+            for (int s = 0; s < n_sources; s++) {
+                int32_t v = (int32_t)(((int64_t)nv * (2 * s + 1)) / (2 * n_sources));
+                mfmm_source src = {v, -1, {0, 0, 0}, 0.0};
                 double t1 = now();
                 mfmm_solve(solver, &src, 1, &opt, d, NULL);
                 times[k++] = now() - t1;
             }
-            settled = 0;
-            for (int32_t i = 0; i < nv; i++)
-                settled += isfinite(d[i]) != 0;
-        }
+        for (int32_t i = 0; i < nv; i++)
+            settled += isfinite(d[i]) != 0;
         qsort(times, (size_t)k, sizeof *times, cmp_double);
         double med = times[k / 2];
         double min = times[0], ceil_min = NAN;
