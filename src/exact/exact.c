@@ -67,7 +67,10 @@
  * ends are pseudo-sources; copies of a face are no part of the surface
  * (skip 2); a zero-area face (skip 1, its corners on one line) is passed
  * through along that line (ex_pass), its edges relax their ends, and a
- * vertex on its longest edge starts windows across that edge. max_distance
+ * vertex on its longest edge starts windows across that edge. An edge
+ * almost a point next to the faces at its ends (a vertex split in two 1e-15
+ * apart) is a wall whose ends start windows all around: no frame can be
+ * unfolded onto it (ex_wall_short_edges). max_distance
  * (and the radius of mfmm_exact_patch) drops every window and event beyond
  * it, so the work grows with the area reached.
  *
@@ -110,6 +113,12 @@
 /* a vertex this near (in edge lengths) to the pseudo-source of the path
  * that reached it starts windows all around (ex_set_in) */
 #define EX_NEAR 1e-3
+/* a vertex this close (in edge lengths) outside a window's rays is
+ * reached over the window's end (ex_propagate) */
+#define EX_GRAZE 1e-6
+/* an edge shorter than this times the longest edge of a face at its ends
+ * is a wall (ex_wall_short_edges) */
+#define EX_SHORT_EDGE 1e-6
 /* zero-area faces one window may pass through in a row (ex_pass) */
 #define EX_MAX_PASS 8
 /* a vertex whose angle sum exceeds 2 pi by this much is a saddle */
@@ -398,6 +407,42 @@ static int ex_link_nonmanifold(mfmm_exact_tables *t)
     return 0;
 }
 
+/* Makes every edge shorter than EX_SHORT_EDGE times the longest edge of a
+ * face at either end a wall, its ends pseudo-sources that start windows all
+ * around (their fans are then open: ex_build_fans). A window crossing a face
+ * goes on in the frame of the edge it leaves, whose direction comes from
+ * the corners' positions in the face's frame, exact to rounding of the
+ * face's longest edge: for an edge 2e-15 long in a face 0.06 long that is a
+ * turn of a few per cent, and distances below the straight line beyond it.
+ * A path through the short edge is then one through an end of it, longer by
+ * at most twice its length. */
+static void ex_wall_short_edges(mfmm_exact_tables *t)
+{
+    double *reach = t->height; /* scratch (nv), filled later */
+    for (int32_t v = 0; v < t->nv; v++) {
+        double m = 0.0;
+        for (int32_t i = t->vf_offset[v]; i < t->vf_offset[v + 1]; i++) {
+            const ex_face *r = t->fr + ex_corner(t->vf_corner, t->face_in, i) / 3;
+            m = fmax(m, fmax(r->len[0], fmax(r->len[1], r->len[2])));
+        }
+        reach[v] = m;
+    }
+    for (int32_t f = 0; f < t->nf; f++) {
+        ex_face *r = t->fr + f;
+        if (r->skip == 2)
+            continue;
+        for (int k = 0; k < 3; k++) {
+            int32_t a = r->v[ex_next[k]], b = r->v[ex_prev[k]];
+            if (r->len[k] >= EX_SHORT_EDGE * fmax(reach[a], reach[b]))
+                continue;
+            r->across[k] = -1;
+            r->flip[k] = 0;
+            t->pseudo[a] = 1;
+            t->pseudo[b] = 1;
+        }
+    }
+}
+
 /* Walks the fan of every vertex through the faces across its edges, giving
  * each corner its angles (fan_a0, fan_sgn) and each vertex its angle sum;
  * NaN for vertices whose corners do not form one closed disk. */
@@ -474,6 +519,37 @@ size_t mfmm_exact_ws_bytes(const mfmm_mesh *mesh)
 {
     return sizeof(mfmm_exact_ws) + (size_t)mesh->nv * (4 * sizeof(double) + sizeof(int32_t) + 1) +
            3 * EX_NB * sizeof(int32_t);
+}
+
+/* A zero-area face's corners on one line (ex_pass): positions along its
+ * longest edge, so that no corner lands on the others through the frame of
+ * a short edge (a needle 2e-15 wide put its far corner on the near ones, a
+ * path of length 0 across it). In the frame of edge k (corner k+1 at 0,
+ * facing corner k+2), corner k is at cx[k]. */
+static void ex_lay_on_line(const double *X, ex_face *r)
+{
+    int m = 0;
+    for (int k = 1; k < 3; k++)
+        if (r->len[k] > r->len[m])
+            m = k;
+    double L = r->len[m];
+    if (!(L > 0.0) || !isfinite(L)) {
+        /* all corners at one point: nothing passes through (ex_pass) */
+        for (int k = 0; k < 3; k++)
+            r->cx[k] = NAN;
+        return;
+    }
+    const double *a = X + 3 * (size_t)r->v[ex_next[m]], *b = X + 3 * (size_t)r->v[ex_prev[m]];
+    double u[3] = {(b[0] - a[0]) / L, (b[1] - a[1]) / L, (b[2] - a[2]) / L}, t[3];
+    for (int j = 0; j < 3; j++) {
+        const double *c = X + 3 * (size_t)r->v[j];
+        t[j] = (c[0] - a[0]) * u[0] + (c[1] - a[1]) * u[1] + (c[2] - a[2]) * u[2];
+    }
+    for (int k = 0; k < 3; k++) {
+        double t1 = t[ex_next[k]], t2 = t[ex_prev[k]];
+        r->cx[k] = (t[k] - t1) * (t2 >= t1 ? 1.0 : -1.0);
+        r->cy[k] = 0.0;
+    }
 }
 
 mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **out)
@@ -559,6 +635,8 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
             if (!(L > 0.0) || !(y > 0.0) || !isfinite(x) || !isfinite(y))
                 bad = 1;
         }
+        if (bad)
+            ex_lay_on_line(X, r);
         r->skip = (uint8_t)(bad ? 1 : mfmm_mesh_copy(mesh, (int32_t)f) ? 2 : 0);
     }
     for (size_t f = 0; f < nf; f++) {
@@ -612,6 +690,7 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
         mfmm_exact_tables_destroy(t);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
+    ex_wall_short_edges(t);
     double sum_len = 0.0;
     size_t n_len = 0;
     for (size_t hh = 0; hh < nh; hh++) {
@@ -1406,6 +1485,15 @@ static void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
             double cr = cx * ey - cy * ex, dt = cx * ex + cy * ey;
             ex_set_in(ws, vc, h, atan2(fabs(cr), dt), rc, L);
         }
+    } else if (tc >= b0 - EX_GRAZE * L && tc <= b1 + EX_GRAZE * L) {
+        /* C just outside the window: the rays to it may have been in a
+         * window dropped as too narrow, or missed by rounding (a flat mesh
+         * whose straight paths graze vertices was left 3x too long). The path
+         * over the window's nearer end is a real one, within rounding of the
+         * straight one. */
+        double e = tc < b0 ? b0 : b1;
+        double ie = sqrt((e - px) * (e - px) + py * py), ec = sqrt((cx - e) * (cx - e) + cy * cy);
+        ex_update(ws, vc, sigma + ie + ec, 0);
     }
     int m1 = ex_next[m], m2 = ex_prev[m];
     if (b0 < tc) {
