@@ -321,6 +321,22 @@ MFMM_API mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources,
                                 int32_t n_sources, const mfmm_solve_options *options,
                                 double *distances, mfmm_error *err);
 
+/* What the last mfmm_solve on a solver did. */
+typedef struct mfmm_solve_info {
+    size_t struct_size;      /* set by the caller: sizeof(mfmm_solve_info); the library
+                                writes no more than this many bytes */
+    int64_t start_fallbacks; /* vertices of the exact start whose exact distance failed
+                                a bound every distance meets (at least the straight-line
+                                distance from the source, at most the shortest edge path
+                                to it) and which the march computed instead; 0 unless the
+                                exact solver erred on a degenerate mesh */
+} mfmm_solve_info;
+
+/* Fills info about the solver's last mfmm_solve (zeros before the first).
+ * MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_ARGUMENT when info->struct_size is
+ * smaller than a size_t. Not safe while the solver solves in another thread. */
+MFMM_API mfmm_status mfmm_solver_get_info(const mfmm_solver *solver, mfmm_solve_info *info);
+
 /* ----------------------------------------------------------------- exact */
 
 /* Exact polyhedral geodesic distance (F = 1): the length of the shortest
@@ -615,6 +631,8 @@ typedef struct mfmm_matrix_options {
      * every backend (OpenCL: computed on the host, uploaded with the batch).
      * Default MFMM_EXACT_START_AUTO; 0: the plain start */
     double exact_start_radius;
+    int64_t start_fallbacks;         /* out: over all rows, on every backend, as
+                                        mfmm_solve_info.start_fallbacks */
 } mfmm_matrix_options;
 
 MFMM_API void mfmm_matrix_options_init(mfmm_matrix_options *options);

@@ -116,6 +116,9 @@
 /* a vertex this close (in edge lengths) outside a window's rays is
  * reached over the window's end (ex_propagate) */
 #define EX_GRAZE 1e-6
+/* a patch distance outside its bounds by more than this times (the
+ * distance + a mean edge) is a defect (mfmm_exact_patch_check) */
+#define EX_PATCH_TOL 1e-9
 /* an edge shorter than this times the longest edge of a face at its ends
  * is a wall (ex_wall_short_edges) */
 #define EX_SHORT_EDGE 1e-6
@@ -1889,6 +1892,84 @@ mfmm_status mfmm_exact_patch(mfmm_exact_ws *ws, const mfmm_source *sources, int3
         }
     }
     *n_vertices = n;
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_exact_patch_check(mfmm_exact_ws *ws, const mfmm_source *src, int32_t *n_vertices,
+                                   int32_t *n_rejected)
+{
+    if (!ws || !src || !n_vertices || !n_rejected)
+        return MFMM_ERR_NULL_POINTER;
+    *n_rejected = 0;
+    int32_t n = *n_vertices;
+    if (n <= 0)
+        return MFMM_OK;
+    const double *X = ws->mesh->xyz;
+    /* the source's point, and the real paths that start the edge paths:
+     * to the vertex itself, or straight to its face's corners */
+    double p[3];
+    double *up = ws->emitted; /* edge-path lengths (ex_reset clears them) */
+    for (int32_t i = 0; i < n; i++)
+        up[ws->touched[i]] = INFINITY;
+    if (src->face < 0) {
+        memcpy(p, X + 3 * (size_t)src->vertex, sizeof p);
+        if (ws->in_patch[src->vertex])
+            up[src->vertex] = src->value;
+    } else {
+        const int32_t *fv = ws->mesh->face_records[src->face].v;
+        double w[3], sum = 0.0;
+        for (int k = 0; k < 3; k++) {
+            w[k] = src->bary[k] > 0.0 ? src->bary[k] : 0.0;
+            sum += w[k];
+        }
+        for (int e = 0; e < 3; e++)
+            p[e] = (w[0] * X[3 * (size_t)fv[0] + e] + w[1] * X[3 * (size_t)fv[1] + e] +
+                    w[2] * X[3 * (size_t)fv[2] + e]) / sum;
+        for (int k = 0; k < 3; k++)
+            if (ws->in_patch[fv[k]])
+                up[fv[k]] = fmin(up[fv[k]], src->value + vdist(p, X + 3 * (size_t)fv[k]));
+    }
+    /* edge paths through the patch, each the length of a real path: two
+     * sweeps in the order the propagation reached the vertices, about the
+     * order of their distances (a Dijkstra's sort cost as much as the rest
+     * of the check, for bounds that only need to be real) */
+    for (int sweep = 0; sweep < 2; sweep++) {
+        for (int32_t i = 0; i < n; i++) {
+            int32_t v = ws->touched[i];
+            double uv = up[v];
+            if (uv == INFINITY)
+                continue;
+            for (int32_t j = ws->vf_offset[v]; j < ws->vf_offset[v + 1]; j++) {
+                int32_t c = ex_corner(ws->vf_corner, ws->face_in, j);
+                const ex_face *r = ws->fr + c / 3;
+                int k = c % 3;
+                int32_t a = r->v[ex_next[k]], b = r->v[ex_prev[k]];
+                if (ws->in_patch[a])
+                    up[a] = fmin(up[a], uv + r->len[ex_prev[k]]);
+                if (ws->in_patch[b])
+                    up[b] = fmin(up[b], uv + r->len[ex_next[k]]);
+            }
+        }
+    }
+    /* keep, in their order, the vertices within both bounds (to rounding
+     * relative to the distance, or to an edge next to the source) */
+    double edge = ws->mesh->info.mean_edge_length;
+    int32_t kept = 0;
+    for (int32_t i = 0; i < n; i++) {
+        int32_t v = ws->touched[i];
+        double d = ws->patch_d[i];
+        double lo = src->value + vdist(p, X + 3 * (size_t)v), hi = up[v];
+        double tol = EX_PATCH_TOL * (fmax(fabs(d), fabs(lo)) + edge);
+        if (d >= lo - tol && (hi == INFINITY || d <= hi + tol)) {
+            ws->touched[i] = ws->touched[kept];
+            ws->touched[kept] = v;
+            ws->patch_d[kept++] = d;
+        } else {
+            ws->in_patch[v] = 0;
+        }
+    }
+    *n_rejected = n - kept;
+    *n_vertices = kept;
     return MFMM_OK;
 }
 

@@ -59,6 +59,19 @@ mfmm_status mfmm_exact_patch(mfmm_exact_ws *ws, const mfmm_source *sources, int3
                              const int32_t **vertices, const double **distances,
                              mfmm_exact_info *info);
 
+/* Checks the patch of ws's last mfmm_exact_patch from the one source src
+ * against two bounds that any correct distance meets: at least the
+ * straight-line distance from the source's point, at most the shortest edge
+ * path to the vertex through the patch (both lengths of real paths, to
+ * 1e-9 of the distance plus a mean edge length). A vertex outside them is a defect of the exact solver: it
+ * leaves the patch, so that the march computes it instead.
+ *   n_vertices: in, the patch's size; out, the vertices kept, first in the
+ *   arrays of mfmm_exact_patch and in their order.
+ *   n_rejected: receives the number of vertices taken out.
+ * MFMM_ERR_OUT_OF_MEMORY when its scratch (the patch's size) cannot grow. */
+mfmm_status mfmm_exact_patch_check(mfmm_exact_ws *ws, const mfmm_source *src, int32_t *n_vertices,
+                                   int32_t *n_rejected);
+
 /* Whether vertex v is in the patch of ws's last mfmm_exact_patch. */
 int mfmm_exact_in_patch(const mfmm_exact_ws *ws, int32_t v);
 

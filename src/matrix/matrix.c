@@ -223,6 +223,7 @@ static mfmm_status run_serial(const mfmm_rows_job *job, int32_t start, mfmm_erro
                 goto done;
             }
             settled += k;
+            job->opt->start_fallbacks += mfmm_solver_start_fallbacks(solver);
         }
         job->opt->vertices_settled = settled;
         mfmm_status bst;
@@ -253,6 +254,7 @@ typedef struct pool {
     mfmm_error fail_err;
     char *ring;               /* 2 blocks, or NULL when writing into out */
     int64_t settled;          /* vertices settled so far */
+    int64_t fallbacks;        /* exact-start vertices the marches computed instead */
 } pool;
 
 static int32_t block_len(const pool *p, int32_t b)
@@ -315,6 +317,7 @@ static void *pool_worker(void *arg)
             break;
         }
         p->settled += k;
+        p->fallbacks += mfmm_solver_start_fallbacks(solver);
         if (++p->done[b & 1] == block_len(p, b))
             pthread_cond_broadcast(&p->cv_main);
     }
@@ -419,6 +422,7 @@ static mfmm_status run_threads(const mfmm_rows_job *job, int32_t start, mfmm_err
     for (int i = 0; i < started; i++)
         pthread_join(tid[i], NULL);
     job->opt->vertices_settled = p.settled;
+    job->opt->start_fallbacks += p.fallbacks;
     if (p.ring && job->sparse) /* rows of blocks not delivered (a failure) */
         mfmm_sparse_rows_free((mfmm_sparse_row *)(void *)p.ring, 2 * p.block);
     if (st == MFMM_OK && p.fail != MFMM_OK) {
@@ -452,6 +456,7 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     o->fallback_reason[0] = '\0';
     int32_t nv = mesh->nv;
     o->vertices_settled = 0;
+    o->start_fallbacks = 0;
     if (!o->out && !o->on_rows && !o->on_sparse)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
                          "options give neither an out buffer nor an on_rows or on_sparse callback");

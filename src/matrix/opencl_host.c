@@ -763,6 +763,7 @@ typedef struct seed_buf {
     int32_t *idx;
     double *val;
     size_t cap, n;
+    int64_t fallbacks; /* patch vertices left to the march (mfmm_exact_start) */
 } seed_buf;
 
 static int seed_room(seed_buf *b, size_t need)
@@ -804,11 +805,14 @@ static mfmm_status batch_seeds(const mfmm_rows_job *job, mfmm_exact_ws **ws,
         const int32_t *pv = NULL;
         const double *pd = NULL;
         double f = 1.0;
+        int32_t n_fallback = 0;
         mfmm_status st = mfmm_exact_start(job->mesh, ws, &src, job->opt->exact_start_radius,
                                           job->opt->max_distance, job->cost,
-                                          job->cost ? uniform : NULL, &n, &pv, &pd, &f);
+                                          job->cost ? uniform : NULL, &n, &pv, &pd, &f,
+                                          &n_fallback);
         if (st != MFMM_OK)
             return st;
+        b->fallbacks += n_fallback;
         b->idx[i] = (int32_t)pos;
         if (seed_room(b, pos + (size_t)(n > 0 ? n : 1)))
             return MFMM_ERR_OUT_OF_MEMORY;
@@ -1147,6 +1151,7 @@ done:
             api->clReleaseMemObject(mem[i]);
     free(host);
     free(uniform);
+    job->opt->start_fallbacks += sb.fallbacks;
     free(sb.idx);
     free(sb.val);
     mfmm_exact_ws_destroy(ews);

@@ -44,9 +44,11 @@ static double reach_around(const mfmm_mesh *m, int32_t v, const double *p)
 static mfmm_status exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const mfmm_source *src,
                                double radius, double max_d, const double *cost,
                                const double *uniform, int32_t *n, const int32_t **vertices,
-                               const double **distances, double *F, double *patch_radius)
+                               const double **distances, double *F, double *patch_radius,
+                               int32_t *n_fallback)
 {
     *n = 0;
+    *n_fallback = 0;
     *patch_radius = 0.0;
     *F = 1.0;
     radius = mfmm_exact_start_edges(mesh, radius, max_d);
@@ -81,7 +83,7 @@ static mfmm_status exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const 
             s.bary[1] = b[1];
             s.bary[2] = b[2];
             return exact_start(mesh, ws, &s, radius, max_d, cost, uniform, n, vertices,
-                               distances, F, patch_radius);
+                               distances, F, patch_radius, n_fallback);
         } else {
             /* its own faces' corners (both faces of an edge it lies on) */
             for (int k = 0; k < 3; k++)
@@ -118,6 +120,10 @@ static mfmm_status exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const 
         return MFMM_ERR_OUT_OF_MEMORY;
     if (st != MFMM_OK) /* a face the exact solver skips: straight start */
         return MFMM_OK;
+    /* a distance the exact solver got wrong is left to the march */
+    st = mfmm_exact_patch_check(*ws, &s, &np, n_fallback);
+    if (st != MFMM_OK)
+        return st;
     if (cost)
         for (int32_t i = 0; i < np; i++)
             if (uniform[pv[i]] != f)
@@ -133,11 +139,11 @@ static mfmm_status exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const 
 mfmm_status mfmm_exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const mfmm_source *src,
                              double radius, double max_distance, const double *cost,
                              const double *uniform, int32_t *n, const int32_t **vertices,
-                             const double **distances, double *F)
+                             const double **distances, double *F, int32_t *n_fallback)
 {
     double R;
     return exact_start(mesh, ws, src, radius, max_distance - src->value, cost, uniform, n,
-                       vertices, distances, F, &R);
+                       vertices, distances, F, &R, n_fallback);
 }
 
 typedef struct beyond_ctx {
@@ -160,14 +166,15 @@ static int seed_beyond(void *user, const mfmm_start_hit *h)
 
 mfmm_status mfmm_exact_start_seed(const mfmm_mesh *mesh, mfmm_exact_ws **ws,
                                   mfmm_march_state *st, const mfmm_source *src, double radius,
-                                  const double *uniform, int fixed)
+                                  const double *uniform, int fixed, int32_t *n_fallback)
 {
     int32_t n = 0;
     const int32_t *pv = NULL;
     const double *pd = NULL;
     double f = 1.0, R = 0.0;
     mfmm_status status = exact_start(mesh, ws, src, radius, st->max_distance - src->value,
-                                     st->cost, st->cost ? uniform : NULL, &n, &pv, &pd, &f, &R);
+                                     st->cost, st->cost ? uniform : NULL, &n, &pv, &pd, &f, &R,
+                                     n_fallback);
     if (status != MFMM_OK)
         return status;
     if (n == 0) {

@@ -37,21 +37,25 @@ double mfmm_exact_start_edges(const mfmm_mesh *mesh, double radius, double max_d
  * (the caller frees it with mfmm_exact_ws_destroy).
  *   n, vertices, distances: the patch (arrays of *ws, valid until its next
  *   use); F: the cost there (1 without a cost).
+ *   n_fallback: receives the number of patch vertices whose exact distance
+ *   failed its bounds (mfmm_exact_patch_check) and which the march computes
+ *   instead; 0 unless the exact solver erred.
  * MFMM_ERR_OUT_OF_MEMORY when the workspace or its queue cannot grow. */
 mfmm_status mfmm_exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const mfmm_source *src,
                              double radius, double max_distance, const double *cost,
                              const double *uniform, int32_t *n, const int32_t **vertices,
-                             const double **distances, double *F);
+                             const double **distances, double *F, int32_t *n_fallback);
 
 /* Seeds one checked source into a reset march state (cost fields set): its
  * exact start (mfmm_exact_start, uniform as there) where that applies, at
  * value + F * d, final where `fixed` (one source: the march never lowers
  * them); for a point, also the straight start's vertices (core/start.h)
  * beyond the patch, which the march may lower. Elsewhere the straight
- * start alone. MFMM_ERR_OUT_OF_MEMORY as mfmm_exact_start. */
+ * start alone. n_fallback as for mfmm_exact_start. MFMM_ERR_OUT_OF_MEMORY as
+ * mfmm_exact_start. */
 mfmm_status mfmm_exact_start_seed(const mfmm_mesh *mesh, mfmm_exact_ws **ws,
                                   mfmm_march_state *st, const mfmm_source *src, double radius,
-                                  const double *uniform, int fixed);
+                                  const double *uniform, int fixed, int32_t *n_fallback);
 
 /* Bytes the exact start takes per thread (a workspace's state; the queue
  * of a patch is small), for memory budgets; the read-only tables (exact.h)

@@ -26,6 +26,7 @@ struct mfmm_solver {
     const double *fixed_cost;
     int fixed_location;
     mfmm_exact_ws *exact; /* the exact start's workspace, made on first use */
+    int64_t start_fallbacks; /* the last solve's (mfmm_solve_info) */
     mfmm_mapped_args args; /* mfmm_solve's arguments in internal order (order.h) */
     /* the mesh's spokes (mfmm_mesh_spokes_of), asked for by the first march
      * at F = 1 with unfolding; NULL then only if out of memory (the face
@@ -180,8 +181,32 @@ void mfmm_solver_fix_cost(mfmm_solver *solver, const double *cost, int cost_loca
 static int seed_source(mfmm_solver *solver, mfmm_march_state *s, const mfmm_source *src,
                        double radius, int fixed)
 {
-    return mfmm_exact_start_seed(solver->mesh, &solver->exact, s, src, radius, solver->uniform,
-                                 fixed) == MFMM_OK ? 0 : -1;
+    int32_t n_fallback = 0;
+    mfmm_status st = mfmm_exact_start_seed(solver->mesh, &solver->exact, s, src, radius,
+                                           solver->uniform, fixed, &n_fallback);
+    solver->start_fallbacks += n_fallback;
+    return st == MFMM_OK ? 0 : -1;
+}
+
+int64_t mfmm_solver_start_fallbacks(const mfmm_solver *solver)
+{
+    return solver->start_fallbacks;
+}
+
+mfmm_status mfmm_solver_get_info(const mfmm_solver *solver, mfmm_solve_info *info)
+{
+    if (!solver || !info)
+        return MFMM_ERR_NULL_POINTER;
+    size_t size;
+    memcpy(&size, info, sizeof size);
+    if (size < sizeof size)
+        return MFMM_ERR_BAD_ARGUMENT;
+    mfmm_solve_info all;
+    memset(&all, 0, sizeof all);
+    all.struct_size = size < sizeof all ? size : sizeof all;
+    all.start_fallbacks = solver->start_fallbacks;
+    memcpy(info, &all, all.struct_size);
+    return MFMM_OK;
 }
 
 /* One march into T (the caller's +inf-filled row, or the solver's own T);
@@ -195,6 +220,7 @@ static int32_t solver_march(mfmm_solver *solver, const mfmm_source *sources, int
     if (!opt.cost)
         opt.cost_location = MFMM_COST_NONE;
     solver_reset_pending(solver);
+    solver->start_fallbacks = 0;
     mfmm_march_state s;
     memset(&s, 0, sizeof s);
     s.T = T;

@@ -239,6 +239,10 @@ static void test_never_worse(void **state)
             double plain = tm_mean_rel_error(d, e, nv);
             solve_r(solver, &src, MFMM_EXACT_START_RADIUS, d);
             double ex = tm_mean_rel_error(d, e, nv);
+            /* every patch value met its bounds (mfmm_exact_patch_check) */
+            mfmm_solve_info si = {sizeof si, -1};
+            assert_int_equal(mfmm_solver_get_info(solver, &si), MFMM_OK);
+            assert_int_equal(si.start_fallbacks, 0);
             free(e);
             assert_true(ex <= plain);
             if (k == 3) {
@@ -542,6 +546,68 @@ static void test_auto_radius(void **state)
 }
 
 /* Bad radii are refused, by mfmm_solve and mfmm_distance_matrix. */
+/* A patch value below the straight-line distance or above the shortest
+ * edge path leaves the patch (mfmm_exact_patch_check), and the others stay
+ * in their order; on a correct patch nothing leaves. */
+static void test_patch_check(void **state)
+{
+    (void)state;
+    int32_t nv = 0, nf = 0, *F = NULL;
+    mfmm_mesh_info info;
+    mfmm_exact_ws *ws = NULL;
+    mfmm_mesh *mesh = load_with_ws("meshes/spot.obj", &nv, &nf, &F, &info, &ws);
+    for (int face = 0; face < 2; face++) {
+        mfmm_source src = tm_vertex_source(mfmm_vertex_in(mesh, F[3 * (nf / 3) + 1]));
+        if (face) { /* internal ids, as the patch API takes */
+            src.face = nf / 5;
+            src.bary[0] = 0.25;
+            src.bary[1] = 0.25;
+            src.bary[2] = 0.5;
+        }
+        double R = MFMM_EXACT_START_RADIUS * info.mean_edge_length;
+        int32_t n = 0, n_bad = -1;
+        const int32_t *pv = NULL;
+        const double *pd = NULL;
+        assert_int_equal(mfmm_exact_patch(ws, &src, 1, R, 0, &n, &pv, &pd, NULL), MFMM_OK);
+        int32_t n0 = n;
+        assert_int_equal(mfmm_exact_patch_check(ws, &src, &n, &n_bad), MFMM_OK);
+        assert_int_equal(n_bad, 0);
+        assert_int_equal(n, n0);
+        /* two defects: the farthest patch vertex at half its distance (below
+         * the straight line: the patch reaches a few edges), one at 5 times
+         * (above any edge path), as a broken solver would leave them */
+        int32_t far = 0, mid = n / 2;
+        for (int32_t i = 0; i < n; i++)
+            far = pd[i] > pd[far] ? i : far;
+        if (mid == far)
+            mid = (mid + 1) % n;
+        int32_t v_far = pv[far], v_mid = pv[mid];
+        double *w = (double *)(uintptr_t)pd; /* the workspace's own array */
+        w[far] *= 0.5;
+        w[mid] = 5.0 * w[mid] + info.mean_edge_length;
+        int32_t *order = malloc((size_t)n * sizeof *order);
+        assert_non_null(order);
+        memcpy(order, pv, (size_t)n * sizeof *order);
+        assert_int_equal(mfmm_exact_patch_check(ws, &src, &n, &n_bad), MFMM_OK);
+        assert_int_equal(n_bad, 2);
+        assert_int_equal(n, n0 - 2);
+        assert_false(mfmm_exact_in_patch(ws, v_far));
+        assert_false(mfmm_exact_in_patch(ws, v_mid));
+        for (int32_t i = 0, j = 0; i < n0; i++) {
+            if (order[i] == v_far || order[i] == v_mid)
+                continue;
+            assert_int_equal(pv[j++], order[i]);
+        }
+        free(order);
+    }
+    int32_t n = 1, n_bad = 0;
+    mfmm_source src = tm_vertex_source(0);
+    assert_int_equal(mfmm_exact_patch_check(NULL, &src, &n, &n_bad), MFMM_ERR_NULL_POINTER);
+    mfmm_exact_ws_destroy(ws);
+    mfmm_mesh_destroy(mesh);
+    mfmm_free(F);
+}
+
 static void test_bad_radius(void **state)
 {
     (void)state;
@@ -575,6 +641,7 @@ int main(void)
         cmocka_unit_test(test_off_is_plain_start),
         cmocka_unit_test(test_saddle_corner_continuous),
         cmocka_unit_test(test_auto_radius),
+        cmocka_unit_test(test_patch_check),
         cmocka_unit_test(test_bad_radius),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

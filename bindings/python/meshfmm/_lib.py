@@ -255,6 +255,7 @@ class mfmm_matrix_options(Structure):
         ("vertices_settled", c_int64),  # out
         ("on_sparse", mfmm_sparse_callback),
         ("exact_start_radius", c_double),  # appended: as in mfmm_solve_options
+        ("start_fallbacks", c_int64),  # out
     ]
 
 
