@@ -464,3 +464,276 @@ def test_mesh_options_reach_the_workers_and_the_job(hand, client, tmp_path):
     Z = md.distance_matrix(lean, str(tmp_path / "lean.zarr"), sources=src, client=client,
                            dtype="float64", block_rows=8, progress=False)
     assert np.array_equal(Z[:], hand.distance_matrix(src, backend="serial", dtype="float64"))
+
+
+# ------------------------------------------------ one owner per store, bound chunks
+
+# the store's layout: the owner record in the attributes, the block digests
+# beside the chunk tree
+OWNER, SUMS = "meshfmm_owner", "meshfmm_blocks"
+
+
+def _owner(store):
+    return zarr.open_array(store, mode="r").attrs[OWNER]
+
+
+def _set_owner(store, **changes):
+    z = zarr.open_array(store, mode="r+")
+    z.attrs[OWNER] = dict(z.attrs.get(OWNER) or {}, **changes)
+
+
+def test_a_second_job_on_a_store_a_live_job_owns_is_refused(hand, serial64, client, tmp_path):
+    # two jobs on one store both exited 0, the store labelled with one job and
+    # holding rows of both; now the second is refused while the first runs
+    store = str(tmp_path / "own.zarr")
+    other = meshfmm.Mesh(hand.vertices * 1.5, hand.faces)
+    refused = []
+
+    def start_b(done, total):
+        if not refused:
+            with pytest.raises(RuntimeError, match="in use by another meshfmm job") as e:
+                md.distance_matrix(other, store, sources=SOURCES, client=client,
+                                   dtype="float64", resume=False, block_rows=8, progress=False)
+            refused.append(e.value)
+
+    Z = md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                           block_rows=8, progress=start_b)
+    assert refused and isinstance(refused[0], md.StoreOwnerError)
+    assert np.array_equal(Z[:], serial64)
+    assert Z.attrs[md.JOB_ATTR]["mesh_sha256"] == md.job_description(
+        hand, SOURCES, None, "float64", None, None, None, True)["mesh_sha256"]
+    assert _owner(store)["state"] == "finished"
+    Z = md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                           progress=False)
+    assert Z.attrs[md.RUN_ATTR]["blocks_computed"] == 0
+
+
+def test_a_run_whose_store_is_taken_over_writes_nothing_more(hand, serial64, client, tmp_path):
+    store = str(tmp_path / "taken.zarr")
+    Z = md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                           block_rows=8, progress=False)
+    # a task checks the owner token before it writes: with another run's
+    # token in the store it refuses and leaves the chunk alone
+    os.remove(os.path.join(store, "c", "2", "0"))
+    V, F = hand.vertices, hand.faces
+    with pytest.raises(RuntimeError, match="taken over") as e:
+        md._compute_block("k", V, F, store, None, 16, 24, SOURCES, None,
+                          {"backend": "serial", "dtype": "float64", "n_threads": 1,
+                           "max_distance": None, "unfolding": True, "cost": None,
+                           "cost_location": None}, 2, "not-the-owner", "job")
+    assert isinstance(e.value, md.StoreOwnerError)
+    assert not os.path.exists(os.path.join(store, "c", "2", "0"))
+
+    # another run (on another host) takes the store over while this one runs:
+    # this one fails and leaves the other's record in place
+    def take_over(done, total):
+        if _owner(store)["token"] != "elsewhere":
+            _set_owner(store, token="elsewhere", host="another-host", pid=1,
+                       state="running", heartbeat=time.time())
+
+    with pytest.raises(md.StoreOwnerError, match="taken over"):
+        md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                           resume=False, block_rows=8, progress=take_over)
+    assert _owner(store)["token"] == "elsewhere"
+    # that run is alive (a heartbeat within the lease): the store is refused
+    with pytest.raises(md.StoreOwnerError, match="in use"):
+        md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                           progress=False)
+    # its heartbeat stopped over a minute ago: a killed run, taken over
+    _set_owner(store, heartbeat=time.time() - 2 * md._LEASE_S)
+    Z = md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                           progress=False)
+    assert np.array_equal(Z[:], serial64)
+    assert _owner(store)["state"] == "finished"
+
+
+def test_the_owner_heartbeat_advances_while_a_job_runs(hand, client, tmp_path, monkeypatch):
+    # a run on another host is taken for dead after _LEASE_S without a
+    # heartbeat: a live one beats every _HEARTBEAT_S (shortened here)
+    monkeypatch.setattr(md, "_HEARTBEAT_S", 0.05)
+    store = str(tmp_path / "hb.zarr")
+    beats = []
+
+    def watch(done, total):
+        if not beats:
+            t0 = _owner(store)["heartbeat"]
+            deadline = time.monotonic() + 5
+            while _owner(store)["heartbeat"] == t0 and time.monotonic() < deadline:
+                time.sleep(0.02)
+            beats.append(_owner(store)["heartbeat"] - t0)
+
+    md.distance_matrix(hand, store, sources=SOURCES[:24], client=client, block_rows=8,
+                       progress=watch)
+    assert beats and beats[0] > 0
+    assert _owner(store)["state"] == "finished"
+
+
+def test_a_killed_jobs_token_does_not_block_its_resume(hand, serial64, client, tmp_path,
+                                                       capsys):
+    store = str(tmp_path / "stale.zarr")
+    md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                       block_rows=8, progress=False)
+    for b in (1, 6):
+        os.remove(os.path.join(store, "c", str(b), "0"))
+    # a run on this host whose process is alive owns the store: refused, and
+    # the command line says so in one line
+    src = tmp_path / "s.txt"
+    np.savetxt(src, SOURCES, fmt="%d")
+    p = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(120)"])
+    try:
+        _set_owner(store, token="live", pid=p.pid, pid_started=None, state="running")
+        with pytest.raises(RuntimeError, match="in use") as e:
+            md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                               progress=False)
+        assert isinstance(e.value, md.StoreOwnerError)
+        capsys.readouterr()
+        rc = md.cli_allpairs_zarr([str(MESHES / "hand_lowres.obj"), "-o", store, "--sources",
+                                   str(src), "--dtype", "float64", "--workers", "1",
+                                   "--resume", "--no-progress"])
+        err = capsys.readouterr().err
+        assert rc == 2 and "in use" in err and len(err.strip().splitlines()) == 1
+        assert _owner(store)["token"] == "live"
+    finally:
+        p.kill()
+        p.wait()
+    # its process was killed without releasing the store: the same job
+    # resumes at once
+    assert _owner(store)["state"] == "running"
+    Z = md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                           progress=False)
+    assert Z.attrs[md.RUN_ATTR]["blocks_computed"] == 2
+    assert np.array_equal(Z[:], serial64)
+    # nor does a run of this process that did not release it
+    for b in (1, 6):
+        os.remove(os.path.join(store, "c", str(b), "0"))
+    _set_owner(store, token="left-behind", pid=os.getpid(), state="running")
+    Z = md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                           progress=False)
+    assert Z.attrs[md.RUN_ATTR]["blocks_computed"] == 2
+    assert np.array_equal(Z[:], serial64)
+
+
+def _copy_block(src_store, b_from, dst_store, b_to):
+    """A chunk and, where there is one, its digest, copied as bytes."""
+    for sub in (("c", "{}", "0"), (SUMS, "{}")):
+        a = os.path.join(src_store, *sub).format(b_from)
+        if os.path.exists(a):
+            data = open(a, "rb").read()
+            open(os.path.join(dst_store, *sub).format(b_to), "wb").write(data)
+
+
+def test_a_chunk_from_another_block_or_job_is_recomputed(hand, serial64, client, tmp_path):
+    # a chunk's CRC-32C covered only its bytes: a chunk copied from another
+    # block or another job's store passed, and resume kept the wrong rows
+    store = str(tmp_path / "a.zarr")
+    md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                       block_rows=8, progress=False)
+    other = str(tmp_path / "b.zarr")
+    md.distance_matrix(meshfmm.Mesh(hand.vertices * 1.5, hand.faces), other, sources=SOURCES,
+                       client=client, dtype="float64", block_rows=8, progress=False)
+    _copy_block(store, 3, store, 4)
+    _copy_block(other, 9, store, 9)
+    Z = zarr.open_array(store, mode="r")
+    assert not np.array_equal(Z[:], serial64)  # the copies hold other rows
+    assert md.complete_blocks(Z, 8) == [b for b in range(15) if b not in (4, 9)]
+    Z = md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                           progress=False)
+    assert Z.attrs[md.RUN_ATTR]["blocks_computed"] == 2
+    assert np.array_equal(Z[:], serial64)
+
+
+def test_a_chunk_that_does_not_decode_is_recomputed(hand, serial64, client, tmp_path):
+    # a chunk whose CRC-32C matches but whose payload Blosc cannot decode made
+    # resume die with RuntimeError; it is recomputed as a bad checksum is
+    import google_crc32c
+
+    store = str(tmp_path / "g.zarr")
+    md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                       block_rows=8, progress=False)
+    inner = np.random.default_rng(7).integers(0, 256, 5000, dtype=np.uint8).tobytes()
+    crc = np.array([google_crc32c.value(inner)], dtype=np.uint32).tobytes()
+    open(os.path.join(store, "c", "4", "0"), "wb").write(inner + crc)
+    Z = zarr.open_array(store, mode="r")
+    with pytest.raises(RuntimeError):  # what the codec raises on this chunk
+        Z[32:40]
+    assert md.complete_blocks(Z, 8) == [b for b in range(15) if b != 4]
+    Z = md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
+                           progress=False)
+    assert Z.attrs[md.RUN_ATTR]["blocks_computed"] == 1
+    assert np.array_equal(Z[:], serial64)
+
+
+def _tree(root):
+    return {os.path.relpath(os.path.join(d, f), root): open(os.path.join(d, f), "rb").read()
+            for d, _, fs in os.walk(root) for f in fs}
+
+
+def test_an_output_that_holds_an_input_is_refused_and_left_intact(tmp_path, capsys):
+    # `-o DIR.zarr` deleted everything in DIR, the job's mesh and sources too
+    proj = tmp_path / "proj.zarr"
+    (proj / "sub").mkdir(parents=True)
+    (proj / "mesh.obj").write_bytes((MESHES / "hand_lowres.obj").read_bytes())
+    (proj / "src.txt").write_text("0\n1\n2\n")
+    (proj / "notes.txt").write_text("my notes\n")
+    (proj / "sub" / "results.csv").write_text("data\n")
+    before = _tree(proj)
+    (tmp_path / "link").symlink_to(proj)
+    for mesh, src, out in ((proj / "mesh.obj", proj / "src.txt", proj),
+                           (MESHES / "hand_lowres.obj", proj / "src.txt", proj / "src.txt"),
+                           (tmp_path / "link" / "mesh.obj", None, proj)):
+        capsys.readouterr()
+        rc = md.cli_allpairs_zarr([str(mesh), "-o", str(out), "--workers", "1", "--no-progress",
+                                   *(["--sources", str(src)] if src else [])])
+        err = capsys.readouterr().err
+        assert rc == 2 and "is an input or contains one" in err
+        assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+        assert _tree(proj) == before
+
+
+def test_a_location_that_is_not_a_meshfmm_store_needs_overwrite(hand, serial64, client,
+                                                                tmp_path, capsys):
+    out = tmp_path / "data.zarr"
+    (out / "sub").mkdir(parents=True)
+    (out / "notes.txt").write_text("my notes\n")
+    (out / "sub" / "results.csv").write_text("data\n")
+    before = _tree(out)
+    for resume in (True, False):
+        with pytest.raises(ValueError, match="not a meshfmm store") as e:
+            md.distance_matrix(hand, str(out), sources=SOURCES, client=client, resume=resume,
+                               progress=False)
+        assert isinstance(e.value, md.StoreError)
+    rc = md.cli_allpairs_zarr([str(MESHES / "hand_lowres.obj"), "-o", str(out), "--workers",
+                               "1", "--no-progress"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "--overwrite" in err and len(err.strip().splitlines()) == 1
+    assert _tree(out) == before
+    # asked for: the store is written beside the files, which stay
+    Z = md.distance_matrix(hand, str(out), sources=SOURCES, client=client, dtype="float64",
+                           block_rows=8, progress=False, overwrite=True)
+    assert np.array_equal(Z[:], serial64)
+    assert all(_tree(out)[k] == v for k, v in before.items())
+    # starting over a meshfmm store deletes its own entries only: a smaller
+    # job leaves no chunk or digest of the old one, and the files stay
+    Z = md.distance_matrix(hand, str(out), sources=SOURCES[:24], client=client, dtype="float64",
+                           block_rows=8, resume=False, progress=False)
+    assert np.array_equal(Z[:], serial64[:24])
+    assert md.complete_blocks(Z, 8) == [0, 1, 2]
+    after = _tree(out)
+    assert all(after[k] == v for k, v in before.items())
+    assert sorted(k for k in after if k not in before) == sorted(
+        ["zarr.json"] + [os.path.join("c", str(b), "0") for b in range(3)]
+        + [os.path.join(SUMS, str(b)) for b in range(3)])
+    # the command line's --overwrite reaches the call
+    capsys.readouterr()
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "keep.txt").write_text("kept\n")
+    src = tmp_path / "s.txt"
+    src.write_text("0\n5\n9\n")
+    rc = md.cli_allpairs_zarr([str(MESHES / "hand_lowres.obj"), "-o", str(other), "--sources",
+                               str(src), "--dtype", "float64", "--workers", "1",
+                               "--no-progress", "--overwrite"])
+    assert rc == 0, capsys.readouterr().err
+    assert (other / "keep.txt").read_text() == "kept\n"
+    assert np.array_equal(zarr.open_array(str(other), mode="r")[:],
+                          hand.distance_matrix([0, 5, 9], backend="serial", dtype="float64"))

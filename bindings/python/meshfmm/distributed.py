@@ -9,10 +9,27 @@ per worker.
 
 Resuming: the array's attributes record the job (mesh hash, sources, targets,
 options, meshfmm version). Chunks carry a CRC-32C (Zarr's crc32c codec) and
-the array's fill value is NaN, which the library never returns, so a block is
-complete exactly when its chunk reads back without a checksum error and
-without NaN. Re-running the same job skips those blocks; a different job on
-the same store is refused.
+the array's fill value is NaN, which the library never returns. Each task
+also writes a digest of its rows beside its chunk (``meshfmm_blocks/<b>``),
+computed over the job's hash, the block's index and rows and the values, so
+a block is complete exactly when its chunk decodes, holds no NaN and matches
+that digest: a torn or altered chunk, or one copied from another block or
+another job, is recomputed. Re-running the same job skips complete blocks; a
+different job on the same store is refused.
+
+One owner at a time: a run writes a fresh token into the attributes
+(``meshfmm_owner``, with its host, pid and a heartbeat every 10 s) before
+any task starts, and every task checks that token before it computes and
+again before it writes, so a run whose store was taken over writes nothing
+more and fails with :class:`StoreOwnerError`. A run refuses a store that a
+live run owns (same host: its process is alive; another host: a heartbeat
+within 60 s); a run that was killed leaves a stale token that the next run
+(``resume`` of the same job) replaces at once on the same host.
+
+Starting over deletes only the store's own entries (``zarr.json``, the chunk
+tree ``c/`` and ``meshfmm_blocks/``), never other files; a location that
+holds something else than a meshfmm store is refused unless
+``overwrite=True``.
 
 Needs ``dask[distributed]`` and ``zarr>=3``.
 """
@@ -26,8 +43,11 @@ import hashlib
 import json
 import math
 import os
+import socket
 import sys
+import threading
 import time
+import uuid
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -36,10 +56,21 @@ from . import __version__
 from . import _lib
 from ._mesh import Mesh, _as_index, _cost_array, _exact_start, _is_int, _max_distance
 
-__all__ = ["distance_matrix", "job_description", "complete_blocks", "symmetrize", "DASK_CONFIG"]
+__all__ = ["distance_matrix", "job_description", "complete_blocks", "symmetrize", "DASK_CONFIG",
+           "StoreError", "StoreOwnerError"]
 
 JOB_ATTR = "meshfmm_job"
 RUN_ATTR = "meshfmm_last_run"
+OWNER_ATTR = "meshfmm_owner"
+# Key prefix of the per-block digests, beside Zarr's chunk tree "c/".
+_SUMS = "meshfmm_blocks"
+# The owner's heartbeat period, and how long without one a run on another
+# host is taken for dead (on its own host its process is looked up instead).
+_HEARTBEAT_S = 10.0
+_LEASE_S = 60.0
+# Tokens of the runs in progress in this process: a record naming this
+# process with another token was left by a run of it that did not release.
+_ACTIVE_TOKENS: set = set()
 # Bytes of one block: large enough that scheduling is noise, small enough
 # that a 2-worker cluster gets many tasks and a lost worker loses little.
 _BLOCK_BYTES = 8 << 20
@@ -153,6 +184,117 @@ def _same_job(stored: Dict[str, Any], job: Dict[str, Any]) -> List[str]:
     return [k for k in job if k != "meshfmm_version" and stored.get(k) != job[k]]
 
 
+class StoreError(ValueError):
+    """The store cannot take this job: it holds another job, it is not a
+    meshfmm store (and ``overwrite`` was not given), or it is an input."""
+
+
+class StoreOwnerError(RuntimeError):
+    """Another run owns the store: a live one refused this run at its start,
+    or one took the store over while this run was writing."""
+
+
+def _job_key(job: Dict[str, Any]) -> str:
+    """The hash of a recorded job that each block's digest is bound to (the
+    version and unset options left out, as _same_job compares them)."""
+    core = {k: v for k, v in job.items() if k != "meshfmm_version" and v is not None}
+    return hashlib.sha256(json.dumps(core, sort_keys=True).encode()).hexdigest()
+
+
+def _block_digest(job_key: str, b: int, r0: int, r1: int, rows: np.ndarray) -> str:
+    """Digest of block b's values bound to the job and the block, so that a
+    chunk holding another block's or another job's rows does not verify."""
+    a = np.ascontiguousarray(rows, dtype=rows.dtype.newbyteorder("<"))
+    h = hashlib.blake2b(digest_size=16)
+    h.update(f"meshfmm-block:{job_key}:{b}:{r0}:{r1}:{a.dtype.str}:{a.shape}:".encode())
+    h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def _key_get(arr: Any, key: str) -> Optional[bytes]:
+    from zarr.core.sync import sync
+
+    buf = sync((arr.store_path / key).get())
+    return None if buf is None else buf.to_bytes()
+
+
+def _key_set(arr: Any, key: str, data: bytes) -> None:
+    from zarr.core.buffer import default_buffer_prototype
+    from zarr.core.sync import sync
+
+    sync((arr.store_path / key).set(default_buffer_prototype().buffer.from_bytes(data)))
+
+
+def _owner_record(token: str) -> Dict[str, Any]:
+    pid = os.getpid()
+    try:
+        import psutil
+
+        started: Optional[float] = psutil.Process(pid).create_time()
+    except Exception:  # no psutil: the pid alone identifies the process
+        started = None
+    now = time.time()
+    return {"token": token, "host": socket.gethostname(), "pid": pid, "pid_started": started,
+            "started": now, "heartbeat": now, "state": "running"}
+
+
+def _pid_alive(pid: Any, started: Any) -> bool:
+    if not _is_int(pid) or pid <= 0:
+        return False
+    try:
+        import psutil
+    except ImportError:
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return False
+        except PermissionError:
+            return True
+        return True
+    try:
+        p = psutil.Process(pid)
+        # another process reusing the pid is not the owner
+        if isinstance(started, (int, float)) and abs(p.create_time() - started) > 1.0:
+            return False
+        return p.status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return False
+    except psutil.AccessDenied:
+        return True
+
+
+def _owner_alive(rec: Any) -> bool:
+    """Whether the run recorded in `rec` may still be writing: it has not
+    released the store, and its process is alive (same host) or its last
+    heartbeat is younger than _LEASE_S (another host)."""
+    if not isinstance(rec, dict) or rec.get("state") != "running":
+        return False
+    if rec.get("host") == socket.gethostname():
+        if rec.get("pid") == os.getpid():
+            return rec.get("token") in _ACTIVE_TOKENS
+        return _pid_alive(rec.get("pid"), rec.get("pid_started"))
+    hb = rec.get("heartbeat")
+    return isinstance(hb, (int, float)) and time.time() - hb < _LEASE_S
+
+
+def _refuse_live_owner(url: str, rec: Any) -> None:
+    if _owner_alive(rec):
+        hb = rec.get("heartbeat")
+        age = time.time() - hb if isinstance(hb, (int, float)) else float("nan")
+        raise StoreOwnerError(
+            f"the store {url} is in use by another meshfmm job (pid {rec.get('pid')} on "
+            f"{rec.get('host')}, last heartbeat {age:.0f} s ago); wait for it to finish or "
+            f"stop it (a killed job's store is free at once on its host, after "
+            f"{_LEASE_S:.0f} s from another host)")
+
+
+def _check_token(arr: Any, token: str, url: str, r0: int, r1: int) -> None:
+    rec = arr.attrs.get(OWNER_ATTR) or {}
+    if rec.get("token") != token:
+        raise StoreOwnerError(f"the store {url} was taken over by another run while this job "
+                              f"ran; rows {r0}:{r1} were not written")
+
+
 # ------------------------------------------------------------- worker side
 
 def _worker_cache() -> Dict[str, Mesh]:
@@ -200,13 +342,18 @@ def _task_threads(n_threads: int, host_threads: Dict[str, int]) -> int:
 def _compute_block(key: str, V: np.ndarray, F: np.ndarray, url: str,
                    storage_options: Optional[dict], r0: int, r1: int,
                    src: Optional[np.ndarray], targets: Optional[np.ndarray],
-                   opts: Dict[str, Any]) -> Tuple[int, int, float, float, float]:
-    """One task: rows [r0, r1) into their own chunk. Idempotent: a retry
-    writes the same bytes. Returns r0, r1, the seconds spent computing and
-    writing (encoding included), and the CPU seconds of the task's thread
-    (library threads started beyond it not counted)."""
+                   opts: Dict[str, Any], b: int, token: str,
+                   job_key: str) -> Tuple[int, int, float, float, float]:
+    """One task: rows [r0, r1) (block b) into their own chunk, then the
+    block's digest beside it. Idempotent: a retry writes the same bytes.
+    Writes only while the store's owner token is `token` (checked before
+    computing and again before writing). Returns r0, r1, the seconds spent
+    computing and writing (encoding included), and the CPU seconds of the
+    task's thread (library threads started beyond it not counted)."""
     import zarr
 
+    _check_token(zarr.open_array(url, mode="r", storage_options=storage_options),
+                 token, url, r0, r1)
     cache = _worker_cache()
     # the caller's mesh options (unfolding walk, spokes): part of the key
     mesh_opts = opts.get("mesh_options") or {}
@@ -226,7 +373,12 @@ def _compute_block(key: str, V: np.ndarray, F: np.ndarray, url: str,
     rows = mesh.distance_matrix(rows_src, targets=targets, **kw)
     t1 = time.perf_counter()
     arr = zarr.open_array(url, mode="r+", storage_options=storage_options)
+    _check_token(arr, token, url, r0, r1)
+    rows = np.ascontiguousarray(rows, dtype=arr.dtype)
     arr[r0:r1, :] = rows
+    _key_set(arr, f"{_SUMS}/{b}", json.dumps(
+        {"block": b, "rows": [r0, r1], "job": job_key,
+         "blake2b": _block_digest(job_key, b, r0, r1, rows)}).encode())
     return r0, r1, t1 - t0, time.perf_counter() - t1, time.thread_time() - c0
 
 
@@ -241,17 +393,31 @@ def _open_store(store: Any, storage_options: Optional[dict]) -> Tuple[str, Optio
 
 
 def _verified(arr: Any, blocks: Sequence[int], block_rows: int) -> List[int]:
-    """Those of `blocks` whose chunk decodes (its CRC-32C matches) and holds no
-    NaN (a chunk never written reads as the NaN fill value)."""
+    """Those of `blocks` whose chunk decodes (its CRC-32C matches and the
+    codecs accept its payload), holds no NaN (a chunk never written reads as
+    the NaN fill value) and matches its digest for the store's job and this
+    block."""
+    job = arr.attrs.get(JOB_ATTR)
+    if not isinstance(job, dict) or not job:
+        return []
+    key = _job_key(job)
     n_rows = arr.shape[0]
     done = []
     for b in blocks:
         r0, r1 = b * block_rows, min(n_rows, (b + 1) * block_rows)
         try:
             block = arr[r0:r1, :]
-        except ValueError:  # checksum mismatch: a torn or altered chunk
+        except (OSError, MemoryError):  # the store itself failed: not the chunk's fault
+            raise
+        except Exception:  # a torn or altered chunk: a checksum mismatch (ValueError) or a
+            continue       # payload the codecs cannot decode (Blosc: RuntimeError, ...)
+        if np.isnan(block).any():
             continue
-        if not np.isnan(block).any():
+        try:
+            rec = json.loads(_key_get(arr, f"{_SUMS}/{b}") or b"null")
+        except ValueError:
+            rec = None
+        if isinstance(rec, dict) and rec.get("blake2b") == _block_digest(key, b, r0, r1, block):
             done.append(b)
     return done
 
@@ -266,8 +432,9 @@ def _verify_task(url: str, storage_options: Optional[dict], blocks: List[int],
 
 def complete_blocks(arr: Any, block_rows: int) -> List[int]:
     """Indices of the row blocks of `arr` that are complete and verified: the
-    chunk decodes (its CRC-32C matches) and holds no NaN (the fill value of a
-    chunk never written). Reads the whole array in this process; a resumed
+    chunk decodes (its CRC-32C matches), holds no NaN (the fill value of a
+    chunk never written) and matches the digest its task wrote for the
+    store's job and this block. Reads the whole array in this process; a resumed
     ``distance_matrix`` does the same check as tasks on its cluster."""
     return _verified(arr, range(math.ceil(arr.shape[0] / block_rows)), block_rows)
 
@@ -284,6 +451,126 @@ def _complete_blocks_on(client: Any, url: str, storage_options: Optional[dict], 
                          [block_rows] * n_tasks, pure=False,
                          key=[f"meshfmm-verify-{i}-{time.time_ns()}" for i in range(n_tasks)])
     return sorted(b for done in client.gather(futures) for b in done)
+
+
+def _local_path(url: str) -> Optional[str]:
+    """The filesystem path of a local store, None for another fsspec URL."""
+    if url.startswith("file://"):
+        return url[len("file://"):]
+    return None if "://" in url else url
+
+
+def _probe(url: str, storage_options: Optional[dict]) -> Tuple[str, Any]:
+    """What is at `url`: ("absent", None), ("empty", None), ("meshfmm", the
+    array, read-only) or ("foreign", None) for anything else (files, a Zarr
+    node that records no meshfmm job)."""
+    import zarr
+
+    try:
+        arr = zarr.open_array(url, mode="r", storage_options=storage_options)
+    except FileNotFoundError:
+        arr = None
+    except OSError:
+        raise
+    except Exception:  # a group, or metadata that is not an array's
+        return "foreign", None
+    if arr is not None:
+        return ("meshfmm", arr) if isinstance(arr.attrs.get(JOB_ATTR), dict) else ("foreign", None)
+    path = _local_path(url)
+    if path is not None:
+        if not os.path.lexists(path):
+            return "absent", None
+        if not os.path.isdir(path):
+            raise StoreError(f"the output {url} exists and is not a directory")
+        return ("empty", None) if not os.listdir(path) else ("foreign", None)
+    from zarr.core.sync import sync
+    from zarr.storage import FsspecStore
+
+    root = FsspecStore.from_url(url, storage_options=storage_options, read_only=True)
+    return ("empty", None) if sync(root.is_empty("")) else ("foreign", None)
+
+
+def _check_store(url: str, storage_options: Optional[dict], job: Dict[str, Any],
+                 shape: Tuple[int, int], resume: bool, overwrite: bool) -> Tuple[str, Any]:
+    """Refuses a store this job may not write (another live job owns it, it
+    holds another job and `resume` is set, it is not a meshfmm store and
+    `overwrite` is not set); else returns _probe's answer."""
+    kind, arr = _probe(url, storage_options)
+    if kind == "meshfmm":
+        _refuse_live_owner(url, arr.attrs.get(OWNER_ATTR))
+        if resume:
+            diff = _same_job(dict(arr.attrs.get(JOB_ATTR) or {}), job)
+            if diff or tuple(arr.shape) != shape:
+                raise StoreError(
+                    f"the store {url} holds a different job (differs in: "
+                    f"{', '.join(diff) or 'shape'}); use another store, or resume=False "
+                    "to overwrite it")
+    elif kind == "foreign" and not overwrite:
+        raise StoreError(
+            f"the output {url} exists and is not a meshfmm store (no {JOB_ATTR} attribute); "
+            "choose another output, or pass overwrite=True (--overwrite) to write the store "
+            "into it (its Zarr entries are replaced, other files kept)")
+    return kind, arr
+
+
+def _delete_own_entries(url: str, storage_options: Optional[dict]) -> None:
+    """Deletes a store's Zarr entries (metadata, the chunk tree, the block
+    digests) and nothing else: files beside them are not the job's."""
+    from zarr.core.sync import sync
+    from zarr.storage import FsspecStore, LocalStore, StorePath
+
+    path = _local_path(url)
+    store = (LocalStore(path) if path is not None else
+             FsspecStore.from_url(url, storage_options=storage_options, read_only=False))
+    root = StorePath(store, "")
+    for key in ("zarr.json", ".zarray", ".zattrs", ".zgroup"):
+        sync((root / key).delete())
+    for prefix in ("c", _SUMS):
+        sync((root / prefix).delete_dir())
+
+
+class _Ownership:
+    """This run's hold on a store: its token in the attributes, a heartbeat
+    every _HEARTBEAT_S while the job runs (from a thread), and the release
+    (state "finished" or "stopped") at its end. Every write first re-reads
+    the token, so a run never overwrites a newer owner's record."""
+
+    def __init__(self, url: str, storage_options: Optional[dict], token: str) -> None:
+        self.url, self.storage_options, self.token = url, storage_options, token
+        self.lost = False
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._thread: Optional[threading.Thread] = None
+
+    def update(self, changes: Dict[str, Any], attrs: Optional[Dict[str, Any]] = None) -> bool:
+        import zarr
+
+        with self._lock:
+            arr = zarr.open_array(self.url, mode="r+", storage_options=self.storage_options)
+            rec = arr.attrs.get(OWNER_ATTR) or {}
+            if rec.get("token") != self.token:
+                self.lost = True
+                return False
+            arr.attrs.update({OWNER_ATTR: dict(rec, **changes), **(attrs or {})})
+            return True
+
+    def _beat(self) -> None:
+        while not self._stop.wait(_HEARTBEAT_S):
+            try:
+                if not self.update({"heartbeat": time.time()}):
+                    return
+            except Exception:  # a missed beat (the store hiccuped): the next one tries again
+                pass
+
+    def start(self) -> None:
+        self._thread = threading.Thread(target=self._beat, name="meshfmm-heartbeat",
+                                        daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
 
 
 def _fmt_seconds(s: float) -> str:
@@ -340,7 +627,7 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                     unfolding: bool = True, exact_start: Any = True,
                     n_workers: Optional[int] = None,
                     storage_options: Optional[dict] = None, compression: str = "lz4",
-                    progress: Any = True, retries: int = 3) -> Any:
+                    progress: Any = True, retries: int = 3, overwrite: bool = False) -> Any:
     """Computes a dense S x N (or S x T) distance matrix as Dask tasks writing
     a Zarr v3 array at `store`, and returns the ``zarr.Array``.
 
@@ -358,7 +645,11 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         (float64 bit for bit, float32 the same rounding).
     resume: True skips blocks already complete and verified when the store
         holds the same job, and refuses a store holding another job; False
-        starts over, overwriting the store.
+        starts over a meshfmm store, deleting only its own entries
+        (``zarr.json``, ``c/``, ``meshfmm_blocks/``), never other files.
+        Either way a store that another live run owns is refused
+        (:class:`StoreOwnerError`), and a run killed before it finished does
+        not block the next one (see the module's notes).
     block_rows: rows per task and chunk (default: about 8 MiB a chunk, at
         least 4 tasks per Dask thread of the cluster).
     backend, n_threads: the in-process backend each task runs ("threads",
@@ -377,6 +668,16 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         exception it raises stops the job (blocks in flight still finish).
     retries: times a failed task is retried (a killed worker's tasks are
         rescheduled by Dask regardless).
+    overwrite: write the store into a location that exists and is not a
+        meshfmm store (a non-empty directory, another Zarr node): its Zarr
+        entries (``zarr.json``, ``c/``) are replaced and other files kept.
+        Without it such a location is refused with :class:`StoreError`, as
+        is a store holding another job when `resume` is set.
+
+    A run owns the store while it writes (a token in the attribute
+    ``meshfmm_owner``, checked by every task before it writes): if another
+    run takes the store over meanwhile, this one writes nothing more and
+    raises :class:`StoreOwnerError`.
 
     The attribute ``meshfmm_last_run`` of the returned array records how many
     blocks this call computed and skipped, the task seconds spent computing
@@ -423,6 +724,9 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
     n_cols = nv if tgt is None else tgt.shape[0]
     job = job_description(mesh, src, tgt, dt.name, max_distance, cost_arr, cost_location,
                           unfolding, radius)
+    # refused before a cluster is started for nothing; checked again below
+    _check_store(url, storage_options, job, (n_rows, n_cols), resume, overwrite)
+    token = uuid.uuid4().hex  # this run's owner token
 
     own_cluster = None
     quiet = contextlib.ExitStack()
@@ -450,102 +754,136 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
             host = w.get("host", "")
             host_threads[host] = host_threads.get(host, 0) + int(w.get("nthreads", 1))
         dask_threads = max(1, sum(host_threads.values()))
-        arr = None
-        fresh = False
-        if resume:
+        owner = _Ownership(url, storage_options, token)
+        record = _owner_record(token)
+        _ACTIVE_TOKENS.add(token)
+        try:
+            kind, _ = _check_store(url, storage_options, job, (n_rows, n_cols), resume,
+                                   overwrite)
+            fresh = not (resume and kind == "meshfmm")
+            if not fresh:
+                zarr.open_array(url, mode="r+", storage_options=storage_options) \
+                    .attrs[OWNER_ATTR] = record
+            else:
+                if kind == "meshfmm":
+                    # the previous run's tasks still in flight see the new token first
+                    zarr.open_array(url, mode="r+", storage_options=storage_options) \
+                        .attrs[OWNER_ATTR] = record
+                if kind in ("meshfmm", "foreign"):
+                    _delete_own_entries(url, storage_options)
+                if block_rows is None:
+                    block_rows = _default_block_rows(n_rows, n_cols * dt.itemsize,
+                                                     dask_threads)
+                compressors = [Crc32cCodec()]
+                if _CODECS[compression] is not None:
+                    cname, clevel = _CODECS[compression]
+                    compressors.insert(0, BloscCodec(cname=cname, clevel=clevel,
+                                                     shuffle=BloscShuffle.bitshuffle,
+                                                     typesize=dt.itemsize))
+                zarr.create_array(url, shape=(n_rows, n_cols),
+                                  chunks=(int(block_rows), n_cols), dtype=dt,
+                                  fill_value=np.nan, compressors=compressors,
+                                  attributes={JOB_ATTR: job, OWNER_ATTR: record},
+                                  overwrite=False, storage_options=storage_options)
+            arr = zarr.open_array(url, mode="r+", storage_options=storage_options)
+            if (arr.attrs.get(OWNER_ATTR) or {}).get("token") != token:  # two runs at once
+                raise StoreOwnerError(f"the store {url} was taken by another run starting at "
+                                      "the same time; run again once it has finished")
+            owner.start()
+            run = _run_blocks(client, arr, url, storage_options, mesh, src, tgt, token,
+                              fresh, n_rows, dask_threads, progress, owner,
+                              {"backend": backend, "dtype": dt.name,
+                               "max_distance": max_distance, "unfolding": unfolding,
+                               "exact_start": radius, "cost": cost_arr,
+                               "cost_location": cost_location, "n_threads": n_threads,
+                               "host_threads": host_threads,
+                               "mesh_options": mesh._options()}, retries)
+        except BaseException:
+            # release the store (only where this run's token is still there)
+            owner.stop()
             try:
-                arr = zarr.open_array(url, mode="r+", storage_options=storage_options)
-            except FileNotFoundError:
-                arr = None
-            if arr is not None:
-                stored = dict(arr.attrs.get(JOB_ATTR) or {})
-                diff = _same_job(stored, job) if stored else ["(no meshfmm job recorded)"]
-                if diff or arr.shape != (n_rows, n_cols):
-                    raise ValueError(
-                        f"the store {url} holds a different job (differs in: "
-                        f"{', '.join(diff) or 'shape'}); use another store, or resume=False "
-                        "to overwrite it")
-        if arr is None:
-            if block_rows is None:
-                block_rows = _default_block_rows(n_rows, n_cols * dt.itemsize, dask_threads)
-            compressors = [Crc32cCodec()]
-            if _CODECS[compression] is not None:
-                cname, clevel = _CODECS[compression]
-                compressors.insert(0, BloscCodec(cname=cname, clevel=clevel,
-                                                 shuffle=BloscShuffle.bitshuffle,
-                                                 typesize=dt.itemsize))
-            fresh = True
-            arr = zarr.create_array(url, shape=(n_rows, n_cols), chunks=(int(block_rows), n_cols),
-                                    dtype=dt, fill_value=np.nan, compressors=compressors,
-                                    attributes={JOB_ATTR: job}, overwrite=True,
-                                    storage_options=storage_options)
-        block_rows = int(arr.chunks[0])
-        n_blocks = math.ceil(n_rows / block_rows)
-        # a store just created holds nothing to verify
-        done = (set(_complete_blocks_on(client, url, storage_options, n_rows, block_rows,
-                                        dask_threads)) if resume and not fresh else set())
-        todo = [b for b in range(n_blocks) if b not in done]
-
-        report: Optional[Callable[[int], None]] = None
-        if progress is True:
-            bar = _Progress(n_rows, done=sum(min(n_rows, (b + 1) * block_rows) - b * block_rows
-                                             for b in done))
-            bar(0)
-            report = bar
-        elif callable(progress):
-            rows_done = [sum(min(n_rows, (b + 1) * block_rows) - b * block_rows for b in done)]
-
-            def report(rows: int) -> None:
-                rows_done[0] += rows
-                progress(rows_done[0], n_rows)
-
-        opts = {"backend": backend, "dtype": dt.name, "max_distance": max_distance,
-                "unfolding": unfolding, "exact_start": radius,
-                "cost": cost_arr, "cost_location": cost_location,
-                "n_threads": n_threads, "host_threads": host_threads,
-                "mesh_options": mesh._options()}
-        V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
-        F = np.ascontiguousarray(mesh.faces, dtype=np.int32)
-        computed, t_compute, t_write, t_cpu = 0, 0.0, 0.0, 0.0
-        if todo:
-            from distributed import as_completed
-
-            # hash=False: keys of this call alone. Scattered by content hash, a
-            # second job on the same mesh reused the keys the first job's
-            # futures were releasing, and the scheduler lost them under the new
-            # tasks ("lost dependencies": the job failed, or hung)
-            V_f, F_f = client.scatter([V, F], broadcast=True, hash=False)
-            src_f = (client.scatter(src, broadcast=True, hash=False) if src is not None
-                     else None)
-            key = job["mesh_sha256"]
-            futures = [client.submit(_compute_block, key, V_f, F_f, url, storage_options,
-                                     b * block_rows, min(n_rows, (b + 1) * block_rows),
-                                     src_f, tgt, opts, retries=retries, pure=False,
-                                     key=f"meshfmm-block-{key[:12]}-{b}-{time.time_ns()}")
-                       for b in todo]
-            try:
-                for fut in as_completed(futures):
-                    r0, r1, tc, tw, tcpu = fut.result()
-                    computed += 1
-                    t_compute += tc
-                    t_write += tw
-                    t_cpu += tcpu
-                    if report:
-                        report(r1 - r0)
-            except BaseException:
-                client.cancel(futures)
-                raise
-        arr.attrs[RUN_ATTR] = {"blocks": n_blocks, "blocks_computed": computed,
-                               "blocks_skipped": len(done), "block_rows": block_rows,
-                               "task_compute_seconds": t_compute,
-                               "task_write_seconds": t_write,
-                               "task_thread_cpu_seconds": t_cpu}
-        return arr
+                owner.update({"state": "stopped"})
+            except Exception:  # the job's own error is the one to report
+                pass
+            raise
+        owner.stop()
+        if not owner.update({"state": "finished", "heartbeat": time.time()}, {RUN_ATTR: run}):
+            raise StoreOwnerError(f"the store {url} was taken over by another run before this "
+                                  "job finished")
+        return zarr.open_array(url, mode="r+", storage_options=storage_options)
     finally:
+        _ACTIVE_TOKENS.discard(token)
         if own_cluster is not None:
             client.close()
             own_cluster.close()
         quiet.close()
+
+
+def _run_blocks(client: Any, arr: Any, url: str, storage_options: Optional[dict], mesh: Mesh,
+                src: Optional[np.ndarray], tgt: Optional[np.ndarray], token: str, fresh: bool,
+                n_rows: int, dask_threads: int, progress: Any, owner: _Ownership,
+                opts: Dict[str, Any], retries: int) -> Dict[str, Any]:
+    """Verifies a resumed store's blocks, then computes the others as tasks;
+    returns the run's record (RUN_ATTR)."""
+    block_rows = int(arr.chunks[0])
+    n_blocks = math.ceil(n_rows / block_rows)
+    job_key = _job_key(arr.attrs[JOB_ATTR])
+    # a store just created holds nothing to verify
+    done = (set(_complete_blocks_on(client, url, storage_options, n_rows, block_rows,
+                                    dask_threads)) if not fresh else set())
+    todo = [b for b in range(n_blocks) if b not in done]
+
+    report: Optional[Callable[[int], None]] = None
+    if progress is True:
+        bar = _Progress(n_rows, done=sum(min(n_rows, (b + 1) * block_rows) - b * block_rows
+                                         for b in done))
+        bar(0)
+        report = bar
+    elif callable(progress):
+        rows_done = [sum(min(n_rows, (b + 1) * block_rows) - b * block_rows for b in done)]
+
+        def report(rows: int) -> None:
+            rows_done[0] += rows
+            progress(rows_done[0], n_rows)
+
+    V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
+    F = np.ascontiguousarray(mesh.faces, dtype=np.int32)
+    computed, t_compute, t_write, t_cpu = 0, 0.0, 0.0, 0.0
+    if todo:
+        from distributed import as_completed
+
+        # hash=False: keys of this call alone. Scattered by content hash, a
+        # second job on the same mesh reused the keys the first job's
+        # futures were releasing, and the scheduler lost them under the new
+        # tasks ("lost dependencies": the job failed, or hung)
+        V_f, F_f = client.scatter([V, F], broadcast=True, hash=False)
+        src_f = (client.scatter(src, broadcast=True, hash=False) if src is not None
+                 else None)
+        key = arr.attrs[JOB_ATTR]["mesh_sha256"]
+        futures = [client.submit(_compute_block, key, V_f, F_f, url, storage_options,
+                                 b * block_rows, min(n_rows, (b + 1) * block_rows),
+                                 src_f, tgt, opts, b, token, job_key, retries=retries,
+                                 pure=False,
+                                 key=f"meshfmm-block-{key[:12]}-{b}-{time.time_ns()}")
+                   for b in todo]
+        try:
+            for fut in as_completed(futures):
+                r0, r1, tc, tw, tcpu = fut.result()
+                computed += 1
+                t_compute += tc
+                t_write += tw
+                t_cpu += tcpu
+                if owner.lost:
+                    raise StoreOwnerError(f"the store {url} was taken over by another run "
+                                          "while this job ran; this job stopped")
+                if report:
+                    report(r1 - r0)
+        except BaseException:
+            client.cancel(futures)
+            raise
+    return {"blocks": n_blocks, "blocks_computed": computed, "blocks_skipped": len(done),
+            "block_rows": block_rows, "task_compute_seconds": t_compute,
+            "task_write_seconds": t_write, "task_thread_cpu_seconds": t_cpu}
 
 
 def symmetrize(store: Any, out: Any, storage_options: Optional[dict] = None) -> Any:
@@ -589,9 +927,45 @@ class _Once(argparse.Action):
         setattr(namespace, self.dest, values)
 
 
+def _refuse_inputs(output: str, inputs: Sequence[Optional[str]]) -> None:
+    """Refuses an output that is one of the job's input files or a directory
+    holding one (compared by device and inode, walking up each input's
+    parents as given and as resolved), as the C command line refuses an
+    output that is an input: starting over would write into it."""
+    path = _local_path(output)
+    if path is None:
+        return
+    try:
+        st = os.stat(path)
+    except OSError:  # not there yet: it holds nothing
+        return
+    ident = (st.st_dev, st.st_ino)
+    for given in inputs:
+        if given is None:
+            continue
+        for q in {os.path.abspath(given), os.path.realpath(given)}:
+            while True:
+                try:
+                    s = os.stat(q)
+                    if (s.st_dev, s.st_ino) == ident:
+                        raise StoreError(f"the output {output} is an input or contains one "
+                                         f"({given}); choose another output")
+                except OSError:
+                    pass
+                parent = os.path.dirname(q)
+                if parent == q:
+                    break
+                q = parent
+
+
 def cli_allpairs_zarr(argv: Sequence[str]) -> int:
     """``meshfmm allpairs MESH -o OUT.zarr [--scheduler ADDRESS | --workers N]
-    [--resume] ...``: the distributed all-pairs job from the command line."""
+    [--resume] [--overwrite] ...``: the distributed all-pairs job from the
+    command line. OUT may not be an input or contain one; without
+    ``--resume`` a meshfmm store there is started over (only its own Zarr
+    entries deleted); ``--overwrite`` is needed to write into a location
+    that exists and is not a meshfmm store (its Zarr entries are replaced,
+    other files kept). Errors are one line on stderr and exit status 2."""
     ap = argparse.ArgumentParser(prog="meshfmm allpairs",
                                  description="All-pairs geodesic distances on a Dask cluster, "
                                              "written into a Zarr v3 array.")
@@ -604,7 +978,12 @@ def cli_allpairs_zarr(argv: Sequence[str]) -> int:
     g.add_argument("--workers", type=int, action=_Once,
                    help="worker processes of a local cluster (default: cores)")
     ap.add_argument("--resume", action="store_true",
-                    help="go on with a job already in OUT (default: start over)")
+                    help="go on with a job already in OUT (default: start over, deleting "
+                         "only the store's own entries)")
+    ap.add_argument("--overwrite", action="store_true",
+                    help="write into OUT even where it exists and is not a meshfmm store: its "
+                         "Zarr entries (zarr.json, c/) are replaced, other files kept "
+                         "(default: refuse)")
     ap.add_argument("--dtype", choices=["float32", "float64"], default="float32", action=_Once)
     ap.add_argument("--sources", help="vertex ids (.npy or .txt)", action=_Once)
     ap.add_argument("--targets", help="vertex ids for the columns (.npy or .txt)", action=_Once)
@@ -625,6 +1004,7 @@ def cli_allpairs_zarr(argv: Sequence[str]) -> int:
                          "(~380 bytes per vertex each; same matrix, marches 1.25-1.6x as long)")
     a = ap.parse_args(list(argv))
     try:
+        _refuse_inputs(a.output, [a.mesh, a.sources, a.targets, a.cost])
         from ._mesh import load_mesh
 
         mesh = Mesh(*load_mesh(a.mesh), spokes=not a.no_spokes)
@@ -648,7 +1028,7 @@ def cli_allpairs_zarr(argv: Sequence[str]) -> int:
                             exact_start=(False if a.plain_start else
                                          True if a.exact_start_radius is None
                                          else a.exact_start_radius),
-                            compression=a.compression)
+                            compression=a.compression, overwrite=a.overwrite)
         run = Z.attrs.get(RUN_ATTR, {})
         print(f"meshfmm: wrote {Z.shape[0]} x {Z.shape[1]} {Z.dtype} to {a.output} "
               f"({run.get('blocks_computed')} blocks computed, {run.get('blocks_skipped')} "
@@ -660,7 +1040,7 @@ def cli_allpairs_zarr(argv: Sequence[str]) -> int:
         print("meshfmm: interrupted; complete blocks are kept (run again with --resume)",
               file=sys.stderr)
         return 130
-    except (ValueError, TypeError, OSError) as e:
+    except (ValueError, TypeError, OSError, StoreOwnerError) as e:
         print(f"meshfmm: {e}", file=sys.stderr)
         return 2
 
