@@ -380,9 +380,15 @@ typedef struct mfmm_exact_options {
                              from an earlier solve is released first); needing
                              more returns MFMM_ERR_MEMORY_LIMIT. 0 (default): no
                              limit */
+    int (*interrupt)(void *user); /* NULL (default), or called every few milliseconds
+                             of propagation: non-zero stops the solve with
+                             MFMM_ERR_CANCELLED (Ctrl-C in a program that solves
+                             large meshes) */
+    void *user;           /* passed to interrupt */
 } mfmm_exact_options;
 
-/* Fills `options` with the defaults: no cost, no limit on distance or memory. */
+/* Fills `options` with the defaults: no cost, no limit on distance or memory,
+ * no interrupt. */
 MFMM_API void mfmm_exact_options_init(mfmm_exact_options *options);
 
 /* What one exact solve did. */

@@ -232,7 +232,10 @@ struct mfmm_exact_solver {
     int32_t n_in;      /* entries in the window's buckets */
     size_t fixed_bytes, memory_limit, peak_bytes;
     double max_d;
-    int failed; /* MFMM_ERR_MEMORY_LIMIT or MFMM_ERR_OUT_OF_MEMORY once a growth fails */
+    int failed; /* MFMM_ERR_MEMORY_LIMIT or MFMM_ERR_OUT_OF_MEMORY once a growth fails,
+                   MFMM_ERR_CANCELLED once interrupt asked to stop */
+    int (*interrupt)(void *user); /* mfmm_exact_options' (NULL for a patch) */
+    void *interrupt_user;
     int pass_depth; /* zero-area faces a window is passing through (ex_pass) */
     /* with non-manifold edges crossed, windows past a budget (over_budget):
      * the run is redone with those edges as walls (walls; ex_run) */
@@ -251,11 +254,14 @@ void mfmm_exact_options_init(mfmm_exact_options *options)
 {
     if (!options)
         return;
+    memset(options, 0, sizeof *options);
     options->struct_size = sizeof *options;
     options->cost = NULL;
     options->cost_location = MFMM_COST_NONE;
     options->max_distance = INFINITY;
     options->memory_limit = 0;
+    options->interrupt = NULL;
+    options->user = NULL;
 }
 
 void mfmm_exact_tables_destroy(mfmm_exact_tables *t)
@@ -1723,6 +1729,11 @@ static mfmm_status ex_run_once(mfmm_exact_ws *ws, const mfmm_source *sources,
             ws->over_budget = 1;
             break;
         }
+        /* about every 5 ms */
+        if (!(n & 65535) && ws->interrupt && ws->interrupt(ws->interrupt_user)) {
+            ws->failed = MFMM_ERR_CANCELLED;
+            break;
+        }
         ex_entry e;
         ex_pop(ws, &e);
         if (e.he < 0) {
@@ -1825,9 +1836,15 @@ mfmm_status mfmm_solve_exact(mfmm_exact_solver *solver, const mfmm_source *sourc
     if (mfmm_order_map_args(solver->mesh, sources, n_sources, NULL, 0, NULL, 0, NULL, &mapped) !=
         MFMM_OK)
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the sources");
+    solver->interrupt = options->interrupt;
+    solver->interrupt_user = options->user;
     st = ex_run(solver, mapped.sources, n_sources, max_d, options->memory_limit);
+    solver->interrupt = NULL;
+    solver->interrupt_user = NULL;
     free(mapped.block);
     ex_fill_info(solver, info);
+    if (st == MFMM_ERR_CANCELLED)
+        return mfmm_fail(err, st, -1, "the exact solve was interrupted");
     if (st != MFMM_OK) {
         if (st == MFMM_ERR_MEMORY_LIMIT)
             return mfmm_fail(err, st, -1,

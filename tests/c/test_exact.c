@@ -486,6 +486,37 @@ static void test_max_distance(void **state)
     ex_free(&fx);
 }
 
+static int ex_stop_at(void *user)
+{
+    int *calls = user;
+    return ++*calls >= 2;
+}
+
+/* interrupt is called as the propagation goes on, and its non-zero answer
+ * stops the solve with MFMM_ERR_CANCELLED; the next solve on the solver
+ * gives the full row (the plane's Euclidean distances). */
+static void test_interrupt(void **state)
+{
+    (void)state;
+    ex_fx fx = ex_make(mfmm_gen_grid(150));
+    mfmm_exact_options o;
+    mfmm_exact_options_init(&o);
+    assert_null(o.interrupt);
+    int calls = 0;
+    o.interrupt = ex_stop_at;
+    o.user = &calls;
+    mfmm_source s = tm_vertex_source(0);
+    mfmm_error err;
+    assert_int_equal(mfmm_solve_exact(fx.solver, &s, 1, &o, fx.d, NULL, &err),
+                     MFMM_ERR_CANCELLED);
+    assert_int_equal(calls, 2);
+    assert_non_null(strstr(err.message, "interrupted"));
+    ex_solve(&fx, &s, 1, NULL);
+    for (int32_t v = 0; v < fx.g.nv; v++)
+        tm_assert_close(fx.d[v], dist3(fx.g.V + 3 * v, fx.g.V), 1e-12);
+    ex_free(&fx);
+}
+
 /* Two components and a non-manifold edge: a unit square cut along its
  * diagonal (1,0)-(0,1), and a fin on that diagonal, and a copy of the
  * square far away. The diagonal, shared by three faces, joins each to the
@@ -1030,6 +1061,7 @@ int main(void)
         cmocka_unit_test(test_saddle),
         cmocka_unit_test(test_reflex_corner),
         cmocka_unit_test(test_max_distance),
+        cmocka_unit_test(test_interrupt),
         cmocka_unit_test(test_nonmanifold_components),
         cmocka_unit_test(test_degenerate_face),
         cmocka_unit_test(test_memory_limit),

@@ -557,6 +557,37 @@ def test_ctrl_c_stops_distance_matrix():
     assert done < 10, f"{done} blocks ran after Ctrl-C"
 
 
+def test_ctrl_c_stops_exact_solve():
+    """SIGINT during an exact solve stops the propagation within milliseconds
+    and raises KeyboardInterrupt; the mesh's next exact solve gives the row
+    it gave before."""
+    code = textwrap.dedent(
+        """
+        import os, signal, threading, time, numpy as np, meshfmm, sys
+        sys.path.insert(0, %r)
+        from test_api import grid
+        m = meshfmm.Mesh(*grid(240))
+        t0 = time.perf_counter(); row = m.distance(0, method="exact")
+        full = time.perf_counter() - t0
+        threading.Timer(0.05, os.kill, (os.getpid(), signal.SIGINT)).start()
+        t0 = time.perf_counter()
+        try:
+            m.distance(0, method="exact")
+            print("finished", full)
+        except KeyboardInterrupt:
+            print("interrupted", time.perf_counter() - t0, full)
+        assert np.array_equal(m.distance(0, method="exact"), row)
+        """
+    ) % str(Path(__file__).parent)
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    words = proc.stdout.split()
+    assert words[0] == "interrupted", proc.stdout
+    stopped, full = float(words[1]), float(words[2])
+    assert stopped < 0.5 * full, proc.stdout
+
+
 def test_max_unfold_steps_reaches_the_core(meshes_dir):
     V, F = load("wingnut.obj")
     default = meshfmm.Mesh(V, F).info

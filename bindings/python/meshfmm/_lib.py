@@ -181,6 +181,8 @@ class mfmm_exact_options(Structure):
         ("cost_location", c_enum),
         ("max_distance", c_double),
         ("memory_limit", c_size_t),
+        ("interrupt", CFUNCTYPE(c_int, c_void_p)),  # non-zero stops the solve
+        ("user", c_void_p),
     ]
 
 
