@@ -196,6 +196,34 @@ def test_symmetrize_matches_numpy(hand, tmp_path):
     assert np.allclose(S[:], (D + D.T) / 2, rtol=0, atol=0)
 
 
+def test_symmetrize_never_deletes_what_it_did_not_write(hand, tmp_path):
+    """symmetrize refuses its own input (or a directory around or inside it)
+    as output, and a non-empty output unless overwrite=True, which replaces
+    only the Zarr entries."""
+    proj = tmp_path / "proj"
+    proj.mkdir()
+    store = str(proj / "sq.zarr")
+    sq = np.arange(0, 810, 40, dtype=np.int32)
+    Z = md.distance_matrix(hand, store, sources=sq, targets=sq, n_workers=1, dtype="float64",
+                           progress=False)
+    D = Z[:]
+    for bad in (store, str(proj), str(proj / "sq.zarr" / "inner.zarr")):
+        with pytest.raises(md.StoreError):
+            md.symmetrize(store, bad)
+    assert np.array_equal(zarr.open_array(store, mode="r")[:], D)
+    out = tmp_path / "notes"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    with pytest.raises(md.StoreError, match="not empty"):
+        md.symmetrize(store, str(out))
+    for _ in range(2):  # onto a foreign directory, then over its own output
+        S = md.symmetrize(store, str(out), overwrite=True)
+        assert np.array_equal(S[:], (D + D.T) / 2)
+        assert (out / "notes.txt").read_text() == "mine"
+    with pytest.raises(md.StoreError, match="not empty"):
+        md.symmetrize(store, str(out))
+
+
 def test_bad_arguments_are_refused(hand, tmp_path):
     with pytest.raises(ValueError, match="targets"):
         md.distance_matrix(hand, str(tmp_path / "x.zarr"), targets=[10**6], n_workers=1)

@@ -886,20 +886,43 @@ def _run_blocks(client: Any, arr: Any, url: str, storage_options: Optional[dict]
             "task_write_seconds": t_write, "task_thread_cpu_seconds": t_cpu}
 
 
-def symmetrize(store: Any, out: Any, storage_options: Optional[dict] = None) -> Any:
+def symmetrize(store: Any, out: Any, storage_options: Optional[dict] = None,
+               overwrite: bool = False) -> Any:
     """(D + D^T) / 2 of a square matrix in a Zarr store, written to `out`, with
     Dask arrays (chunk by chunk, never the whole matrix in memory):
     ``da.from_zarr(store)`` then ``((D + D.T) / 2).astype(D.dtype).to_zarr(out)``.
-    Returns the new ``zarr.Array``."""
+    Returns the new ``zarr.Array``.
+
+    Raises StoreError when `out` is `store`, holds it or lies inside it, and
+    when `out` exists and is not empty unless `overwrite` is set; then only
+    its Zarr entries are replaced, and other files in it are kept."""
     import dask.array as da
     import zarr
 
-    D = da.from_zarr(store, storage_options=storage_options)
+    url, storage_options = _open_store(store, storage_options)
+    out_url, _ = _open_store(out, storage_options)
+    a, b = _local_path(url), _local_path(out_url)
+    if a is not None and b is not None:
+        _refuse_inputs(out_url, [url])
+        ra, rb = os.path.realpath(a), os.path.realpath(b)
+        if os.path.commonpath([ra, rb]) == ra:
+            raise StoreError(f"the output {out_url} lies inside the input store {url}; "
+                             "choose another output")
+    elif url.rstrip("/") == out_url.rstrip("/"):
+        raise StoreError(f"the output {out_url} is the input store; choose another output")
+    D = da.from_zarr(url, storage_options=storage_options)
     if D.ndim != 2 or D.shape[0] != D.shape[1]:
         raise ValueError(f"symmetrize needs a square matrix, not {D.shape}")
+    kind, _ = _probe(out_url, storage_options)
+    if kind in ("meshfmm", "foreign"):
+        if not overwrite:
+            raise StoreError(f"the output {out_url} exists and is not empty; choose another "
+                             "output, or pass overwrite=True (its Zarr entries are replaced, "
+                             "other files kept)")
+        _delete_own_entries(out_url, storage_options)
     S = ((D + D.T) / 2).astype(D.dtype)
-    S.to_zarr(out, overwrite=True, storage_options=storage_options)
-    return zarr.open_array(out, mode="r", storage_options=storage_options)
+    S.to_zarr(out_url, storage_options=storage_options)
+    return zarr.open_array(out_url, mode="r", storage_options=storage_options)
 
 
 # ------------------------------------------------------------- command line
