@@ -153,6 +153,32 @@ static int strip_push(strip_buf *sb, mfmm_virt_step st, vec2 p1, vec2 p2)
     return 1;
 }
 
+/* Whether the segment from C (the origin) to pv crosses every edge of the
+ * strip's steps [first, sb->n) between its ends, in order, before pv: then
+ * it runs through the strip's faces and its length is a path's on the
+ * surface. A strip that folds back over itself in the unfolding (a fan
+ * around a vertex whose faces' angles exceed 2 pi, a sliver) can put V in
+ * the section but beside the strip, 1167 from C where the surface's
+ * shortest path is 4966 and the straight line through space 2896. */
+static int strip_holds(const strip_buf *sb, int32_t first, vec2 pv)
+{
+    const double tol = 1e-9;
+    double last = 0.0;
+    for (int32_t i = first; i < sb->n; i++) {
+        vec2 u = sb->end[2 * i], v = sb->end[2 * i + 1];
+        vec2 d = {v.x - u.x, v.y - u.y};
+        double den = pv.x * d.y - pv.y * d.x;
+        if (!(den != 0.0))
+            return 0;
+        double t = (u.x * pv.y - u.y * pv.x) / den; /* along the edge */
+        double s = (u.x * d.y - u.y * d.x) / den;   /* along C -> V */
+        if (!(t >= -tol && t <= 1.0 + tol && s > 0.0 && s <= 1.0 + tol && s >= last - tol))
+            return 0;
+        last = s;
+    }
+    return 1;
+}
+
 /* Walks from obtuse corner k of face f; returns 1 and fills the corner's
  * virtual edge and appends its strip to sb, 0 if the walk fails (boundary,
  * non-manifold edge, degenerate face, or more than max_steps faces), -1 when
@@ -175,7 +201,7 @@ static int unfold_corner(mfmm_mesh *m, int32_t corner, int32_t max_steps, strip_
         if (qa >= 0.0 && qb >= 0.0) {
             /* in the section: both virtual angles are acute */
             double l = sqrt(dot2(pq, pq));
-            if (!(l > 0.0))
+            if (!(l > 0.0) || !strip_holds(sb, first, pq))
                 break;
             for (int32_t i = first; i < sb->n; i++)
                 sb->step[i].t = crossing_t(pq, sb->end[2 * i], sb->end[2 * i + 1]);
