@@ -119,6 +119,11 @@
 /* a patch distance outside its bounds by more than this times (the
  * distance + a mean edge) is a defect (mfmm_exact_patch_check) */
 #define EX_PATCH_TOL 1e-9
+/* a face's edge shorter than this times the edge a window enters by gets
+ * its direction normalised by the length of its own vector in that frame
+ * (ex_propagate): its corners are placed to rounding of the longer edge, so
+ * the table's length would scale the frame, and every distance in it */
+#define EX_SHORT_CHILD 1e-3
 /* an edge shorter than this times the longest edge of a face at its ends
  * is a wall (ex_wall_short_edges) */
 #define EX_SHORT_EDGE 1e-6
@@ -1508,7 +1513,7 @@ static void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
     if (b0 < tc) {
         /* left child: edge C -> A (half-edge 3f+m2), rays through [b0, min(b1, tc)] */
         int32_t hl = 3 * f + m2;
-        double lac = r->len[m2], il = 1.0 / lac;
+        double lac = r->len[m2], il = 1.0 / (lac < EX_SHORT_CHILD * L ? hypot(cx, cy) : lac);
         double ux = -cx * il, uy = -cy * il;
         double s_hi = b0 <= 0.0 ? lac : ex_hit(cx, cy, ux, uy, px, py, b0, lac);
         double s_lo = tc <= b1 ? 0.0 : ex_hit(cx, cy, ux, uy, px, py, b1, lac);
@@ -1523,7 +1528,7 @@ static void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
     if (b1 > tc) {
         /* right child: edge B -> C (half-edge 3f+m1), rays through [max(b0, tc), b1] */
         int32_t hr = 3 * f + m1;
-        double lbc = r->len[m1], il = 1.0 / lbc;
+        double lbc = r->len[m1], il = 1.0 / (lbc < EX_SHORT_CHILD * L ? hypot(cx - L, cy) : lbc);
         double ux = (cx - L) * il, uy = cy * il;
         double s_lo = b1 >= L ? 0.0 : ex_hit(L, 0.0, ux, uy, px, py, b1, lbc);
         double s_hi = tc >= b0 ? lbc : ex_hit(L, 0.0, ux, uy, px, py, b0, lbc);

@@ -1,0 +1,36 @@
+"""Meshes the oracle sweep (bench/oracle_sweep.py) found wrong, kept as
+regressions: every value must be the length of a real path on the surface,
+so never below the straight line through space from the source."""
+import numpy as np
+
+import meshfmm
+from conftest import DATA
+
+
+def _case(name):
+    d = np.load(DATA / "oracles" / name)
+    return d["V"], d["F"], int(d["source"])
+
+
+def test_a_strip_that_folds_back_gives_no_virtual_edge():
+    # two flat pages on one spine, folded 66 degrees, 67 vertices: a strip
+    # unfolded from an obtuse corner folded back over itself and put the
+    # virtual vertex 1167 from the corner, where the straight line is 2896
+    # and the surface's shortest path 4966 (section 4.2's virtual edges)
+    V, F, s = _case("book_strip_folds_back.npz")
+    m = meshfmm.Mesh(V, F)
+    assert m.info.n_virtual_edges + m.info.n_unfold_failures == m.info.n_obtuse_corners
+    euclid = np.linalg.norm(V - V[s], axis=1)
+    for kwargs in ({"exact_start": False}, {}):
+        d = m.distance(s, **kwargs)
+        assert np.all(d >= euclid * (1 - 1e-12)), kwargs
+
+
+def test_a_window_unfolded_onto_a_short_edge_keeps_its_scale():
+    # a flat disk with three vertex pairs 2e-14 apart: a window's frame on a
+    # 2e-14 edge of a face 0.05 long was scaled by the rounding of the long
+    # edge, and the exact distance came out 1.1e-8 below the Euclidean one
+    V, F, s = _case("disk_short_edge_frame.npz")
+    euclid = np.linalg.norm(V - V[s], axis=1)
+    exact = meshfmm.Mesh(V, F).distance(s, method="exact")
+    assert np.all(np.abs(exact - euclid) <= 1e-12 * euclid + 1e-15)
