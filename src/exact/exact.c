@@ -1078,15 +1078,18 @@ static void ex_set_in(mfmm_exact_ws *ws, int32_t v, int32_t c, double psi, doubl
  * shorter than the paths through the edge's ends, with distances dA (at 0)
  * and dB (at L). sigma + |I X| - (dA + t) does not increase with t, so the
  * part beaten by A is [0, t*), t* the root of
- * sigma + sqrt((t - px)^2 + py^2) = dA + t; likewise from B. Returns 0 when
- * too little is left. Without branches (an end not reached yet, d = +inf,
+ * sigma + sqrt((t - px)^2 + py^2) = dA + t; likewise from B. A tie within
+ * EX_TIE keeps the window: where I, A and the edge are almost on one line
+ * the two sides are equal to rounding, and a window trimmed at a vertex that
+ * starts no windows (a flat one) left what lay behind it unreached (+inf, or
+ * longer than a path along the edges). Returns 0 when too little is left. Without branches (an end not reached yet, d = +inf,
  * gives inf / inf = NaN, which moves nothing): whether an end moves is data
  * the branch predictor cannot guess. */
 static int ex_trim(double px, double py, double sigma, double L, double dA, double dB,
                    double *b0, double *b1)
 {
     double py2 = py * py;
-    double a = dA - sigma, qx = L - px, c = dB - sigma;
+    double a = dA + EX_TIE * dA - sigma, qx = L - px, c = dB + EX_TIE * dB - sigma;
     int ok = !(px + a <= 0.0) & !(qx + c <= 0.0);
     double t0 = (px * px + py2 - a * a) / (2.0 * (px + a));
     double t1 = L - (qx * qx + py2 - c * c) / (2.0 * (qx + c));
