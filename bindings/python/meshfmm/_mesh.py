@@ -329,7 +329,9 @@ class Mesh:
     A Mesh may be used from several threads at once: each concurrent call
     gets its own solver workspace, and the C calls release the GIL. Free it
     early with :meth:`close` or a ``with`` block; otherwise it is freed when
-    garbage-collected.
+    garbage-collected. :meth:`close` may be called while other threads
+    compute: it refuses new calls at once (ValueError), waits for the calls
+    in flight to end, then frees the C memory.
 
     Copies are independent: ``copy.copy``, ``copy.deepcopy`` and pickling
     rebuild the C mesh from ``vertices``, ``faces`` and the options, so
@@ -351,7 +353,12 @@ class Mesh:
         self._max_unfold_steps = max_unfold_steps
         self._spokes = _flag(spokes, "spokes")
         self._lock = threading.Lock()
-        self._active = 0
+        # _leave notifies it when the last call in flight ends (close waits on it)
+        self._idle = threading.Condition(self._lock)
+        self._active = 0  # calls in flight
+        self._callers: Dict[int, int] = {}  # thread id -> its calls in flight
+        self._closing = False  # close() was called: no new calls
+        self._close_waiters = 0  # close() calls waiting for the calls in flight
         self._solvers: List[int] = []
         self._exact_solvers: List[int] = []
         #: Name of the backend that ran the last :meth:`distance_matrix` call
@@ -422,43 +429,100 @@ class Mesh:
         return {"max_unfold_steps": self._max_unfold_steps, "spokes": self._spokes}
 
     def __reduce__(self) -> Tuple[Any, ...]:
-        if self._ptr is None:
+        if self.closed:
             raise ValueError("cannot pickle or copy a closed mesh")
         return (_rebuild_mesh, (type(self), self._V, self._F, self._options()))
 
     def __copy__(self) -> "Mesh":
         # a new C mesh (the vertex and face arrays are read-only, so shared)
-        if self._ptr is None:
+        if self.closed:
             raise ValueError("cannot copy a closed mesh")
         return _rebuild_mesh(type(self), self._V, self._F, self._options())
 
     def __deepcopy__(self, memo: dict) -> "Mesh":
-        if self._ptr is None:
+        if self.closed:
             raise ValueError("cannot copy a closed mesh")
         return _rebuild_mesh(type(self), self._V.copy(), self._F.copy(), self._options())
 
     # ---- lifetime
-    def close(self) -> None:
-        """Frees the C mesh and its solvers now. Idempotent. Raises
-        RuntimeError if another thread is computing on this mesh."""
-        with self._lock:
-            if self._ptr is None:
-                return
-            if self._active:
-                raise RuntimeError("Mesh.close(): another thread is still computing on this mesh")
-            ptr, self._ptr = self._ptr, None
-            solvers, self._solvers = self._solvers, []
-            exact, self._exact_solvers = self._exact_solvers, []
-        for s in solvers:
-            _lib.mfmm_solver_destroy(s)
-        for s in exact:
-            _lib.mfmm_exact_solver_destroy(s)
-        _lib.mfmm_mesh_destroy(ptr)
+    def close(self, timeout: Optional[float] = None) -> None:
+        """Frees the C mesh and its solver workspaces. Idempotent.
+
+        The mesh is closed to new calls at once: from then on every method
+        that reaches the C library (:meth:`distance`, :meth:`distance_matrix`,
+        :meth:`geodesic_path`, :meth:`memory`, ...) raises
+        ``ValueError("the mesh is closed")``, from any thread. Calls that other
+        threads already have in flight run to the end with their normal
+        results; close() waits for them, then frees the memory and returns.
+        (The Python-side properties -- ``vertices``, ``faces``, ``info``,
+        ``n_vertices`` -- stay readable.)
+
+        timeout: None (default) waits as long as the calls in flight take;
+            a number of seconds >= 0 waits at most that long (0: not at all).
+            When calls are still in flight then, TimeoutError is raised and
+            the mesh stays closed to new calls; the last call in flight frees
+            the memory as it returns (a later close() waits for that, and
+            garbage collection frees whatever is left).
+
+        Raises RuntimeError, and changes nothing, when the calling thread
+        itself has a call on this mesh in flight (close() from a ``progress``
+        callback, for one): it would wait for itself. The call in flight then
+        goes on, and the mesh stays open. Safe to call from any thread, and
+        from several at once.
+        """
+        if timeout is not None:
+            if isinstance(timeout, (bool, np.bool_)) or not isinstance(timeout, numbers.Real):
+                raise TypeError(f"timeout must be a number of seconds or None, got {timeout!r}")
+            timeout = float(timeout)
+            if math.isnan(timeout) or timeout < 0:
+                raise ValueError(f"timeout must be >= 0 seconds or None, got {timeout!r}")
+        freed = None
+        busy = 0
+        try:
+            with self._idle:
+                if self._ptr is None:
+                    return
+                if self._callers.get(threading.get_ident()):
+                    raise RuntimeError(
+                        "Mesh.close() called on a thread that has a call on this mesh in "
+                        "flight (from a callback?): it would wait for itself; close the mesh "
+                        "after the call returns"
+                    )
+                self._closing = True
+                self._close_waiters += 1
+                try:
+                    self._idle.wait_for(lambda: self._active == 0, timeout)
+                finally:
+                    # also when the wait is interrupted (Ctrl-C): with calls still
+                    # in flight, the last of them frees the mesh (_leave)
+                    self._close_waiters -= 1
+                    busy = self._active
+                    if not busy:
+                        freed = self._detach()
+        finally:
+            if freed is not None:
+                _free(*freed)
+        if busy:
+            raise TimeoutError(
+                f"Mesh.close(): {busy} call(s) on this mesh still in flight after {timeout} s; "
+                "the mesh takes no new calls and is freed when they end"
+            )
+
+    def _detach(self) -> Tuple[Optional[int], List[int], List[int]]:
+        """With the lock held and no call in flight: takes the C pointers off
+        the mesh (which is then closed) for _free to release outside the lock."""
+        ptr, self._ptr = self._ptr, None
+        solvers, self._solvers = self._solvers, []
+        exact, self._exact_solvers = self._exact_solvers, []
+        self._closing = True
+        return ptr, solvers, exact
 
     @property
     def closed(self) -> bool:
-        """True once :meth:`close` has freed the mesh."""
-        return self._ptr is None
+        """True once :meth:`close` has been called: the mesh takes no new
+        calls. (After a close() that timed out, the C memory is freed a
+        little later, when the calls in flight end.)"""
+        return self._closing or self._ptr is None
 
     def __enter__(self) -> "Mesh":
         return self
@@ -467,22 +531,51 @@ class Mesh:
         self.close()
 
     def __del__(self) -> None:
+        # Never blocks: garbage collection may run it on any thread, at any
+        # point. With no reference left no call can be in flight, so the lock
+        # is free; if it is not, the memory is left to the process's end.
         try:
-            if getattr(self, "_ptr", None) is not None and not self._active:
-                self.close()
+            lock = getattr(self, "_lock", None)
+            if lock is None or getattr(self, "_ptr", None) is None:
+                return
+            if not lock.acquire(blocking=False):
+                return
+            try:
+                if self._active or self._ptr is None:
+                    return
+                freed = self._detach()
+            finally:
+                lock.release()
+            _free(*freed)
         except Exception:  # interpreter shutdown: the library may be gone
             pass
 
     def _enter(self) -> int:
         with self._lock:
-            if self._ptr is None:
+            if self._ptr is None or self._closing:
                 raise ValueError("the mesh is closed")
             self._active += 1
+            me = threading.get_ident()
+            self._callers[me] = self._callers.get(me, 0) + 1
             return self._ptr
 
     def _leave(self) -> None:
+        freed = None
         with self._lock:
             self._active -= 1
+            me = threading.get_ident()
+            left = self._callers[me] - 1
+            if left:
+                self._callers[me] = left
+            else:
+                del self._callers[me]
+            if self._active == 0 and self._closing:
+                if self._close_waiters:
+                    self._idle.notify_all()  # a waiting close() frees the mesh
+                elif self._ptr is not None:
+                    freed = self._detach()  # after a close() that timed out
+        if freed is not None:
+            _free(*freed)
 
     def _take_solver(self, mesh_ptr: int) -> int:
         try:
@@ -538,7 +631,12 @@ class Mesh:
         return {names[i].decode(): int(sizes[i]) for i in range(n)}
 
     def __repr__(self) -> str:
-        state = "closed" if self._ptr is None else f"{self._nv} vertices, {self._nf} faces"
+        if self._ptr is None:
+            state = "closed"
+        elif self._closing:
+            state = "closed, freed when its calls in flight end"
+        else:
+            state = f"{self._nv} vertices, {self._nf} faces"
         return f"<meshfmm.Mesh {state}>"
 
     # ---- distances
@@ -1068,6 +1166,16 @@ def _sigint_as_flag(flag: List[int]) -> Iterator[None]:
         yield
     finally:
         signal.signal(signal.SIGINT, previous)
+
+
+def _free(ptr: Optional[int], solvers: List[int], exact: List[int]) -> None:
+    """Releases what Mesh._detach took off a mesh."""
+    for s in solvers:
+        _lib.mfmm_solver_destroy(s)
+    for s in exact:
+        _lib.mfmm_exact_solver_destroy(s)
+    if ptr is not None:
+        _lib.mfmm_mesh_destroy(ptr)
 
 
 def _rebuild_mesh(cls: type, V: np.ndarray, F: np.ndarray, options: dict) -> Mesh:
