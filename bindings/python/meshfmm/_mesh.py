@@ -740,6 +740,10 @@ class Mesh:
         out = np.empty(self._nv, dtype=np.float64)
         err = _lib.mfmm_error()
         info = _lib.mfmm_exact_info()
+        # Ctrl-C stops a long solve: the library asks every few milliseconds
+        interrupted: List[int] = []
+        interrupt = type(opts.interrupt)(lambda user: 1 if interrupted else 0)
+        opts.interrupt = interrupt
         solver = None
         mesh_ptr = self._enter()
         try:
@@ -749,12 +753,15 @@ class Mesh:
                 ptr = ctypes.c_void_p()
                 _lib.check(_lib.mfmm_exact_solver_create(mesh_ptr, byref(ptr)))
                 solver = ptr.value
-            status = _lib.mfmm_solve_exact(solver, _addr(src), src.shape[0], byref(opts),
-                                           _addr(out), byref(info), byref(err))
+            with _sigint_as_flag(interrupted):
+                status = _lib.mfmm_solve_exact(solver, _addr(src), src.shape[0], byref(opts),
+                                               _addr(out), byref(info), byref(err))
         finally:
             if solver is not None:
                 self._exact_solvers.append(solver)
             self._leave()
+        if interrupted:
+            raise KeyboardInterrupt
         if status:
             raise _lib.make_error(status, err)
         return out
