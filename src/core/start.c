@@ -56,6 +56,36 @@ void mfmm_source_locate(const mfmm_mesh *mesh, const mfmm_source *src, mfmm_sour
         memcpy(loc->p, mesh->xyz + 3 * (size_t)fv[top], sizeof loc->p);
         return;
     }
+    if (n_zero == 0) {
+        /* on an edge's line to rounding, as start_face tests it (2e-12 here
+         * against its 1e-12, so that every edge it does not cross because
+         * the point lies on it is this one): a point of both faces, whose
+         * neighbour then starts too (a point on the line a T-junction's face
+         * was split along seeded one piece, and the other's far corner got
+         * its distance round the junction, 1.559 for 0.559) */
+        int k = 0;
+        for (int j = 1; j < 3; j++)
+            if (src->bary[j] < src->bary[k])
+                k = j;
+        const double *xa = mesh->xyz + 3 * (size_t)fv[(k + 1) % 3],
+                     *xb = mesh->xyz + 3 * (size_t)fv[(k + 2) % 3];
+        double p[3] = {0.0, 0.0, 0.0}, u[3], v[3];
+        for (int j = 0; j < 3; j++)
+            for (int c = 0; c < 3; c++)
+                p[c] += src->bary[j] * mesh->xyz[3 * (size_t)fv[j] + c];
+        for (int c = 0; c < 3; c++) {
+            u[c] = xa[c] - p[c];
+            v[c] = xb[c] - p[c];
+        }
+        double cr[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                        u[0] * v[1] - u[1] * v[0]};
+        double nu = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]),
+               nv = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        if (sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]) <= 2e-12 * nu * nv) {
+            n_zero = 1;
+            zero = k;
+        }
+    }
     loc->kind = n_zero == 1 ? MFMM_ON_EDGE : MFMM_IN_FACE;
     if (n_zero == 1) {
         loc->zero = zero;

@@ -60,3 +60,20 @@ def test_a_window_tied_with_a_path_through_a_flat_vertex_is_kept():
         assert np.all(np.isfinite(exact)), name
         assert np.all(exact >= euclid * (1 - 1e-12)), name
         assert np.all(exact <= graph * (1 + 1e-12)), name
+
+
+def test_a_point_on_the_line_a_face_was_split_along_starts_both_pieces():
+    # a T-junction: (2, 0) on the edge (3, 0)-(0, 0) of face 1, closed by a
+    # zero-area face; the face is split there at build time, and a point on
+    # the line of that split (to rounding) started only one piece, so the
+    # other piece's corner (3, 0) got its distance round the junction: 1.559
+    # where the straight segment is 0.559
+    V = np.array([[2.0, 0, 0], [3, 0, 0], [0, 0, 0], [4, 1, 0]])
+    F = np.array([[0, 1, 2], [1, 3, 2]])
+    m = meshfmm.Mesh(V, F)
+    bary = np.array([0.5, 0.25, 0.25])
+    euclid = np.linalg.norm(V - bary @ V[F[1]], axis=1)
+    src = meshfmm.SurfacePoint(1, bary)
+    for kwargs in ({"exact_start": False}, {}, {"method": "exact"}):
+        d = m.distance(src, **kwargs)
+        assert np.allclose(d, euclid, rtol=1e-12, atol=0), kwargs
