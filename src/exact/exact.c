@@ -1078,18 +1078,20 @@ static void ex_set_in(mfmm_exact_ws *ws, int32_t v, int32_t c, double psi, doubl
  * shorter than the paths through the edge's ends, with distances dA (at 0)
  * and dB (at L). sigma + |I X| - (dA + t) does not increase with t, so the
  * part beaten by A is [0, t*), t* the root of
- * sigma + sqrt((t - px)^2 + py^2) = dA + t; likewise from B. A tie within
- * EX_TIE keeps the window: where I, A and the edge are almost on one line
- * the two sides are equal to rounding, and a window trimmed at a vertex that
- * starts no windows (a flat one) left what lay behind it unreached (+inf, or
- * longer than a path along the edges). Returns 0 when too little is left. Without branches (an end not reached yet, d = +inf,
+ * sigma + sqrt((t - px)^2 + py^2) = dA + t; likewise from B. The caller
+ * raises dA by EX_TIE where A starts no windows (a flat vertex): where I, A
+ * and the edge are almost on one line the two sides are equal to rounding,
+ * and a window trimmed there left what lay behind A unreached (+inf, or
+ * longer than a path along the edges). Not where A starts windows: those
+ * carry the path on, and windows kept at ties there went round coincident
+ * vertices without end. Returns 0 when too little is left. Without branches (an end not reached yet, d = +inf,
  * gives inf / inf = NaN, which moves nothing): whether an end moves is data
  * the branch predictor cannot guess. */
 static int ex_trim(double px, double py, double sigma, double L, double dA, double dB,
                    double *b0, double *b1)
 {
     double py2 = py * py;
-    double a = dA + EX_TIE * dA - sigma, qx = L - px, c = dB + EX_TIE * dB - sigma;
+    double a = dA - sigma, qx = L - px, c = dB - sigma;
     int ok = !(px + a <= 0.0) & !(qx + c <= 0.0);
     double t0 = (px * px + py2 - a * a) / (2.0 * (px + a));
     double t1 = L - (qx * qx + py2 - c * c) / (2.0 * (qx + c));
@@ -1179,7 +1181,12 @@ MFMM_INLINE void ex_enqueue(mfmm_exact_ws *ws, int32_t g, int fl, int32_t va, in
     if (key > ws->max_d)
         return;
     /* pruning against the ends of the edge */
-    if (!ex_trim(ix, -iy, sigma, L, ws->d[va], ws->d[vb], &s0, &s1))
+    /* a tie with a path through an end that starts no windows keeps the
+     * window (ex_trim); an end that does start them carries that path on */
+    double da = ws->d[va], db = ws->d[vb];
+    da += ws->pseudo[va] ? 0.0 : EX_TIE * da;
+    db += ws->pseudo[vb] ? 0.0 : EX_TIE * db;
+    if (!ex_trim(ix, -iy, sigma, L, da, db, &s0, &s1))
         return;
     int32_t wi = ex_new(ws);
     if (wi < 0)

@@ -77,3 +77,17 @@ def test_a_point_on_the_line_a_face_was_split_along_starts_both_pieces():
     for kwargs in ({"exact_start": False}, {}, {"method": "exact"}):
         d = m.distance(src, **kwargs)
         assert np.allclose(d, euclid, rtol=1e-12, atol=0), kwargs
+
+
+def test_windows_tied_at_coincident_vertices_do_not_go_round_for_ever():
+    # a flat grid with two vertices at one point: windows kept at ties with
+    # paths through them (which start windows of their own) went round the
+    # two without end; the solve must end, within the bounds
+    d = np.load(DATA / "oracles" / "coincident_tie_loop.npz")
+    V, F = d["V"], d["F"]
+    bary = d["source_bary"]
+    src = meshfmm.SurfacePoint(int(d["source_face"]), bary)
+    euclid = np.linalg.norm(V - bary @ V[F[int(d["source_face"])]], axis=1)
+    exact = meshfmm.Mesh(V, F).distance(src, method="exact")
+    assert np.all(np.isfinite(exact))
+    assert np.all(exact >= euclid * (1 - 1e-12))
