@@ -6,12 +6,38 @@
  * it where the full solve fell back to walls at non-manifold edges); the march
  * from the exact start without NaN or negative values.
  *
+ * Bounds on every vertex, for the exact solve and for the march (each source
+ * k a 3D point p_k with its value t_k; tests/python/oracles.py checks the
+ * same on random flat, slit and book meshes):
+ *   lower: min_k t_k + |x_v - p_k|, the Euclidean distance (any path on the
+ *          surface is at least as long as the straight segment, whatever the
+ *          faces: zero-area, folded, coincident vertices);
+ *   upper: the shortest path along edges of faces of nonzero area (with a
+ *          margin over the library's zero-area test, so that a face it drops
+ *          is never used), from each source vertex, or from a face source
+ *          through its corners (t_k + |c - p_k| to corner c): a path on the
+ *          surface the solvers must not exceed;
+ *   reach: where that path is finite the distance is finite, unless
+ *          max_distance is set and the path is longer than it; a finite
+ *          distance is at most max_distance.
+ * The exact solve must meet both to rounding (1e-12 relative, 1e-13 of the
+ * mesh size). Where it fell back to walls at non-manifold edges its values
+ * are upper bounds of the geodesic distance, still paths on the surface: the
+ * bounds hold there too. The march must meet the upper one to rounding, and
+ * from one source the lower one to 1e-6 relative (tests/python/oracles.py:
+ * bench/oracle_sweep.py measured -7.5e-8 at the 1e-4 quantile of the plain
+ * start, the one below -1e-6 a defect);
+ * from two sources with values a triangle's planar update may be below the
+ * Euclidean distance from either (the lower bound, a minimum of two cones, is
+ * not convex).
+ *
  * Input layout (all optional past the end: zeros):
  *   byte 0: nv - 3 (3..66)      byte 1: nf - 1 (1..128)
  *   byte 2: flags: 1 face source, 2 max_distance, 4 memory_limit, 8 two sources
  *   byte 3: radius of the exact start, in eighths of a mean edge (0..31)
  *   then nv * 3 int8 coordinates / 8, nf * 3 vertex bytes (mod nv),
  *   the source bytes, a max_distance byte. */
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -23,6 +49,133 @@
 #include "exact/exact.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+/* Relative and absolute (of the mesh size) rounding allowed on the bounds,
+ * and the march's undershoot of the Euclidean distance (tests/python/oracles.py). */
+#define BOUND_REL 1e-12
+#define BOUND_ABS 1e-13
+#define MARCH_UNDER_REL 1e-6
+
+static double dist3(const double *a, const double *b)
+{
+    double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
+    return sqrt(x * x + y * y + z * z);
+}
+
+/* A face of nonzero area with a factor 4 over the library's zero-area test
+ * (src/core/mesh.c: the sine between two unit edge vectors above
+ * 64 eps (lmax / l0) (lmax / l1)). */
+static int solid_face(const double *V, const int32_t *f)
+{
+    double e[3][3], len[3];
+    for (int k = 0; k < 3; k++) {
+        const double *a = V + 3 * f[(k + 1) % 3], *b = V + 3 * f[(k + 2) % 3];
+        for (int d = 0; d < 3; d++)
+            e[k][d] = b[d] - a[d];
+        len[k] = sqrt(e[k][0] * e[k][0] + e[k][1] * e[k][1] + e[k][2] * e[k][2]);
+    }
+    if (!(len[0] > 0.0 && len[1] > 0.0))
+        return 0;
+    double lmax = fmax(len[0], fmax(len[1], len[2])), u[3], w[3];
+    for (int d = 0; d < 3; d++) {
+        u[d] = e[0][d] / len[0];
+        w[d] = e[1][d] / len[1];
+    }
+    double c0 = u[1] * w[2] - u[2] * w[1], c1 = u[2] * w[0] - u[0] * w[2],
+           c2 = u[0] * w[1] - u[1] * w[0];
+    double sine = sqrt(c0 * c0 + c1 * c1 + c2 * c2);
+    return sine > 4.0 * 64.0 * DBL_EPSILON * (lmax / len[0]) * (lmax / len[1]);
+}
+
+/* The bounds of every vertex (header comment): lo the Euclidean one, hi the
+ * edge-graph path (+inf where none reaches), by Dijkstra on a dense matrix
+ * (nv <= 66). Returns 0 when out of memory. */
+static int bounds(const double *V, int32_t nv, const int32_t *F, int32_t nf,
+                  const mfmm_source *src, int n_src, double *lo, double *hi)
+{
+    double *W = malloc((size_t)nv * nv * sizeof *W);
+    char *done = calloc((size_t)nv, 1), *solid = calloc((size_t)nv, 1);
+    if (!W || !done || !solid) {
+        free(W);
+        free(done);
+        free(solid);
+        return 0;
+    }
+    for (int32_t i = 0; i < nv * nv; i++)
+        W[i] = INFINITY;
+    for (int32_t f = 0; f < nf; f++) {
+        if (!solid_face(V, F + 3 * f))
+            continue;
+        for (int k = 0; k < 3; k++) {
+            solid[F[3 * f + k]] = 1;
+            int32_t p = F[3 * f + k], q = F[3 * f + (k + 1) % 3];
+            double len = dist3(V + 3 * p, V + 3 * q);
+            if (len < W[p * nv + q])
+                W[p * nv + q] = W[q * nv + p] = len;
+        }
+    }
+    for (int32_t v = 0; v < nv; v++) {
+        lo[v] = hi[v] = INFINITY;
+    }
+    for (int k = 0; k < n_src; k++) {
+        double p[3];
+        if (src[k].face < 0) {
+            memcpy(p, V + 3 * src[k].vertex, sizeof p);
+            /* a vertex on no face of nonzero area may be +inf */
+            if (solid[src[k].vertex])
+                hi[src[k].vertex] = fmin(hi[src[k].vertex], src[k].value);
+        } else {
+            const int32_t *f = F + 3 * src[k].face;
+            for (int d = 0; d < 3; d++)
+                p[d] = src[k].bary[0] * V[3 * f[0] + d] + src[k].bary[1] * V[3 * f[1] + d] +
+                       src[k].bary[2] * V[3 * f[2] + d];
+            /* the segment from p to a corner lies in the face (solid or not:
+             * then the path may be longer, never shorter, which keeps hi an
+             * upper bound only where the face is solid) */
+            if (solid_face(V, f))
+                for (int c = 0; c < 3; c++)
+                    hi[f[c]] = fmin(hi[f[c]], src[k].value + dist3(p, V + 3 * f[c]));
+        }
+        for (int32_t v = 0; v < nv; v++)
+            lo[v] = fmin(lo[v], src[k].value + dist3(V + 3 * v, p));
+    }
+    for (;;) {
+        int32_t u = -1;
+        for (int32_t v = 0; v < nv; v++)
+            if (!done[v] && isfinite(hi[v]) && (u < 0 || hi[v] < hi[u]))
+                u = v;
+        if (u < 0)
+            break;
+        done[u] = 1;
+        for (int32_t v = 0; v < nv; v++)
+            if (hi[u] + W[u * nv + v] < hi[v])
+                hi[v] = hi[u] + W[u * nv + v];
+    }
+    free(W);
+    free(done);
+    free(solid);
+    return 1;
+}
+
+/* Whether distances d meet the bounds: d >= lo (1 - under) - tol (under
+ * < 0: not checked), d <= hi (1 + BOUND_REL) + tol, finite where hi is (up
+ * to max_distance), at most max_distance where finite. */
+static int within(const double *d, const double *lo, const double *hi, int32_t nv,
+                  double under, double maxd, double tol)
+{
+    for (int32_t v = 0; v < nv; v++) {
+        if (under >= 0.0 && !(d[v] >= lo[v] * (1.0 - under) - tol))
+            return 0;
+        if (isfinite(d[v])) {
+            if (!(d[v] <= hi[v] * (1.0 + BOUND_REL) + tol) ||
+                !(d[v] <= maxd * (1.0 + BOUND_REL) + tol))
+                return 0;
+        } else if (hi[v] * (1.0 + BOUND_REL) + tol < maxd) {
+            return 0; /* a path shorter than max_distance, and no distance */
+        }
+    }
+    return 1;
+}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
@@ -63,8 +216,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (flags & 4)
         eo.memory_limit = 4096 + 64 * (size_t)next(&r);
     double *e = malloc((size_t)nv * sizeof *e), *d = malloc((size_t)nv * sizeof *d);
+    double *lo = malloc((size_t)nv * sizeof *lo), *hi = malloc((size_t)nv * sizeof *hi);
     mfmm_exact_solver *ex = NULL;
-    if (!e || !d || mfmm_exact_solver_create(mesh, &ex) != MFMM_OK)
+    if (!e || !d || !lo || !hi || mfmm_exact_solver_create(mesh, &ex) != MFMM_OK)
         goto done;
     mfmm_exact_info info;
     mfmm_status st = mfmm_solve_exact(ex, src, n_src, &eo, e, &info, &err);
@@ -76,6 +230,18 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (int32_t v = 0; v < nv; v++)
         if (isnan(e[v]) || e[v] < 0)
             abort();
+    /* the Euclidean and edge-graph bounds (header comment), to rounding of
+     * the mesh's size and the sources' values */
+    double extent = 0.0, maxd = flags & 2 ? eo.max_distance : INFINITY;
+    for (int32_t v = 0; v < nv; v++)
+        extent = fmax(extent, dist3(V + 3 * v, V));
+    for (int k = 0; k < n_src; k++)
+        extent += src[k].value;
+    double btol = BOUND_ABS * (2.0 * extent + 1.0);
+    if (!bounds(V, nv, F, nf, src, n_src, lo, hi))
+        goto done;
+    if (!within(e, lo, hi, nv, BOUND_REL, maxd, btol))
+        abort();
     /* a vertex source at its value (or less, from another source), unless it
      * is beyond max_distance or on no face of nonzero area (+inf) */
     for (int k = 0; k < n_src; k++)
@@ -144,16 +310,26 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         mfmm_solve_options_init(&so);
         so.exact_start_radius = radius;
         st = mfmm_solve(solver, src, n_src, &so, d, &err);
-        if (st == MFMM_OK)
+        if (st == MFMM_OK) {
             for (int32_t v = 0; v < nv; v++)
                 if (isnan(d[v]) || d[v] < 0)
                     abort();
+            /* the lower bound from one source only: from two, the update
+             * of a triangle fits a plane to both values (a front that is
+             * neither circle), below the Euclidean distance from either
+             * (0.2 % on one triangle with values 0 and 0.75 on an edge of
+             * 0.77) */
+            if (!within(d, lo, hi, nv, n_src == 1 ? MARCH_UNDER_REL : -1.0, INFINITY, btol))
+                abort();
+        }
         mfmm_solver_destroy(solver);
     }
 done:
     mfmm_exact_solver_destroy(ex);
     free(e);
     free(d);
+    free(lo);
+    free(hi);
     mfmm_mesh_destroy(mesh);
     return 0;
 }
