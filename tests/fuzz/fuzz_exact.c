@@ -23,13 +23,17 @@
  * The exact solve must meet both to rounding (1e-12 relative, 1e-13 of the
  * mesh size). Where it fell back to walls at non-manifold edges its values
  * are upper bounds of the geodesic distance, still paths on the surface: the
- * bounds hold there too. The march must meet the upper one to rounding, and
- * from one source the lower one to 1e-6 relative (tests/python/oracles.py:
- * bench/oracle_sweep.py measured -7.5e-8 at the 1e-4 quantile of the plain
- * start, the one below -1e-6 a defect);
+ * bounds hold there too. The march is checked for gross defects only (a
+ * shortcut such as a virtual edge beside its strip gave 60 % below): within
+ * MARCH_UNDER_REL below the lower bound from one source, MARCH_OVER_REL above
+ * the upper one. It meets neither to rounding: the planar update of a
+ * virtual triangle (section 4.2), which need not lie on the surface, can
+ * fall below a front curved across it (4.6 % on an 8-vertex flat mesh, 3 %
+ * found here with a 2-edge exact start), the straight start does not cross
+ * the non-manifold edge a T-junction's split can leave (20 % above), and
  * from two sources with values a triangle's planar update may be below the
  * Euclidean distance from either (the lower bound, a minimum of two cones, is
- * not convex).
+ * not convex). bench/oracle_sweep.py holds the default march to 1e-8.
  *
  * Input layout (all optional past the end: zeros):
  *   byte 0: nv - 3 (3..66)      byte 1: nf - 1 (1..128)
@@ -54,7 +58,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
  * and the march's undershoot of the Euclidean distance (tests/python/oracles.py). */
 #define BOUND_REL 1e-12
 #define BOUND_ABS 1e-13
-#define MARCH_UNDER_REL 1e-6
+#define MARCH_UNDER_REL 0.25
+#define MARCH_OVER_REL 0.5
 
 static double dist3(const double *a, const double *b)
 {
@@ -158,16 +163,16 @@ static int bounds(const double *V, int32_t nv, const int32_t *F, int32_t nf,
 }
 
 /* Whether distances d meet the bounds: d >= lo (1 - under) - tol (under
- * < 0: not checked), d <= hi (1 + BOUND_REL) + tol, finite where hi is (up
- * to max_distance), at most max_distance where finite. */
+ * < 0: not checked), d <= hi (1 + over) + tol, finite where hi is (up to
+ * max_distance), at most max_distance where finite. */
 static int within(const double *d, const double *lo, const double *hi, int32_t nv,
-                  double under, double maxd, double tol)
+                  double under, double over, double maxd, double tol)
 {
     for (int32_t v = 0; v < nv; v++) {
         if (under >= 0.0 && !(d[v] >= lo[v] * (1.0 - under) - tol))
             return 0;
         if (isfinite(d[v])) {
-            if (!(d[v] <= hi[v] * (1.0 + BOUND_REL) + tol) ||
+            if (!(d[v] <= hi[v] * (1.0 + over) + tol) ||
                 !(d[v] <= maxd * (1.0 + BOUND_REL) + tol))
                 return 0;
         } else if (hi[v] * (1.0 + BOUND_REL) + tol < maxd) {
@@ -240,7 +245,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     double btol = BOUND_ABS * (2.0 * extent + 1.0);
     if (!bounds(V, nv, F, nf, src, n_src, lo, hi))
         goto done;
-    if (!within(e, lo, hi, nv, BOUND_REL, maxd, btol))
+    if (!within(e, lo, hi, nv, BOUND_REL, BOUND_REL, maxd, btol))
         abort();
     /* a vertex source at its value (or less, from another source), unless it
      * is beyond max_distance or on no face of nonzero area (+inf) */
@@ -319,7 +324,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
              * neither circle), below the Euclidean distance from either
              * (0.2 % on one triangle with values 0 and 0.75 on an edge of
              * 0.77) */
-            if (!within(d, lo, hi, nv, n_src == 1 ? MARCH_UNDER_REL : -1.0, INFINITY, btol))
+            if (!within(d, lo, hi, nv, n_src == 1 ? MARCH_UNDER_REL : -1.0, MARCH_OVER_REL,
+                        INFINITY, btol))
                 abort();
         }
         mfmm_solver_destroy(solver);
