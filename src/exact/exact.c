@@ -149,7 +149,8 @@ typedef struct ex_face {
     int32_t v[3], across[3];
     uint8_t flip[3], skip;
     int8_t sgn[3];   /* the corners' fan_sgn (see mfmm_exact_tables) */
-    uint8_t pad[128 - 12 * sizeof(double) - 6 * sizeof(int32_t) - 7];
+    uint8_t tie;     /* bit k: corner k starts no windows, so a window tied with a
+                        path through it is kept (ex_enqueue) */
 } ex_face;
 
 /* An entry of the queue: a window, or a vertex to start as a pseudo-source. */
@@ -741,6 +742,12 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
         }
         t->height[v] = h;
     }
+    for (int32_t f = 0; f < t->nf; f++) {
+        ex_face *r = t->fr + f;
+        r->tie = 0;
+        for (int k = 0; k < 3; k++)
+            r->tie |= (uint8_t)((t->pseudo[r->v[k]] ? 0 : 1) << k);
+    }
     *out = t;
     return MFMM_OK;
 }
@@ -1162,7 +1169,8 @@ static void ex_pass(mfmm_exact_ws *ws, int32_t hd, int flip, double L, double s0
  * half-edge g (fl: g runs from vb to va), trimmed against the edge's
  * ends. */
 MFMM_INLINE void ex_enqueue(mfmm_exact_ws *ws, int32_t g, int fl, int32_t va, int32_t vb,
-                            double L, double s0, double s1, double ix, double iy, double sigma)
+                            double L, double s0, double s1, double ix, double iy, double sigma,
+                            int tie_a, int tie_b)
 {
     double iy2 = iy * iy;
 #ifdef __GNUC__
@@ -1184,8 +1192,8 @@ MFMM_INLINE void ex_enqueue(mfmm_exact_ws *ws, int32_t g, int fl, int32_t va, in
     /* a tie with a path through an end that starts no windows keeps the
      * window (ex_trim); an end that does start them carries that path on */
     double da = ws->d[va], db = ws->d[vb];
-    da += ws->pseudo[va] ? 0.0 : EX_TIE * da;
-    db += ws->pseudo[vb] ? 0.0 : EX_TIE * db;
+    da += tie_a ? EX_TIE * da : 0.0;
+    db += tie_b ? EX_TIE * db : 0.0;
     if (!ex_trim(ix, -iy, sigma, L, da, db, &s0, &s1))
         return;
     int32_t wi = ex_new(ws);
@@ -1249,7 +1257,8 @@ MFMM_INLINE void ex_emit_inline(mfmm_exact_ws *ws, int32_t h, double s0, double 
             ex_fan_out(ws, h, va, vb, L, s0, s1, ix, iy, sigma);
         return;
     }
-    ex_enqueue(ws, g, r->flip[k], va, vb, L, s0, s1, ix, iy, sigma);
+    ex_enqueue(ws, g, r->flip[k], va, vb, L, s0, s1, ix, iy, sigma, (r->tie >> k1) & 1,
+               (r->tie >> k2) & 1);
 }
 
 /* D(x) - D'(x) of two windows on one edge, in units of the edge */
@@ -1459,7 +1468,8 @@ static void ex_fan_out(mfmm_exact_ws *ws, int32_t h, int32_t va, int32_t vb, dou
         if (!ex_dominate(ws, i, L, &n0, &n1, npx, -iy, sigma))
             continue;
         ex_keep(ws, i, n0, n1, npx, -iy, sigma);
-        ex_enqueue(ws, g, fl, va, vb, L, fl ? L - n1 : n0, fl ? L - n0 : n1, ix, iy, sigma);
+        ex_enqueue(ws, g, fl, va, vb, L, fl ? L - n1 : n0, fl ? L - n0 : n1, ix, iy, sigma,
+                   !ws->pseudo[va], !ws->pseudo[vb]);
     }
 }
 
