@@ -244,8 +244,10 @@ struct mfmm_exact_solver {
     void *interrupt_user;
     int pass_depth; /* zero-area faces a window is passing through (ex_pass) */
     /* with non-manifold edges crossed, windows past a budget (over_budget):
-     * the run is redone with those edges as walls (walls; ex_run) */
-    int over_budget, walls;
+     * the run is redone with those edges as walls (walls; ex_run); past it
+     * otherwise, the run stops (stalled) and edge paths finish it */
+    int over_budget, walls, stalled;
+    double budget; /* windows a reached vertex may cost (ex_over_budget) */
     int64_t n_windows, n_propagated, n_pseudo, peak_windows;
     /* the windows fanned out at non-manifold edges, by nm_he slot: (n_nm,)
      * heads of lists in rec, -1: none */
@@ -764,6 +766,7 @@ mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *t, mfmm_exact_w
         return MFMM_ERR_OUT_OF_MEMORY;
     size_t nv = (size_t)t->nv;
     ws->t = t;
+    ws->budget = 64.0;
     ws->mesh = t->mesh;
     ws->nv = t->nv;
     ws->nf = t->nf;
@@ -1681,19 +1684,116 @@ static void ex_reset(mfmm_exact_ws *ws)
     ws->redist = ws->cur;
     ws->failed = 0;
     ws->over_budget = 0;
+    ws->stalled = 0;
     ws->n_windows = ws->n_propagated = ws->n_pseudo = ws->peak_windows = 0;
     ws->peak_bytes = ex_bytes(ws, ws->heap_cap);
 }
 
 /* Whether the windows created so far are past what the vertices reached
- * so far can need: 64 (1 + sqrt(n) / 8) a vertex, n vertices reached (plus
- * 4096), 12-20 times what a solve needs on camelhead (78 windows a vertex)
- * and beetle (17). Past it, windows are going round without getting
- * farther, which degenerate folded fans (coincident vertices) allowed. */
+ * so far can need: budget (1 + sqrt(n) / 8) a vertex, n vertices reached
+ * (plus 64 budget), budget 64: 12-20 times what a solve needs on camelhead
+ * (78 windows a vertex) and beetle (17). Past it, windows are going round
+ * without getting farther, which degenerate folded fans (coincident
+ * vertices) allowed, and ties kept at coincident vertices. */
 static int ex_over_budget(const mfmm_exact_ws *ws)
 {
     double n = (double)ws->n_touched;
-    return (double)ws->n_windows > 4096.0 + 64.0 * n * (1.0 + sqrt(n) / 8.0);
+    return (double)ws->n_windows > ws->budget * (64.0 + n * (1.0 + sqrt(n) / 8.0));
+}
+
+void mfmm_exact_ws_set_budget(mfmm_exact_ws *ws, double windows_per_vertex)
+{
+    ws->budget = windows_per_vertex;
+}
+
+static void ex_heap_up(const double *d, int32_t *heap, int32_t *pos, int32_t i)
+{
+    int32_t v = heap[i];
+    while (i > 0) {
+        int32_t p = (i - 1) / 2;
+        if (!(d[v] < d[heap[p]]))
+            break;
+        heap[i] = heap[p];
+        pos[heap[i]] = i;
+        i = p;
+    }
+    heap[i] = v;
+    pos[v] = i;
+}
+
+static void ex_heap_down(const double *d, int32_t *heap, int32_t *pos, int32_t n, int32_t i)
+{
+    int32_t v = heap[i];
+    for (;;) {
+        int32_t c = 2 * i + 1;
+        if (c >= n)
+            break;
+        if (c + 1 < n && d[heap[c + 1]] < d[heap[c]])
+            c++;
+        if (!(d[heap[c]] < d[v]))
+            break;
+        heap[i] = heap[c];
+        pos[heap[i]] = i;
+        i = c;
+    }
+    heap[i] = v;
+    pos[v] = i;
+}
+
+/* After a stalled run: every distance lowered to the shortest path along
+ * edges from the distances found, d(v) <= d(u) + |u v| (Dijkstra), each
+ * the length of a real path, so that no vertex a path reaches is left at
+ * +inf; within max_d. */
+static mfmm_status ex_relax_edges(mfmm_exact_ws *ws)
+{
+    int32_t nv = ws->nv, n = 0;
+    int32_t *heap = malloc((size_t)(nv ? nv : 1) * sizeof *heap);
+    int32_t *pos = malloc((size_t)(nv ? nv : 1) * sizeof *pos);
+    if (!heap || !pos) {
+        free(heap);
+        free(pos);
+        return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    double *d = ws->d;
+    for (int32_t v = 0; v < nv; v++)
+        pos[v] = -1;
+    for (int32_t i = 0; i < ws->n_touched; i++) {
+        int32_t v = ws->touched[i];
+        if (d[v] <= ws->max_d) {
+            heap[n] = v;
+            ex_heap_up(d, heap, pos, n++);
+        }
+    }
+    while (n > 0) {
+        int32_t u = heap[0];
+        pos[u] = -2;
+        heap[0] = heap[--n];
+        if (n > 0)
+            ex_heap_down(d, heap, pos, n, 0);
+        for (int32_t j = ws->vf_offset[u]; j < ws->vf_offset[u + 1]; j++) {
+            int32_t c = ex_corner(ws->vf_corner, ws->face_in, j);
+            const ex_face *r = ws->fr + c / 3;
+            int k = c % 3;
+            for (int side = 0; side < 2; side++) {
+                int32_t a = r->v[side ? ex_prev[k] : ex_next[k]];
+                double da = d[u] + r->len[side ? ex_next[k] : ex_prev[k]];
+                if (!(da < d[a]) || da > ws->max_d || pos[a] == -2)
+                    continue;
+                if (d[a] == INFINITY)
+                    ws->touched[ws->n_touched++] = a;
+                d[a] = da;
+                if (pos[a] < 0) {
+                    heap[n] = a;
+                    ex_heap_up(d, heap, pos, n++);
+                } else {
+                    ex_heap_up(d, heap, pos, pos[a]);
+                }
+            }
+        }
+    }
+    free(heap);
+    free(pos);
+    return MFMM_OK;
 }
 
 /* The propagation from checked sources; d[] holds the result for touched
@@ -1750,8 +1850,11 @@ static mfmm_status ex_run_once(mfmm_exact_ws *ws, const mfmm_source *sources,
         ex_start_face(ws, ws->face_in[face], w, s->value);
     }
     for (int64_t n = 1; ws->heap_n > 0 && !ws->failed; n++) {
-        if (!(n & 4095) && ws->n_nm > 0 && !ws->walls && ex_over_budget(ws)) {
-            ws->over_budget = 1;
+        if (!(n & 4095) && ex_over_budget(ws)) {
+            if (ws->n_nm > 0 && !ws->walls)
+                ws->over_budget = 1;
+            else
+                ws->stalled = 1;
             break;
         }
         /* about every 5 ms */
@@ -1777,7 +1880,9 @@ static mfmm_status ex_run_once(mfmm_exact_ws *ws, const mfmm_source *sources,
 /* ex_run_once across non-manifold edges; where its windows pass their
  * budget (ex_over_budget), again with those edges as walls: upper bounds
  * there, the solver's behaviour before it crossed them (mfmm_exact_info's
- * nonmanifold_walls says which). */
+ * nonmanifold_walls says which). A run past its budget otherwise stops, and
+ * paths along edges finish it (ex_relax_edges): a defect's values are then
+ * too long, never too short, and the solve ends. */
 static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t n_sources,
                           double max_d, size_t memory_limit)
 {
@@ -1787,6 +1892,8 @@ static mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t
         ws->walls = 1;
         st = ex_run_once(ws, sources, n_sources, max_d, memory_limit);
     }
+    if (st == MFMM_OK && ws->stalled)
+        st = ex_relax_edges(ws);
     return st;
 }
 

@@ -72,6 +72,10 @@ mfmm_status mfmm_exact_patch(mfmm_exact_ws *ws, const mfmm_source *sources, int3
 mfmm_status mfmm_exact_patch_check(mfmm_exact_ws *ws, const mfmm_source *src, int32_t *n_vertices,
                                    int32_t *n_rejected);
 
+/* For tests: the windows a reached vertex may cost before a run stops
+ * (64 by default; exact.c, ex_over_budget). */
+void mfmm_exact_ws_set_budget(mfmm_exact_ws *ws, double windows_per_vertex);
+
 /* Whether vertex v is in the patch of ws's last mfmm_exact_patch. */
 int mfmm_exact_in_patch(const mfmm_exact_ws *ws, int32_t v);
 

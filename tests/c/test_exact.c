@@ -517,6 +517,62 @@ static void test_interrupt(void **state)
     ex_free(&fx);
 }
 
+/* A run past its window budget (made tiny here) stops and edge paths finish
+ * it: the solve returns, every vertex finite, between the straight line and
+ * the shortest path along edges (Dijkstra here, by scanning the faces; the
+ * budget is checked every 4096 queue pops, which a 2601-vertex grid passes). */
+static void test_stalled_run_ends_within_bounds(void **state)
+{
+    (void)state;
+    ex_fx fx = ex_make(mfmm_gen_grid(50));
+    int32_t nv = fx.g.nv, src = 25 * 51 + 3;
+    mfmm_exact_ws_set_budget(fx.solver, 0.05);
+    mfmm_source s = tm_vertex_source(src);
+    mfmm_exact_info info;
+    mfmm_error err;
+    assert_int_equal(mfmm_solve_exact(fx.solver, &s, 1, NULL, fx.d, &info, &err), MFMM_OK);
+    double *g = malloc((size_t)nv * sizeof *g);
+    char *done = calloc((size_t)nv, 1);
+    assert_true(g && done);
+    for (int32_t v = 0; v < nv; v++)
+        g[v] = INFINITY;
+    g[src] = 0.0;
+    for (;;) {
+        int32_t u = -1;
+        for (int32_t v = 0; v < nv; v++)
+            if (!done[v] && isfinite(g[v]) && (u < 0 || g[v] < g[u]))
+                u = v;
+        if (u < 0)
+            break;
+        done[u] = 1;
+        for (int32_t f = 0; f < fx.g.nf; f++)
+            for (int k = 0; k < 3; k++)
+                if (fx.g.F[3 * f + k] == u)
+                    for (int j = 1; j < 3; j++) {
+                        int32_t w = fx.g.F[3 * f + (k + j) % 3];
+                        double l = g[u] + dist3(fx.g.V + 3 * u, fx.g.V + 3 * w);
+                        if (l < g[w])
+                            g[w] = l;
+                    }
+    }
+    int longer = 0;
+    for (int32_t v = 0; v < nv; v++) {
+        double e = dist3(fx.g.V + 3 * v, fx.g.V + 3 * src);
+        assert_true(isfinite(fx.d[v]));
+        assert_true(fx.d[v] >= e * (1.0 - 1e-12));
+        assert_true(fx.d[v] <= g[v] * (1.0 + 1e-12) + 1e-15);
+        longer += fx.d[v] > e * (1.0 + 1e-12);
+    }
+    assert_true(longer > 0); /* the run did stop early */
+    free(g);
+    free(done);
+    mfmm_exact_ws_set_budget(fx.solver, 64.0);
+    ex_solve(&fx, &s, 1, NULL);
+    for (int32_t v = 0; v < nv; v++)
+        tm_assert_close(fx.d[v], dist3(fx.g.V + 3 * v, fx.g.V + 3 * src), 1e-12);
+    ex_free(&fx);
+}
+
 /* Two components and a non-manifold edge: a unit square cut along its
  * diagonal (1,0)-(0,1), and a fin on that diagonal, and a copy of the
  * square far away. The diagonal, shared by three faces, joins each to the
@@ -1062,6 +1118,7 @@ int main(void)
         cmocka_unit_test(test_reflex_corner),
         cmocka_unit_test(test_max_distance),
         cmocka_unit_test(test_interrupt),
+        cmocka_unit_test(test_stalled_run_ends_within_bounds),
         cmocka_unit_test(test_nonmanifold_components),
         cmocka_unit_test(test_degenerate_face),
         cmocka_unit_test(test_memory_limit),
