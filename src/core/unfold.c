@@ -156,10 +156,10 @@ static int strip_push(strip_buf *sb, mfmm_virt_step st, vec2 p1, vec2 p2)
 /* Whether the segment from C (the origin) to pv crosses every edge of the
  * strip's steps [first, sb->n) between its ends, in order, before pv: then
  * it runs through the strip's faces and its length is a path's on the
- * surface. A strip that folds back over itself in the unfolding (a fan
- * around a vertex whose faces' angles exceed 2 pi, a sliver) can put V in
- * the section but beside the strip, 1167 from C where the surface's
- * shortest path is 4966 and the straight line through space 2896. */
+ * surface. A strip that folds back over itself in the unfolding put V in
+ * the section but beside the strip, on a book of two pages folded 66
+ * degrees: 1167 from C where the surface's shortest path is 4966 and the
+ * straight line through space 2896. */
 static int strip_holds(const strip_buf *sb, int32_t first, vec2 pv)
 {
     const double tol = 1e-9;
