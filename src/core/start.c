@@ -165,6 +165,31 @@ static int in_cone(v2 d, v2 R, v2 L)
     return cross2(R, d) >= 0.0 && cross2(d, L) >= 0.0;
 }
 
+static void enter(walk *w, int depth, int32_t g, int32_t ia, int32_t ib, v2 pa, v2 pb, v2 R, v2 L);
+
+/* Enters every face across the edge (ia, ib) opposite corner k of face f:
+ * its neighbour, or at a non-manifold edge each other face on it (a
+ * straight path from the point goes on into each; a T-junction's split can
+ * leave one, and the straight start then missed the far corner of the
+ * face it split, 20 % too long), copies apart; none at a boundary. */
+static void enter_across(walk *w, int depth, int32_t f, int k, int32_t ia, int32_t ib, v2 pa,
+                         v2 pb, v2 R, v2 L)
+{
+    const mfmm_mesh *m = w->m;
+    int32_t g = m->face_neighbor[3 * (size_t)f + k];
+    if (g >= 0) {
+        enter(w, depth, g, ia, ib, pa, pb, R, L);
+        return;
+    }
+    for (int32_t i = m->vertex_face_offset[ia]; i < m->vertex_face_offset[ia + 1] && !w->stop; i++) {
+        int32_t h = MFMM_WEDGE_FACE(m->vertex_wedge[i]);
+        const int32_t *hv = m->face_records[h].v;
+        if (h == f || mfmm_mesh_copy(m, h) || (hv[0] != ib && hv[1] != ib && hv[2] != ib))
+            continue;
+        enter(w, depth, h, ia, ib, pa, pb, R, L);
+    }
+}
+
 /* Enters face g across the edge (ia at pa, ib at pb), the `depth`-th edge
  * crossed, with the rays from the origin in the cone from R counterclockwise
  * to L still straight. */
@@ -221,8 +246,7 @@ static void enter(walk *w, int depth, int32_t g, int32_t ia, int32_t ib, v2 pa, 
         for (int k = 0; k < 3; k++)
             if (gv[k] != ix && gv[k] != iy)
                 kopp = k;
-        int32_t next = m->face_neighbor[3 * (size_t)g + kopp];
-        enter(w, depth + 1, next, ix, iy, x, y, R2, L2);
+        enter_across(w, depth + 1, g, kopp, ix, iy, x, y, R2, L2);
         /* the chain's slot `depth` was overwritten below: restore this level */
         w->face[depth] = g;
     }
@@ -294,7 +318,7 @@ static void start_face(walk *w, int32_t f, const double *p)
         if (!(fabs(c) > 1e-12 * norm2(x) * norm2(y)) || r[(k + 1) % 3] == 0.0 || r[(k + 2) % 3] == 0.0)
             continue;
         v2 R = c > 0.0 ? x : y, L = c > 0.0 ? y : x;
-        enter(w, 1, m->face_neighbor[3 * (size_t)f + k], fv[(k + 1) % 3], fv[(k + 2) % 3], x, y, R, L);
+        enter_across(w, 1, f, k, fv[(k + 1) % 3], fv[(k + 2) % 3], x, y, R, L);
         w->face[0] = f;
     }
 }

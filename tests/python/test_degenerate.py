@@ -2,6 +2,7 @@
 regressions: every value must be the length of a real path on the surface,
 so never below the straight line through space from the source."""
 import numpy as np
+import pytest
 
 import meshfmm
 from conftest import DATA
@@ -91,3 +92,22 @@ def test_windows_tied_at_coincident_vertices_do_not_go_round_for_ever():
     exact = meshfmm.Mesh(V, F).distance(src, method="exact")
     assert np.all(np.isfinite(exact))
     assert np.all(exact >= euclid * (1 - 1e-12))
+
+
+def test_the_straight_start_crosses_a_non_manifold_edge():
+    # (1, 1, 2) lies on edge (0, 0, 1)-(2, 2, 3) of face 2, closed by the
+    # zero-area face 1; the split leaves the edge (1, 1, 2)-(1, 2, 0) on three
+    # faces. From a point on face 2's edge 4-3 the straight start did not
+    # cross it, and the paper's start reached vertex 1 (a corner of face 2,
+    # the straight segment 2.474 away) at 2.985
+    V = np.array([[1.0, 1, 2], [0, 0, 1], [0, 2, 0], [1, 2, 0], [2, 2, 3]])
+    F = np.array([[3, 2, 0], [1, 4, 0], [4, 3, 1]])
+    bary = np.array([3 / 7, 4 / 7, 0.0])
+    m = meshfmm.Mesh(V, F)
+    src = meshfmm.SurfacePoint(2, bary)
+    straight = np.linalg.norm(V[1] - bary @ V[F[2]])
+    exact = m.distance(src, method="exact")
+    assert exact[1] == pytest.approx(straight, rel=1e-12)
+    for kwargs in ({"exact_start": False}, {}):
+        d = m.distance(src, **kwargs)
+        assert d[1] == pytest.approx(straight, rel=1e-12), kwargs
