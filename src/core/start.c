@@ -168,16 +168,18 @@ static int in_cone(v2 d, v2 R, v2 L)
 static void enter(walk *w, int depth, int32_t g, int32_t ia, int32_t ib, v2 pa, v2 pb, v2 R, v2 L);
 
 /* Enters every face across the edge (ia, ib) opposite corner k of face f:
- * its neighbour, or at a non-manifold edge each other face on it (a
- * straight path from the point goes on into each; a T-junction's split can
- * leave one, and the straight start then missed the far corner of the
- * face it split, 20 % too long), copies apart; none at a boundary. */
+ * its neighbour, or, at a non-manifold edge of a start face, each other
+ * face on it, copies apart (a straight path from the point goes on into
+ * each; a T-junction's split can leave one, and the straight start then
+ * missed the far corner of the face it split, 20 % too long); none at a
+ * boundary. Only from a start face: at every depth, fans of coincident
+ * faces multiplied the walks beyond any time limit. */
 static void enter_across(walk *w, int depth, int32_t f, int k, int32_t ia, int32_t ib, v2 pa,
                          v2 pb, v2 R, v2 L)
 {
     const mfmm_mesh *m = w->m;
     int32_t g = m->face_neighbor[3 * (size_t)f + k];
-    if (g >= 0) {
+    if (g >= 0 || depth > 1) {
         enter(w, depth, g, ia, ib, pa, pb, R, L);
         return;
     }

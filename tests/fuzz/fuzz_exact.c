@@ -29,9 +29,9 @@
  * the upper one. It meets neither to rounding: the planar update of a
  * virtual triangle (section 4.2), which need not lie on the surface, can
  * fall below a front curved across it (4.6 % on an 8-vertex flat mesh, 3 %
- * found here with a 2-edge exact start), the straight start does not cross
- * the non-manifold edge a T-junction's split can leave (20 % above), and
- * from two sources with values a triangle's planar update may be below the
+ * found here with a 2-edge exact start), it exceeds the edge path on some
+ * inputs (seed 31 finds one within 200 s at rounding; not yet explained),
+ * and from two sources with values a triangle's planar update may be below the
  * Euclidean distance from either (the lower bound, a minimum of two cones, is
  * not convex). bench/oracle_sweep.py holds the default march to 1e-8.
  *
