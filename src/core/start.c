@@ -359,6 +359,23 @@ void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double
     int32_t g = at.across;
     if (g >= 0 && mfmm_mesh_degenerate(mesh, g))
         g = -1;
+    if (at.kind == MFMM_ON_EDGE && at.across < 0) {
+        /* on a non-manifold edge (or a boundary): every face on it, copies
+         * and zero-area faces apart, in one order whichever face names the
+         * point (a point on the line a T-junction split a face along, that
+         * edge on a third face too, started one piece, and the other's
+         * corner got its distance round the junction, 28 % too long) */
+        int32_t ia = fv[(at.zero + 1) % 3], ib = fv[(at.zero + 2) % 3];
+        for (int32_t i = mesh->vertex_face_offset[ia]; i < mesh->vertex_face_offset[ia + 1] && !w.stop;
+             i++) {
+            int32_t h = MFMM_WEDGE_FACE(mesh->vertex_wedge[i]);
+            const int32_t *hv = mesh->face_records[h].v;
+            if ((h == src->face || (!mfmm_mesh_copy(mesh, h) && !mfmm_mesh_degenerate(mesh, h))) &&
+                (hv[0] == ib || hv[1] == ib || hv[2] == ib))
+                start_face(&w, h, p);
+        }
+        return;
+    }
     /* on an edge: both faces, in the same order whichever names the point */
     int32_t first = g >= 0 && g < src->face ? g : src->face;
     int32_t second = g < 0 ? -1 : first == g ? src->face : g;
