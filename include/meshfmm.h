@@ -269,7 +269,7 @@ typedef struct mfmm_solve_options {
     int32_t unfolding;               /* 1 (default): obtuse corners update through their
                                         virtual edges; 0: plain stencils (for comparison) */
     /* Appended fields. */
-    /* The exact start (issue 12): the march starts from the exact polyhedral
+    /* The exact start: the march starts from the exact polyhedral
      * distances (mfmm_solve_exact's) of the vertices within this many mean
      * edge lengths of each source (at least the corners of the faces holding
      * it), T = value + F * distance, instead of from the source's vertex (a

@@ -14,7 +14,7 @@
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 #pragma OPENCL FP_CONTRACT OFF
 #define MFMM_GLOBAL __global
-#define MFMM_INLINE inline __attribute__((always_inline)) /* PoCL makes calls of plain inline (issue 13.4) */
+#define MFMM_INLINE inline __attribute__((always_inline)) /* PoCL makes calls of plain inline */
 #define MFMM_COLD MFMM_INLINE
 #define MFMM_INF ((double)INFINITY)
 typedef int mfmm_i32;

@@ -73,7 +73,7 @@ typedef struct mfmm_march_state {
 /* measured: 2, 4, 8, 16 -> 8 fastest (bench_solve); 4 later 1-3 % faster on
  * small meshes, but it settles equal keys in another order (icosphere rows
  * change), so rows would not stay bit-identical.
- * Session 7 (bench_solve, 10 alternating rounds, camelhead, bunny, nefertiti,
+ * Measured (bench_solve, 10 alternating rounds, camelhead, bunny, nefertiti,
  * igea, plain and exact start; median march time against this heap): arity
  * 4 -2 to +2 % (igea slower); ties by (key, vertex id) +2 to +10 % (a tie
  * flag in the child scan, or an SSE2 min tree); a radix heap on T's bits
@@ -211,7 +211,7 @@ MFMM_INLINE mfmm_i32 mfmm_march_settle(mfmm_march_state *w, mfmm_i32 *settled,
  * across the triangle the mean of F(C) and F at the middle of AB, as a
  * characteristic from AB to C has it. (F(C) alone over the whole triangle,
  * the paper's F_ij, made a cheap vertex pull T down through costly
- * neighbours: -96 % against a finer mesh, issue 9.1.) */
+ * neighbours: -96 % against a finer mesh.) */
 MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, mfmm_i32 f_id, mfmm_i32 c,
                                    mfmm_i32 a, mfmm_i32 b, double *f_a, double *f_b,
                                    double *f_t)
@@ -242,7 +242,7 @@ MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, mfmm_i32 f_id, mfm
  * footprint, the faces around the strip's vertices A, B and those up to V
  * (per face: their F; per vertex: F at each of their vertices), read from
  * s->uniform. Elsewhere the corner takes the plain stencil, as with
- * unfolding off (issue 9.1: a cost-1 face's virtual edge through cost-100
+ * unfolding off (a cost-1 face's virtual edge through cost-100
  * faces made T 50x too low). */
 MFMM_INLINE int mfmm_march_virt_ok(const mfmm_march_state *s, const mfmm_march_mesh *m,
                                    MFMM_GLOBAL const mfmm_virt *vr, mfmm_i32 a, mfmm_i32 b,
@@ -659,7 +659,7 @@ MFMM_INLINE double mfmm_march_spoke_triangle(const mfmm_march_state *w,
  * face walk (mfmm_march_loop with general = 0), the same operands in the
  * same order of offers, so the same rows bit for bit, from records that
  * hold them ready: no case for virtual stencils, one offer per spoke, x's
- * spokes read in one sequence (measured, session 14's probe: 0.73-0.79x
+ * spokes read in one sequence (measured: 0.73-0.79x
  * the face walk's march, 56 instead of 72-byte records 0.77-0.87x).
  * A virtual edge's own term (T(V) + |CV|) and the edges from A and B are
  * not in its spokes: V's, A's and B's settling offered them. */

@@ -77,9 +77,9 @@ struct mfmm_mesh {
     /* The exact solver's read-only tables (exact/exact.h: face frames, fans),
      * built on the first exact solve or exact start and then shared by every
      * solver, thread and job on this mesh, so that a job costs what its rows
-     * reach, not a table build over all faces (0.48 s on a 1M-vertex mesh,
-     * issue 11). Built under cache_lock; freed with the mesh by
-     * exact_tables_free. The one part of a built mesh that changes. */
+     * reach, not a table build over all faces (0.48 s on a 1M-vertex mesh).
+     * Built under cache_lock; freed with the mesh by exact_tables_free. The
+     * one part of a built mesh that changes. */
     pthread_mutex_t cache_lock;
     void *exact_tables;
     void (*exact_tables_free)(void *);

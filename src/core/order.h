@@ -1,4 +1,4 @@
-/* Vertex and face renumbering (issue 13.1, private to the library). A mesh
+/* Vertex and face renumbering (private to the library). A mesh
  * numbers its vertices internally along a space-filling curve, so that
  * vertices near each other on the surface are near each other in every
  * per-vertex array the march reads, and its faces along that order (by

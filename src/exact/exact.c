@@ -2024,7 +2024,7 @@ mfmm_status mfmm_exact_patch(mfmm_exact_ws *ws, const mfmm_source *sources, int3
      * and pseudo-source on it was propagated, and d(v) is exact (d is an
      * upper bound, the length of a real path, so d(v) - h <= radius holds
      * for the true distance too). That ring is free and, seeded with the
-     * rest, lowers the march's mean error by 5-15 % (issue 12). */
+     * rest, lowers the march's mean error by 5-15 %. */
     int32_t n = 0;
     for (int32_t i = 0; i < ws->n_touched; i++) {
         int32_t v = ws->touched[i];

@@ -15,7 +15,7 @@ typedef struct mfmm_exact_solver mfmm_exact_ws;
 
 /* A mesh's read-only tables (face records, fans, pseudo-source flags): built
  * once and shared by the workspaces of any number of threads, which keep
- * only a solve's state (issue 12: each thread built its own, ~430 B/vertex).
+ * only a solve's state (a thread building its own held ~430 B/vertex).
  * The mesh must outlive them, and they every workspace made from them.
  * mfmm_exact_tables_bytes: their size; mfmm_exact_ws_bytes: a workspace's
  * (per vertex state, without the queue, which grows with the patch). */

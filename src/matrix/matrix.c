@@ -495,7 +495,7 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     /* Rows re-read the sources and the cost while out fills up: the job works
      * on its own copies, taken before any row is written and checked there,
      * so an out buffer (or a callback) that overwrites the caller's arrays
-     * cannot change later rows (issue 9.6). */
+     * cannot change later rows. */
     int32_t *own_sources = malloc((size_t)n_sources * sizeof *own_sources);
     if (!own_sources)
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for %d source ids",

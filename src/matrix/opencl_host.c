@@ -602,7 +602,7 @@ static void ocl_release(ocl *cl)
 
 /* Device, context and built program. */
 /* Under auto: a CPU device the caller did not name is left to the threads
- * backend, which runs the same rows on the same cores faster (issue 13.4:
+ * backend, which runs the same rows on the same cores faster (measured:
  * camelhead 2000 rows, wall 0.86-0.93x of OpenCL's; README "Command line"). */
 static mfmm_status auto_refuses(const ocl *cl, const mfmm_rows_job *job, mfmm_error *err)
 {
@@ -715,7 +715,7 @@ static size_t item_bytes(const mfmm_rows_job *job, int direct)
 /* Rows per batch: as many as the budget holds (at most 4096), in whole
  * rounds over the compute units. With the default budget (memory_limit 0) a
  * batch holds at least one row per compute unit, so that every core works
- * whatever the mesh size (issue 13: 16 MiB held one row of a 227k-vertex
+ * whatever the mesh size (a 16 MiB budget held one row of a 227k-vertex
  * mesh, and OpenCL ran on one core). */
 static int32_t batch_rows(const ocl *cl, const mfmm_rows_job *job, int direct, int32_t rows)
 {

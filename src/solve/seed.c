@@ -107,7 +107,7 @@ static mfmm_status exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const 
             return st;
     }
     double R = radius * mesh->info.mean_edge_length;
-    /* past max_d the row is +inf: a local row (issue 11) needs no more, and
+    /* past max_d the row is +inf: a local row needs no more, and
      * is then exact where it is finite */
     if (max_d < R * f)
         R = max_d / f * (1.0 + 1e-9);

@@ -1,4 +1,4 @@
-/* The exact start of a march (private to the library; issue 12.2): the
+/* The exact start of a march (private to the library): the
  * exact distances of the vertices near a point source seed the march in
  * place of the paper's start, which creates most of a first-order march's
  * error at the source's point singularity. Shared by the solver (solve.c)
