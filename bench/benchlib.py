@@ -1,6 +1,13 @@
-"""Helpers shared by the comparison benchmarks (bench/compare_*.py, the figures,
-bench/make_results_md.py): machine and version info, the error metrics of
-DESIGN.md, mesh loading and the generated test meshes."""
+"""Helpers shared by the benchmarks of every bench/ folder: machine and version
+info, where results and figures go, and the generated meshes. The mesh lists,
+stored references and error metrics (docs/methods.md#metrics) are the tests'
+own, from tests/python/meshfmm_testing.py, re-exported here.
+
+A script in a bench/ folder imports it with
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    import benchlib
+"""
 
 from __future__ import annotations
 
@@ -8,30 +15,34 @@ import datetime
 import os
 import platform
 import subprocess
+import sys
 from importlib import metadata
 from pathlib import Path
 
-import numpy as np
+_TESTS_PYTHON = str(Path(__file__).resolve().parents[1] / "tests" / "python")
+if _TESTS_PYTHON not in sys.path:
+    sys.path.insert(0, _TESTS_PYTHON)
 
-REPO = Path(__file__).resolve().parents[1]
-DATA = REPO / "tests" / "data"  # meshes/ and reference/ (copied into the repository)
+from meshfmm_testing import (  # noqa: E402,F401  (re-exported for the benchmarks)
+    DATA,
+    DATA_MESHES,
+    MESHES,
+    REFERENCE,
+    REPO,
+    bbox_diagonal,
+    compact,
+    errors,
+    load_mesh,
+    load_reference,
+    mean_rel_error,
+    nearest,
+    plane_distance,
+    sphere_distance,
+)
+
 RESULTS = REPO / "bench" / "results"
 IMAGES = REPO / "docs" / "images"
 CLI = Path(os.environ.get("MESHFMM_CLI", REPO / "build" / "meshfmm"))
-
-# every mesh of tests/data/meshes, smallest first
-DATA_MESHES = [
-    "hand_lowres.obj",
-    "beetle.obj",
-    "spot.obj",
-    "wingnut.obj",
-    "fertility_FE_10k.off",
-    "decimated-max.obj",
-    "camelhead.off",
-    "nefertiti-lowres.obj",
-    "stanford-bunny.obj",
-    "igea.ply",
-]
 
 
 # ---------------------------------------------------------------- machine info
@@ -108,39 +119,10 @@ def machine_info() -> dict:
     }
 
 
-# ---------------------------------------------------------------- metrics
-def errors(d: np.ndarray, e: np.ndarray, diameter: float) -> tuple:
-    """DESIGN.md's metrics: (mean relative error %, max error % of the diameter)
-    over vertices where the reference is finite (relative error where e > 0)."""
-    d = np.asarray(d, dtype=np.float64).reshape(-1)
-    fin = np.isfinite(e)
-    pos = fin & (e > 0)
-    if not np.all(np.isfinite(d[fin])):
-        return float("inf"), float("inf")
-    mre = float(100.0 * np.mean(np.abs(d[pos] - e[pos]) / e[pos]))
-    mx = float(100.0 * np.max(np.abs(d[fin] - e[fin])) / diameter)
-    return mre, mx
-
-
-def bbox_diagonal(V: np.ndarray) -> float:
-    return float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
-
-
 # ---------------------------------------------------------------- meshes
-def compact(V: np.ndarray, F: np.ndarray):
-    """Drop unreferenced vertices (the peers want none): (V2, F2, old_of_new, new_of_old)."""
-    used = np.zeros(V.shape[0], dtype=bool)
-    used[F.reshape(-1)] = True
-    old_of_new = np.flatnonzero(used)
-    new_of_old = np.full(V.shape[0], -1, dtype=np.int64)
-    new_of_old[old_of_new] = np.arange(old_of_new.size)
-    return np.ascontiguousarray(V[old_of_new]), new_of_old[F].astype(np.int64), old_of_new, new_of_old
-
-
 def load_data(name: str):
-    import meshfmm
-
-    return meshfmm.load_mesh(DATA / "meshes" / name)
+    """(V, F) of a mesh of tests/data/meshes."""
+    return load_mesh(name)
 
 
 def generate(shape: str, n: int, workdir: Path):
@@ -152,13 +134,3 @@ def generate(shape: str, n: int, workdir: Path):
         subprocess.run([str(CLI), "generate", shape, str(n), "-o", str(out)], check=True,
                        capture_output=True)
     return meshfmm.load_mesh(out)
-
-
-def sphere_distance(V: np.ndarray, s: int) -> np.ndarray:
-    """Great-circle distance on the unit sphere from vertex s (icosphere vertices lie on it)."""
-    U = V / np.linalg.norm(V, axis=1, keepdims=True)
-    return np.arccos(np.clip(U @ U[s], -1.0, 1.0))
-
-
-def plane_distance(V: np.ndarray, s: int) -> np.ndarray:
-    return np.linalg.norm(V - V[s], axis=1)

@@ -4,7 +4,8 @@ The meshes and exact references live in the repository, in tests/data
 (copied from the project's reference shelf with their licences; see
 tests/data/meshes/README.md); a missing file is a failure, not a skip. For a development build without
 ``pip install .``, point ``MESHFMM_LIBRARY`` at a built libmeshfmm and put
-``bindings/python`` on ``PYTHONPATH``.
+``bindings/python`` on ``PYTHONPATH``. The mesh lists, references and error
+metrics come from meshfmm_testing.py, which the benchmarks share.
 """
 
 from __future__ import annotations
@@ -13,29 +14,23 @@ import functools
 import os
 from pathlib import Path
 
-import numpy as np
 import pytest
 
-REPO = Path(__file__).resolve().parents[2]
-DATA = (REPO / "tests" / "data").resolve()
-MESHES = DATA / "meshes"
-REFERENCE = DATA / "reference"
-
-# Every mesh of tests/data/meshes with its role in the tests.
-MANIFOLD_MESHES = [
-    "hand_lowres.obj",
-    "spot.obj",
-    "wingnut.obj",
-    "fertility_FE_10k.off",
-    "decimated-max.obj",
-    "camelhead.off",
-    "nefertiti-lowres.obj",
-    "stanford-bunny.obj",
-]
-# Obtuse-heavy meshes where unfolding must beat geometry-central clearly.
-OBTUSE_MESHES = ["wingnut.obj", "decimated-max.obj", "camelhead.off"]
-NONMANIFOLD_MESHES = ["beetle.obj"]
-LARGE_MESHES = ["igea.ply"]
+from meshfmm_testing import (  # noqa: F401  (re-exported for the tests)
+    DATA,
+    LARGE_MESHES,
+    MANIFOLD_MESHES,
+    MESHES,
+    NONMANIFOLD_MESHES,
+    OBTUSE_MESHES,
+    REFERENCE,
+    REPO,
+    bbox_diagonal,
+    compact,
+    errors,
+    load_reference,
+    reference_path,
+)
 
 
 def need_data() -> None:
@@ -79,46 +74,24 @@ def mesh(name: str):
 
 def reference(name: str):
     """(sources, exact distances (3, nv)) stored for a mesh, or skip."""
-    path = REFERENCE / (Path(name).stem + ".npz")
+    path = reference_path(name)
     if not path.is_file():
         pytest.skip(f"no stored reference {path}")
-    z = np.load(path)
-    return z["sources"].astype(np.int64), z["distances"]
-
-
-def compact(V: np.ndarray, F: np.ndarray):
-    """Drops unreferenced vertices (libigl and potpourri3d want none).
-    Returns (V2, F2, old_of_new, new_of_old) with new_of_old -1 for dropped."""
-    used = np.zeros(V.shape[0], dtype=bool)
-    used[F.reshape(-1)] = True
-    old_of_new = np.flatnonzero(used)
-    new_of_old = np.full(V.shape[0], -1, dtype=np.int64)
-    new_of_old[old_of_new] = np.arange(old_of_new.size)
-    return V[old_of_new].copy(), new_of_old[F].astype(np.int64), old_of_new, new_of_old
+    return load_reference(name)
 
 
 @functools.lru_cache(maxsize=None)
 def diameter(name: str) -> float:
-    """Bounding-box diagonal of a test mesh's referenced vertices (DESIGN.md's max error scale)."""
+    """Bounding-box diagonal of a test mesh's referenced vertices (the max
+    error's scale, docs/methods.md#metrics)."""
     V, F = load(name)
-    V2 = compact(V, F)[0]
-    return float(np.linalg.norm(V2.max(axis=0) - V2.min(axis=0)))
-
-
-def errors(d: np.ndarray, e: np.ndarray, diameter: float):
-    """DESIGN.md metrics: (mean relative error %, max error % of diameter),
-    over vertices with a finite exact distance (> 0 for the relative one)."""
-    finite = np.isfinite(e)
-    pos = finite & (e > 0)
-    mre = 100.0 * np.mean(np.abs(d[pos] - e[pos]) / e[pos])
-    mx = 100.0 * np.max(np.abs(d[finite] - e[finite])) / diameter
-    return float(mre), float(mx)
+    return bbox_diagonal(compact(V, F)[0])
 
 
 # ------------------------------------------------------- accuracy table
 # Filled by test_accuracy.py; printed at the end of the session, and written
 # only where $MESHFMM_ACCURACY_JSON names a file (tests write nothing tracked;
-# bench/run_all.sh sets it to bench/results/accuracy_python.json).
+# bench/suite/run_all.sh sets it to bench/results/accuracy_python.json).
 ACCURACY: dict = {}
 ACCURACY_JSON = os.environ.get("MESHFMM_ACCURACY_JSON")
 
