@@ -10,10 +10,10 @@
   (tests/data/meshes/decimated-max.obj, the Max Planck head with very skinny
   triangles). -> docs/images/fig10_head_paths.png
 
-Both are drawn with bench/render.py (a z-buffer, so hidden curves stay hidden).
+Both are drawn with bench/figures/render.py (a z-buffer, so hidden curves stay hidden).
 Writes bench/results/figures.json (the Snell check and the path lengths).
 
-    python bench/figures_cost_head.py
+    python bench/figures/figures_cost_head.py
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
 import benchlib as bl  # noqa: E402
 import render  # noqa: E402
 

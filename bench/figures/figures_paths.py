@@ -5,7 +5,7 @@ paths, some through the hole). Writes docs/images/fig8a_sine_paths.png and
 docs/images/fig9_torus_paths.png.
 
     MESHFMM_LIBRARY=build/libmeshfmm.so PYTHONPATH=bindings/python \
-        python bench/figures_paths.py
+        python bench/figures/figures_paths.py
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noq
 
 import meshfmm  # noqa: E402
 
-OUT = Path(__file__).resolve().parents[1] / "docs" / "images"
+OUT = Path(__file__).resolve().parents[2] / "docs" / "images"
 
 
 def grid_faces(nu: int, nv: int, wrap_u: bool, wrap_v: bool) -> np.ndarray:

@@ -8,7 +8,7 @@
 - docs/images/scaling.png: median time per source against vertex count on
   icospheres and sine surfaces, with an n log n reference line.
 
-    python bench/plot_bench.py [peers.json]
+    python bench/figures/plot_bench.py [peers.json]
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
 import benchlib as bl  # noqa: E402
 
 STYLE = {

@@ -4,8 +4,8 @@ that load from other work falls on each alike) and print, per unfolding
 setting, the median of the rounds' medians and the least minimum, each also
 relative to the first build, with the Dijkstra ceiling and the ratio.
 
-    python bench/ab_solve.py --rounds 10 MESH OLD/bench_solve NEW/bench_solve
-    python bench/ab_solve.py --rounds 10 --exact-start 7 MESH OLD NEW ...
+    python bench/micro/ab_solve.py --rounds 10 MESH OLD/bench_solve NEW/bench_solve
+    python bench/micro/ab_solve.py --rounds 10 --exact-start 7 MESH OLD NEW ...
 
 A build is named by the directory above its build/ (or by its path).
 """

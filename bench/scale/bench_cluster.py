@@ -3,7 +3,7 @@ meshfmm.distributed.distance_matrix on a LocalCluster writing Zarr, on the
 same cores; target: the cluster reaches >= 90 % of the in-process entries/s.
 
     MESHFMM_LIBRARY=build/libmeshfmm.so PYTHONPATH=bindings/python \
-        python bench/bench_cluster.py [--rows N] [--repeats 2] [--workers 2]
+        python bench/scale/bench_cluster.py [--rows N] [--repeats 2] [--workers 2]
 
 Default: camelhead (tests/data/meshes, 11,381 vertices), every row (130 M
 entries), float32, 2 worker processes of 1 thread against 2 library threads.
@@ -28,15 +28,17 @@ import json
 import os
 import shutil
 import statistics
+import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-import benchlib
-import meshfmm
-import meshfmm.distributed as mdist
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
+import benchlib  # noqa: E402
+import meshfmm  # noqa: E402
+import meshfmm.distributed as mdist  # noqa: E402
 
 
 def cpu_seconds(tree: bool) -> float:

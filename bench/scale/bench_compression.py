@@ -3,7 +3,7 @@ meshfmm.distributed can use (Blosc: zstd, lz4, blosclz; byte or bit shuffle;
 levels), on rows of real meshes (tests/data/meshes), float32 and float64.
 
     MESHFMM_LIBRARY=build/libmeshfmm.so PYTHONPATH=bindings/python \
-        python bench/bench_compression.py [--rows 256] [--meshes a.off,b.obj]
+        python bench/scale/bench_compression.py [--rows 256] [--meshes a.off,b.obj]
 
 Each mesh: `--rows` contiguous rows (sources k..k+rows-1, as a task's chunk
 holds them) at a random offset, cut into chunks of the shape
@@ -18,14 +18,17 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
+from pathlib import Path
 
 import numcodecs
 import numpy as np
 from numcodecs import Blosc
 
-import benchlib
-import meshfmm
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
+import benchlib  # noqa: E402
+import meshfmm  # noqa: E402
 
 numcodecs.blosc.use_threads = False
 

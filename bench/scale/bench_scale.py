@@ -2,7 +2,7 @@
 full rows, and the sparse local matrix against gdist.local_gdist_matrix.
 
     MESHFMM_LIBRARY=build/libmeshfmm.so PYTHONPATH=bindings/python \
-        python bench/bench_scale.py [--quick] [--threads 1]
+        python bench/scale/bench_scale.py [--quick] [--threads 1]
 
 Writes bench/results/scale.json. Everything in one run, so ratios compare
 like with like on a shared machine (absolute numbers move with the load)."""
@@ -11,14 +11,16 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-import benchlib
-import meshfmm
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
+import benchlib  # noqa: E402
+import meshfmm  # noqa: E402
 
 
 def timed(fn):

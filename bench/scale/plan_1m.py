@@ -2,7 +2,7 @@
 section "Plan: all pairs on 1M vertices"), measured on this machine:
 
     MESHFMM_LIBRARY=build/libmeshfmm.so PYTHONPATH=bindings/python \
-        python bench/plan_1m.py && python bench/make_results_md.py --no-readme
+        python bench/scale/plan_1m.py && python bench/suite/make_results_md.py --no-readme
 
 Measured: the sine surface of `meshfmm generate sine 1000` (1,002,001
 vertices), mesh build time, per-row time for `--rows` contiguous rows (as one
@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -27,8 +28,9 @@ import numcodecs
 import numpy as np
 from numcodecs import Blosc
 
-import benchlib
-import meshfmm
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
+import benchlib  # noqa: E402
+import meshfmm  # noqa: E402
 
 numcodecs.blosc.use_threads = False
 

@@ -1,7 +1,15 @@
 #!/usr/bin/env python3
-"""The exact start's radius against issue 13's speed targets, in one run.
+"""The exact start's radius against the speed targets, in one run.
 
-The exact start (issue 12) seeds each march with the exact distances within r
+Study, 2026-11-24: per source on the four meshes under 5k vertices, r = 7
+costs 1.7-2.3x the plain start and is slower than libigl's heat solve on all
+four; r = 5 beats it on spot and wingnut, r = 3 on hand, only the plain start
+on beetle. All pairs on camelhead: r = 7 costs 1.21x the plain start and is
+still 1.53x faster than the batched heat method
+(bench/results/exact_start_tradeoff.json; the accuracy per radius in
+bench/RESULTS.md, "Exact start").
+
+The exact start seeds each march with the exact distances within r
 mean edge lengths of its source; r = 7 (the default up to 40,000 vertices)
 is the least radius that brings the bunny's mean error to 0.6x the plain
 start's. Its patch costs about the same on any mesh, so it weighs most on
@@ -9,17 +17,18 @@ small meshes and on all pairs around 10k vertices. This script measures, at
 several radii and the plain start (r = 0):
 
   per source   Mesh.distance against libigl's heat solve after its precompute
-               (issue 13: no slower on meshes under 5k vertices), three
+               (target: no slower on meshes under 5k vertices), three
                sources alternating, median over rounds, one thread each;
   all pairs    `meshfmm allpairs --backend serial` against the batched heat
-               method in one process (bench/heat_batched.py), camelhead 2000
+               method in one process (bench/suite/heat_batched.py), camelhead 2000
                rows spread over the mesh, both extrapolated to the full matrix
-               as bench/compare_allpairs.py does (issue 13: 1.5x).
+               as bench/suite/compare_allpairs.py does (target: 1.5x
+               the batched heat method's rate).
 
 The accuracy at each radius is bench_exact_start.py's (RESULTS.md, "Exact
 start"). Writes bench/results/exact_start_tradeoff.json.
 
-    python bench/exact_start_tradeoff.py [--rounds R] [--radii 7 5 4 3]
+    python bench/studies/exact_start_tradeoff.py [--rounds R] [--radii 7 5 4 3]
 """
 
 from __future__ import annotations
@@ -37,7 +46,8 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "suite"))
 import benchlib as bl  # noqa: E402
 import compare_allpairs as ca  # noqa: E402
 

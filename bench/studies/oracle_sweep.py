@@ -2,8 +2,16 @@
 tests/python/oracles.py: the exact solver, the default march and every
 matrix backend's rows, checked against the bounds every distance must meet.
 
+Sweep, 2026-11-27: over 10,000 meshes a seed (30,000 sources, about 90 s),
+four seeds, no value of the exact solver, the default march (at worst 3e-9
+below the straight line, within its 1e-8) or the serial, threads and OpenCL
+rows (equal bit for bit) is outside the bounds; the plain start falls below
+the straight line on 2 of 30,000 sources (4.1 % at worst). The tolerances of
+tests/python/oracles.py are set from these runs; tests/python/test_oracles.py
+runs 350 meshes in every test run.
+
     MESHFMM_LIBRARY=build/libmeshfmm.so PYTHONPATH=bindings/python \\
-        .venv/bin/python bench/oracle_sweep.py [--n 10000] [--seed 0] [--cases-dir DIR]
+        .venv/bin/python bench/studies/oracle_sweep.py [--n 10000] [--seed 0] [--cases-dir DIR]
 
 Each mesh (10-200 vertices: a flat Delaunay triangulation of a convex region
 with near-collinear and near-coincident points, a flat mesh with a slit
@@ -51,7 +59,7 @@ from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "tests" / "python"))
 import oracles as O  # noqa: E402
 

@@ -2,7 +2,7 @@
 igl.exact_geodesic references (Kirsanov's MMP) and against gdist
 (gdist.compute_gdist, also Kirsanov's MMP), timed per source in one run.
 
-    MESHFMM_LIBRARY=build/libmeshfmm.so python bench/bench_exact.py [--json OUT] [mesh ...]
+    MESHFMM_LIBRARY=build/libmeshfmm.so python bench/suite/bench_exact.py [--json OUT] [mesh ...]
 
 One JSON line per mesh as it finishes, then a table. Times are the least of
 BENCH_REPEAT (3) runs per source, averaged over the reference's 3 sources;
@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "bindings" / "python"))
 os.environ.setdefault("MESHFMM_LIBRARY", str(REPO / "build" / "libmeshfmm.so"))
 from meshfmm import _lib  # noqa: E402

@@ -25,7 +25,7 @@ the meshes of 10k vertices and more; ratios from one run.
 
 Writes bench/results/exact_start.json.
 
-    python bench/bench_exact_start.py [--radii 0 3 5 6 7 8 10 auto] [--rounds 5]
+    python bench/suite/bench_exact_start.py [--radii 0 3 5 6 7 8 10 auto] [--rounds 5]
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
 import benchlib as bl  # noqa: E402
 
 import meshfmm  # noqa: E402
@@ -189,7 +189,7 @@ def main():
             print(f"{name:22s} {row['n_vertices']:6d} {'held' if row['held_out'] else 'pick'} | {line} | "
                   f"heat {row['heat_robust']['mre_pct']:.3f}/{row['heat_robust']['max_pct']:.3f}"
                   + (f" | time x{row['time_ratio']:.3f}" if "time_ratio" in row else ""), flush=True)
-    path = Path(__file__).resolve().parent / "results" / "exact_start.json"
+    path = bl.RESULTS / "exact_start.json"
     path.write_text(json.dumps(out, indent=1) + "\n")
     print("wrote", path)
 

@@ -13,7 +13,7 @@ bare ctypes loop on mfmm_solve without a compiler).
 Writes bench/results/python_speed.json. Not a test: timings on a shared
 machine are noisy; the medians over rounds of per-method blocks are reported.
 
-    python bench/bench_python.py [--meshes a.obj b.off ...] [--sources 20] [--large]
+    python bench/suite/bench_python.py [--meshes a.obj b.off ...] [--sources 20] [--large]
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
 from benchlib import REPO, DATA, DATA_MESHES  # noqa: E402
 
 # the manifold meshes with stored exact references (not beetle, not igea)

@@ -10,7 +10,7 @@ peers' best routes to the same matrix:
                   sparse matrix), against `meshfmm allpairs --max-distance` with the
                   same radius
   gdist_loop      gdist.compute_gdist per row (exact), a few rows, extrapolated
-  heat_batched_pN the heat method batched over blocks of 32 sources (bench/heat_batched.py:
+  heat_batched_pN the heat method batched over blocks of 32 sources (bench/suite/heat_batched.py:
                   intrinsic Delaunay Laplacian, one CHOLMOD factorisation per process), in N
                   processes of one BLAS thread each; its rows are checked against meshfmm's
 
@@ -22,7 +22,7 @@ extrapolated (marked "extrapolated").
 
 Writes bench/results/allpairs_peers.json.
 
-    python bench/compare_allpairs.py [--quick]
+    python bench/suite/compare_allpairs.py [--quick]
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
 import benchlib as bl  # noqa: E402
 
 

@@ -25,7 +25,7 @@ averaged over sources, the max is the max over sources.
 
 Writes bench/results/peers.json.
 
-    python bench/compare_peers.py [--quick] [--only shared|sphere|lattice|sine]
+    python bench/suite/compare_peers.py [--quick] [--only shared|sphere|lattice|sine]
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
 import benchlib as bl  # noqa: E402
 
 FAST = ["meshfmm", "meshfmm_nounfold", "gc_fmm", "gc_heat", "igl_heat"]

@@ -5,7 +5,7 @@ vertex, great-circle distance) and on the obtuse lattice (x stretched 3x,
 n = 20..160, source nearest (1.5, 0.43), Euclidean distance), the meshes and
 sources of tests/c/test_convergence.c. Writes bench/results/convergence.json.
 
-    python bench/convergence_exact_start.py
+    python bench/suite/convergence_exact_start.py
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
 import benchlib as bl  # noqa: E402
 
 import meshfmm  # noqa: E402

@@ -10,7 +10,7 @@ wrong. Gradient and divergence are sparse products on the input faces, over
 the whole block at once. |grad u| uses hypot: u underflows far from the
 source, and squaring it would give 0/0.
 
-    python bench/heat_batched.py MESH [ROWS]     # a quick check against meshfmm
+    python bench/suite/heat_batched.py MESH [ROWS]     # a quick check against meshfmm
 """
 
 from __future__ import annotations
@@ -90,7 +90,7 @@ class BatchedHeat:
 
 
 def main() -> None:
-    sys.path.insert(0, str(__import__("pathlib").Path(__file__).resolve().parent))
+    sys.path.insert(0, str(__import__("pathlib").Path(__file__).resolve().parents[1]))
     import benchlib as bl
     import meshfmm
 

@@ -3,9 +3,9 @@
 cluster,compression,plan_1m}.json
 and copies its summary into README.md between the markers
 <!-- bench:begin --> and <!-- bench:end -->. Neither is edited by hand: rerun
-`bash bench/run_all.sh` (or this script on existing JSON).
+`bash bench/suite/run_all.sh` (or this script on existing JSON).
 
-    python bench/make_results_md.py [--no-readme]
+    python bench/suite/make_results_md.py [--no-readme]
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
 import benchlib as bl  # noqa: E402
 
 NAMES = {
@@ -334,7 +334,7 @@ def fbytes(b):
 def scale_section(sc):
     L = ["## Sparse local matrices and landmarks (issue 11)", "",
          f"**Machine:** {machine_line(sc)}; {sc['threads']} thread(s); "
-         f"`bench/bench_scale.py` → bench/results/scale.json.", "",
+         f"`bench/scale/bench_scale.py` → bench/results/scale.json.", "",
          "Sparse local rows (`max_distance=r`, CSR) on sine surfaces, sources at random; a row "
          "costs what it reaches (touched-list reset; the exact tables are the mesh's, built once). "
          "Start: `exact` (the default; its patch ends at r, so rows within the exact start's "
@@ -385,7 +385,7 @@ def cluster_section(cl, cl12=None, cldef=None):
     L = ["## Dask cluster against in-process (issue 11)", "",
          f"**Machine:** {machine_line(cl)}; load average at the end "
          f"{', '.join(f'{x:.1f}' for x in cl['load_average'])}. "
-         f"`bench/bench_cluster.py` → bench/results/cluster.json.", "",
+         f"`bench/scale/bench_cluster.py` → bench/results/cluster.json.", "",
          f"{cl['mesh']}, {cl['rows']:,} x {cl['n_vertices']:,} {cl['dtype']} "
          f"({ent / 1e6:.1f} M entries): the threads backend with "
          f"{cl['in_process_threads']} threads "
@@ -445,7 +445,7 @@ def cluster_section(cl, cl12=None, cldef=None):
 
 def compression_section(co):
     L = ["## Compression of distance matrices (issue 11)", "",
-         f"**Machine:** {machine_line(co)}. `bench/bench_compression.py` → "
+         f"**Machine:** {machine_line(co)}. `bench/scale/bench_compression.py` → "
          "bench/results/compression.json.", "",
          "Rows of real meshes (tests/data/meshes; contiguous sources, as a task writes them), in "
          f"chunks of the default shape (~{co['chunk_bytes'] >> 20} MiB), Blosc single-threaded "
@@ -514,9 +514,9 @@ def plan_section(pl, cl, co):
     L = ["## Plan: all pairs on a 1M-vertex mesh (issue 11)", "",
          f"**Machine:** {machine_line(pl)}; load average "
          f"{', '.join(f'{x:.1f}' for x in pl.get('load_average', []))}. Numbers from "
-         "`bench/plan_1m.py` (bench/results/plan_1m.json), `bench/bench_cluster.py` and "
-         "`bench/bench_compression.py`; refresh with `python bench/plan_1m.py && python "
-         "bench/make_results_md.py --no-readme` (the vertex renumbering of issue 13 changes the "
+         "`bench/scale/plan_1m.py` (bench/results/plan_1m.json), `bench/scale/bench_cluster.py` and "
+         "`bench/scale/bench_compression.py`; refresh with `python bench/scale/plan_1m.py && python "
+         "bench/suite/make_results_md.py --no-readme` (the vertex renumbering of issue 13 changes the "
          "per-row time, and the ratio of real meshes).", "",
          "**Measured** (m) on this machine; **extrapolated** (x) from them by the formula "
          "given.", "",
@@ -601,7 +601,7 @@ def plan_section(pl, cl, co):
 # ---------------------------------------------------------------- document
 def exact_start_section():
     """The exact start (issue 12.2), from bench/results/exact_start.json and
-    convergence.json (bench/bench_exact_start.py, convergence_exact_start.py)."""
+    convergence.json (bench/suite/bench_exact_start.py, convergence_exact_start.py)."""
     es_path, cv_path = bl.RESULTS / "exact_start.json", bl.RESULTS / "convergence.json"
     if not es_path.is_file():
         return []
@@ -615,7 +615,7 @@ def exact_start_section():
          "The march starts from the exact distances (mfmm_solve_exact's window propagation) of "
          "the vertices within r mean edge lengths of each source, instead of the paper's start "
          "(r = 0). Mean relative error % / max error % of the diagonal over 3 sources per case "
-         f"(`bench/bench_exact_start.py`). The default (r = {default}) was chosen on the "
+         f"(`bench/suite/bench_exact_start.py`). The default (r = {default}) was chosen on the "
          "*choice* cases (" + ", ".join(es["choice_set"]) + "): the error falls with r on every "
          "case, and r = 7 is the least that brings the bunny to 0.6x (it was 0.63x at r = 6); "
          "on larger meshes 7 edges cover less of the surface (igea, 134k vertices: 0.62x), so "
@@ -648,7 +648,7 @@ def exact_start_section():
     if cv_path.is_file():
         cv = json.loads(cv_path.read_text())
         D += ["### Convergence with and without the exact start", "",
-              "Mean relative error % (`bench/convergence_exact_start.py`; the meshes and sources "
+              "Mean relative error % (`bench/suite/convergence_exact_start.py`; the meshes and sources "
               "of tests/c/test_convergence.c). Up to 40,000 vertices r is fixed in edge lengths and "
               "the exact region shrinks with h, so the gain is largest on coarse meshes; above, "
               "the default radius grows as sqrt(nv) (MFMM_EXACT_START_AUTO: icosphere 7 takes "
@@ -682,8 +682,8 @@ def main():
     machine = machine_line(peers)
 
     D = ["# Benchmark results", "",
-         "<!-- generated by bench/make_results_md.py from bench/results/*.json: do not edit by "
-         "hand; rerun `bash bench/run_all.sh` -->", "",
+         "<!-- generated by bench/suite/make_results_md.py from bench/results/*.json: do not edit by "
+         "hand; rerun `bash bench/suite/run_all.sh` -->", "",
          f"**Machine:** {machine}.  ",
          f"**Versions:** {versions_line(peers)}.", "",
          "Metrics (DESIGN.md): mean relative error in percent, `100/N Σ |d−e|/e` over vertices "
@@ -755,7 +755,7 @@ def main():
     readme = bl.REPO / "README.md"
     R = readme.read_text()
     block = [BEGIN,
-             "<!-- generated by bench/make_results_md.py from bench/results/*.json; "
+             "<!-- generated by bench/suite/make_results_md.py from bench/results/*.json; "
              "do not edit by hand -->", "",
              f"Measured on {machine}.", "", summary, ""]
     if allp:

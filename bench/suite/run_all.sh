@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # The whole comparison against the field, from one command (issue 6):
-#   bash bench/run_all.sh            # ~10-20 minutes on a 2-core machine
+#   bash bench/suite/run_all.sh            # ~10-20 minutes on a 2-core machine
 # Sets everything up (scripts/setup.sh: Debian packages, .venv with the peers
 # from requirements-dev.txt, the build), then writes bench/results/*.json,
 # the plots and figures under docs/images/, bench/RESULTS.md and the summary
 # block of README.md (all generated; never edit them by hand).
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 
 bash scripts/setup.sh
 py=.venv/bin/python
@@ -38,15 +38,15 @@ step() { echo; echo "== $* ($(( $(date +%s) - start )) s)"; }
 step "accuracy against the stored exact references (pytest)"
 MESHFMM_ACCURACY_JSON="$PWD/bench/results/accuracy_python.json" "$py" -m pytest -q tests/python/test_accuracy.py
 step "per-source accuracy and time against the peers"
-"$py" bench/compare_peers.py
-"$py" bench/bench_exact_start.py   # the exact start: radii, robust heat, time per source
-"$py" bench/convergence_exact_start.py
+"$py" bench/suite/compare_peers.py
+"$py" bench/suite/bench_exact_start.py   # the exact start: radii, robust heat, time per source
+"$py" bench/suite/convergence_exact_start.py
 step "all pairs"
-"$py" bench/compare_allpairs.py
+"$py" bench/suite/compare_allpairs.py
 step "paper figures 8b and 10"
-"$py" bench/figures_cost_head.py
+"$py" bench/figures/figures_cost_head.py
 step "plots"
-"$py" bench/plot_bench.py
+"$py" bench/figures/plot_bench.py
 step "bench/RESULTS.md and the README block"
-"$py" bench/make_results_md.py
+"$py" bench/suite/make_results_md.py
 step "done"

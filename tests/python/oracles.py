@@ -1,6 +1,6 @@
 """Meshes with known geodesic distances, and the bounds every distance must meet.
 
-Shared by tests/python/test_oracles.py and bench/oracle_sweep.py (which puts
+Shared by tests/python/test_oracles.py and bench/studies/oracle_sweep.py (which puts
 tests/python on sys.path). Nothing here calls meshfmm except the checks at
 the end, which take the distances as arrays.
 
@@ -55,7 +55,7 @@ EPS = np.finfo(np.float64).eps
 # and slit meshes (seed 11), at most 1.8e-13 where every edge is longer than
 # 1e-6 of the diagonal. A window on a short edge l places its source only to
 # ~eps d / l, so near-coincident vertices cost more: at most 8.5e-12
-# relative there (seed 11), and over 20,000 meshes of bench/oracle_sweep.py
+# relative there (seed 11), and over 20,000 meshes of bench/studies/oracle_sweep.py
 # (seeds 0, 1) the worst error was 8.9e-11 of the diagonal (a flat mesh with
 # two vertices 8e-12 of the diagonal apart; 1.7e-7 relative at the distance
 # between those two). EXACT_REL = 1e-9 catches any wrong window (the defects
@@ -80,7 +80,7 @@ BOUND_ABS = 1e-13
 # interpolate linearly above a convex function, then a straight leg), so what
 # undershoots comes from rounding in ill-conditioned updates (slivers) and
 # from virtual edges, whose unfolded triangle may leave the surface. Measured
-# by bench/oracle_sweep.py (seeds 0 and 1: 20,000 meshes, 60,000 sources):
+# by bench/studies/oracle_sweep.py (seeds 0 and 1: 20,000 meshes, 60,000 sources):
 # min (d - eu) / eu was -9.3e-10 for the default march (from its exact start,
 # which covers much of these small meshes; vertex sources: -1.5e-13), and for
 # the plain start (exact_start=False) -7.5e-8 at the 1e-4 quantile, with an
