@@ -37,6 +37,7 @@ from meshfmm_testing import (  # noqa: E402,F401  (re-exported for the benchmark
     mean_rel_error,
     nearest,
     plane_distance,
+    reference_path,
     sphere_distance,
 )
 

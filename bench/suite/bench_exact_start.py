@@ -70,13 +70,12 @@ def radius_arg(x):
     return "auto" if x == "auto" else float(x)
 
 
-def nearest(V, pts):
-    return [int(np.argmin(np.linalg.norm(V - p, axis=1))) for p in pts]
+nearest = bl.nearest
 
 
 def stored(name):
-    z = np.load(bl.DATA / "reference" / (Path(name).stem + ".npz"))
-    return [int(s) for s in z["sources"]], list(z["distances"])
+    sources, distances = bl.load_reference(name)
+    return [int(s) for s in sources], list(distances)
 
 
 def cases(workdir):

@@ -33,27 +33,14 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
-from benchlib import REPO, DATA, DATA_MESHES  # noqa: E402
+from benchlib import DATA, DATA_MESHES, REPO, compact, load_reference, reference_path  # noqa: E402
+from benchlib import mean_rel_error as mre  # noqa: E402
 
 # the manifold meshes with stored exact references (not beetle, not igea)
 MESHES = [m for m in DATA_MESHES if m not in ("beetle.obj", "igea.ply")]
 
 import meshfmm  # noqa: E402
 from meshfmm import _lib  # noqa: E402
-
-
-def compact(V, F):
-    used = np.zeros(V.shape[0], dtype=bool)
-    used[F.reshape(-1)] = True
-    old_of_new = np.flatnonzero(used)
-    new_of_old = np.full(V.shape[0], -1, dtype=np.int64)
-    new_of_old[old_of_new] = np.arange(old_of_new.size)
-    return V[old_of_new].copy(), new_of_old[F].astype(np.int64), old_of_new, new_of_old
-
-
-def mre(d, e):
-    pos = np.isfinite(e) & (e > 0)
-    return float(100 * np.mean(np.abs(d[pos] - e[pos]) / e[pos]))
 
 
 def timed(fn, *args):
@@ -102,11 +89,9 @@ def bench_mesh(name, n_sources, repeats):
     row["speedup_vs_gc_fmm"] = row["gc_fmm_s"] / row["meshfmm_s"]
     row["speedup_vs_gc_heat"] = row["gc_heat_s"] / row["meshfmm_s"]
     row["meshfmm_vertices_per_s"] = V.shape[0] / row["meshfmm_s"]
-    ref = DATA / "reference" / (Path(name).stem + ".npz")
-    if ref.is_file():
-        z = np.load(ref)
+    if reference_path(name).is_file():
         errs = {"meshfmm": [], "gc_fmm": [], "gc_heat": []}
-        for s, e in zip(z["sources"], z["distances"]):
+        for s, e in zip(*load_reference(name)):
             errs["meshfmm"].append(mre(mesh.distance(int(s)), e))
             for key, f in (("gc_fmm", lambda t: fmm.compute_distance([[(t, [])]])),
                            ("gc_heat", lambda t: heat.compute_distance(t))):
@@ -232,7 +217,7 @@ def main():
     ap.add_argument("-o", default=str(REPO / "bench" / "results" / "python_speed.json"))
     args = ap.parse_args()
     if not (DATA / "meshes").is_dir():
-        sys.exit(f"no meshes at {DATA / 'meshes'} (set MESHFMM_TEST_DATA_DIR)")
+        sys.exit(f"no meshes at {DATA / 'meshes'}")
     meshes = list(args.meshes) + (["igea.ply"] if args.large else [])
 
     rows = {}

@@ -226,8 +226,7 @@ def run_case(case, rounds, exact_plan, log):
 
 
 # ---------------------------------------------------------------- the cases
-def nearest(V, points):
-    return [int(np.argmin(np.linalg.norm(V - p, axis=1))) for p in points]
+nearest = bl.nearest
 
 
 def shared_cases(index, log):
@@ -238,12 +237,11 @@ def shared_cases(index, log):
             continue
         V, F = bl.load_data(name)
         _, _, old_of_new, new_of_old = bl.compact(V, F)
-        ref_path = bl.DATA / "reference" / (Path(name).stem + ".npz")
         case = {"family": "shared", "name": name, "V": V, "F": F}
-        if ref_path.is_file():
-            z = np.load(ref_path)
-            stored = z["distances"][:, old_of_new]
-            case["sources"] = [int(new_of_old[s]) for s in z["sources"]]
+        if bl.reference_path(name).is_file():
+            ref_sources, ref_distances = bl.load_reference(name)
+            stored = ref_distances[:, old_of_new]
+            case["sources"] = [int(new_of_old[s]) for s in ref_sources]
             case["ref"] = lambda k, s, V_, F_, stored=stored: stored[k]
             case["ref_kind"] = "igl.exact_geodesic (stored)"
             case["ref_time"] = index["meshes"][name]["seconds"]

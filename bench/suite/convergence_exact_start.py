@@ -23,9 +23,7 @@ import benchlib as bl  # noqa: E402
 import meshfmm  # noqa: E402
 
 
-def mre(d, e):
-    k = np.isfinite(e) & (e > 0)
-    return float(100 * np.mean(np.abs(d[k] - e[k]) / e[k]))
+mre = bl.mean_rel_error
 
 
 def order(h, err):
