@@ -4,17 +4,33 @@
 # package into .venv/. Safe to run again: it only does what is missing or
 # changed (stamps in .venv/: the requirements' hash, the package sources' hash),
 # so a second run with nothing changed takes about a second.
-#   setup.sh [--deps-only]   --deps-only: Debian packages and .venv's
-#                            requirements, no build/ and no package install
-#                            (scripts/test.sh builds in a clean clone instead)
+#   setup.sh [--deps-only] [--bench]
+#     --deps-only  Debian packages and .venv's requirements, no build/ and no
+#                  package install (scripts/test.sh builds in a clean clone)
+#     --bench      also the benchmarks' peers: the Debian packages
+#                  libsuitesparse-dev (CHOLMOD) and libopenblas0-pthread, and
+#                  bench/requirements.txt into .venv (bench/suite/run_all.sh
+#                  runs this)
+# Every package install of the project is here: the scripts under bench/ say
+# "run scripts/setup.sh --bench first" instead of installing anything.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 deps_only=0
-[ "${1:-}" = "--deps-only" ] && deps_only=1
+bench=0
+for arg in "$@"; do
+    case "$arg" in
+        --deps-only) deps_only=1 ;;
+        --bench) bench=1 ;;
+        *) echo "setup: unknown option $arg (use --deps-only, --bench)" >&2; exit 2 ;;
+    esac
+done
 
 packages=(build-essential cmake pkg-config python3 python3-venv python3-dev
           pocl-opencl-icd ocl-icd-libopencl1 opencl-headers clinfo libcmocka-dev
           git clang locales)
+# the benchmarks' peers: CHOLMOD for scikit-sparse (the batched heat method) and
+# a threaded OpenBLAS
+[ "$bench" = 1 ] && packages+=(libsuitesparse-dev libopenblas0-pthread)
 if command -v apt-get >/dev/null 2>&1; then
     missing=()
     for p in "${packages[@]}"; do
@@ -43,6 +59,25 @@ if [ "$(cat "$req_stamp" 2>/dev/null)" != "$req_hash" ]; then
     echo "$req_hash" > "$req_stamp"
 else
     echo "setup: .venv has requirements-dev.txt's packages (unchanged)"
+fi
+
+if [ "$bench" = 1 ]; then
+    # pip only when bench/requirements.txt (or the Python) changed
+    bench_hash=$( { cat bench/requirements.txt; .venv/bin/python -VV; } | sha256sum | cut -d' ' -f1)
+    bench_stamp=.venv/.meshfmm-bench-requirements.sha256
+    if [ "$(cat "$bench_stamp" 2>/dev/null)" != "$bench_hash" ]; then
+        .venv/bin/python -m pip install -q -r bench/requirements.txt
+        echo "$bench_hash" > "$bench_stamp"
+    else
+        echo "setup: .venv has bench/requirements.txt's packages (unchanged)"
+    fi
+    # gdist's PyPI wheel (2.1.0) is compiled against numpy 1.x and fails to
+    # import under numpy 2 ("numpy.dtype size changed"); rebuilt from its sdist
+    # against the installed numpy it imports.
+    if ! .venv/bin/python -c "import gdist" >/dev/null 2>&1; then
+        echo "setup: gdist does not import with this numpy; rebuilding it from source"
+        .venv/bin/python -m pip install -q --no-binary gdist --no-deps --force-reinstall gdist
+    fi
 fi
 
 [ "$deps_only" = 1 ] && exit 0

@@ -1,6 +1,6 @@
-"""Issue 11: the full distance matrix in-process (threads backend) against
-meshfmm.distributed.distance_matrix on a LocalCluster writing Zarr, on the
-same cores; target: the cluster reaches >= 90 % of the in-process entries/s.
+"""Does a Dask cluster keep up with one process? The full distance matrix
+in-process (threads backend) against meshfmm.distributed.distance_matrix on
+a LocalCluster writing Zarr, on the same cores; target: the cluster reaches >= 90 % of the in-process entries/s.
 
     MESHFMM_LIBRARY=build/libmeshfmm.so PYTHONPATH=bindings/python \
         python bench/scale/bench_cluster.py [--rows N] [--repeats 2] [--workers 2]

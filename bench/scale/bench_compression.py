@@ -1,6 +1,6 @@
-"""Issue 11: compression of distance-matrix chunks by the Zarr codecs
-meshfmm.distributed can use (Blosc: zstd, lz4, blosclz; byte or bit shuffle;
-levels), on rows of real meshes (tests/data/meshes), float32 and float64.
+"""How well do distance matrices compress? Distance-matrix chunks through the
+Zarr codecs meshfmm.distributed can use (Blosc: zstd, lz4, blosclz; byte or
+bit shuffle; levels), on rows of real meshes (tests/data/meshes), float32 and float64.
 
     MESHFMM_LIBRARY=build/libmeshfmm.so PYTHONPATH=bindings/python \
         python bench/scale/bench_compression.py [--rows 256] [--meshes a.off,b.obj]

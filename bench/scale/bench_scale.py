@@ -1,5 +1,6 @@
-"""Issue 11 benchmarks: sparse local rows/s as N grows, landmark S x T against
-full rows, and the sparse local matrix against gdist.local_gdist_matrix.
+"""Matrices at scale: sparse local rows/s as N grows, landmark S x T against
+full rows, and the sparse local matrix against gdist.local_gdist_matrix
+(skipped when gdist does not import: scripts/setup.sh --bench installs it).
 
     MESHFMM_LIBRARY=build/libmeshfmm.so PYTHONPATH=bindings/python \
         python bench/scale/bench_scale.py [--quick] [--threads 1]

@@ -1,5 +1,5 @@
-"""Issue 11: the numbers behind the 1M-vertex all-pairs plan (bench/RESULTS.md,
-section "Plan: all pairs on 1M vertices"), measured on this machine:
+"""The numbers behind the 1M-vertex all-pairs plan (bench/RESULTS.md,
+section "Plan: all pairs on a 1M-vertex mesh"), measured on this machine:
 
     MESHFMM_LIBRARY=build/libmeshfmm.so PYTHONPATH=bindings/python \
         python bench/scale/plan_1m.py && python bench/suite/make_results_md.py --no-readme

@@ -10,8 +10,9 @@ BENCH_REPEAT (3) runs per source, averaged over the reference's 3 sources;
 gdist's distances from the same sources.
 
 Meshes: tests/data/meshes (or $MESHFMM_DATA_DIR/meshes), references in
-tests/data/reference. gdist is skipped (and said so) when it does not import
-(its wheels are built against numpy 1; numpy 2 refuses them)."""
+tests/data/reference. gdist is skipped (and said so) when it does not import:
+run scripts/setup.sh --bench first (it builds gdist from source, since its
+wheel does not import under numpy 2)."""
 
 from __future__ import annotations
 

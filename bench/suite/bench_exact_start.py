@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The exact start of the march (issue 12.2): accuracy against exact geodesics
+"""The exact start of the march: accuracy against exact geodesics
 with and without it, against potpourri3d's robust heat method, the choice of
 the default radius, and the time per source.
 
@@ -18,8 +18,8 @@ Cases (3 sources each; references as in compare_peers.py):
   The exact reference on the sine surfaces is mfmm_solve_exact (equal to
   igl.exact_geodesic to 1e-9 on every stored mesh, tests/c/test_exact.c).
 
-Metrics: DESIGN.md's mean relative error % and max error % of the bounding-box
-diagonal (MRE averaged over sources, max over sources).
+Metrics (docs/methods.md#metrics): mean relative error % and max error % of the
+bounding-box diagonal (MRE averaged over sources, max over sources).
 Timing: per source, plain vs exact start in alternating rounds (median), on
 the meshes of 10k vertices and more; ratios from one run.
 

@@ -20,7 +20,8 @@ rows, write), except where a row says otherwise. On big meshes a subset of rows
 (spread over the mesh) is computed and the time to the full N x N matrix is
 extrapolated (marked "extrapolated").
 
-Writes bench/results/allpairs_peers.json.
+Writes bench/results/allpairs_peers.json. Needs the peers: run
+scripts/setup.sh --bench first.
 
     python bench/suite/compare_allpairs.py [--quick]
 """
@@ -190,8 +191,8 @@ def main():
         print(msg, flush=True)
 
     # mesh, rows computed (None: all), gdist.local_gdist_matrix radius (fraction of diagonal)
-    # (issue 13 names camelhead 2000 rows, nefertiti and a 250k+ mesh: sine 500,
-    # generated into the results' scratch folder; absolute paths pass through
+    # (camelhead 2000 rows, nefertiti and a 250k+ mesh: sine 500, generated into
+    # a scratch folder; absolute paths pass through
     # bl.DATA / "meshes" / name unchanged)
     gen_dir = Path(tempfile.gettempdir()) / "mfmm_bench_meshes"
     gen_dir.mkdir(exist_ok=True)

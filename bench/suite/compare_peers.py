@@ -19,11 +19,13 @@ the stored igl references is checked and recorded) where igl would take minutes.
 
 Timing: for the fast methods, rounds of per-method blocks (each method runs all
 sources, then the next method), the median over rounds x sources; the exact
-methods run once per source (they take up to seconds). Errors: DESIGN.md's
-mean relative error % and max error % of the bounding-box diagonal; MRE is
-averaged over sources, the max is the max over sources.
+methods run once per source (they take up to seconds). Errors
+(docs/methods.md#metrics): mean relative error % and max error % of the
+bounding-box diagonal; MRE is averaged over sources, the max is the max over
+sources.
 
-Writes bench/results/peers.json.
+Writes bench/results/peers.json. Needs the peers: run scripts/setup.sh --bench
+first.
 
     python bench/suite/compare_peers.py [--quick] [--only shared|sphere|lattice|sine]
 """

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Convergence with and without the exact start (issue 12.2): mean relative
+"""Convergence with and without the exact start: mean relative
 error and fitted order on icospheres (levels 4-7, source at an icosahedron
 vertex, great-circle distance) and on the obtuse lattice (x stretched 3x,
 n = 20..160, source nearest (1.5, 0.43), Euclidean distance), the meshes and

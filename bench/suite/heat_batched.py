@@ -1,5 +1,5 @@
 """The heat method of Crane, Weischedel & Wardetzky (2013) batched over many
-sources: the all-pairs peer of issue 13.
+sources: the strongest all-pairs peer (bench/suite/compare_allpairs.py).
 
 Factor once with CHOLMOD (scikit-sparse), then per block of `block` sources:
 heat flow (M + t L) U = delta_S, X = -grad U / |grad U| per face, Poisson
@@ -11,6 +11,8 @@ the whole block at once. |grad u| uses hypot: u underflows far from the
 source, and squaring it would give 0/0.
 
     python bench/suite/heat_batched.py MESH [ROWS]     # a quick check against meshfmm
+
+Needs scikit-sparse and robust-laplacian: run scripts/setup.sh --bench first.
 """
 
 from __future__ import annotations

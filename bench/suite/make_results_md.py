@@ -260,7 +260,7 @@ ALLP_NAMES = {
 
 
 def heat_batched_ratios(ap):
-    """Issue 13's yardstick: meshfmm's rate over the batched heat method's at
+    """The all-pairs yardstick: meshfmm's rate over the batched heat method's at
     the same core count (serial vs 1 process, threads vs 2), for the full N x N
     matrix (its time to the whole matrix: the heat method's precompute counted
     once, not over the rows run)."""
@@ -318,7 +318,7 @@ def allpairs_table(ap, meshes=None, compact=False):
     return "\n".join(L)
 
 
-# ---------------------------------------------------------------- scale (issue 11)
+# ---------------------------------------------------------------- scale and cluster
 def load_json(name):
     p = bl.RESULTS / name
     return json.loads(p.read_text()) if p.is_file() else None
@@ -332,7 +332,7 @@ def fbytes(b):
 
 
 def scale_section(sc):
-    L = ["## Sparse local matrices and landmarks (issue 11)", "",
+    L = ["## Sparse local matrices and landmarks", "",
          f"**Machine:** {machine_line(sc)}; {sc['threads']} thread(s); "
          f"`bench/scale/bench_scale.py` → bench/results/scale.json.", "",
          "Sparse local rows (`max_distance=r`, CSR) on sine surfaces, sources at random; a row "
@@ -382,7 +382,7 @@ def scale_section(sc):
 
 def cluster_section(cl, cl12=None, cldef=None):
     ent = cl["entries"]
-    L = ["## Dask cluster against in-process (issue 11)", "",
+    L = ["## Dask cluster against in-process", "",
          f"**Machine:** {machine_line(cl)}; load average at the end "
          f"{', '.join(f'{x:.1f}' for x in cl['load_average'])}. "
          f"`bench/scale/bench_cluster.py` → bench/results/cluster.json.", "",
@@ -444,7 +444,7 @@ def cluster_section(cl, cl12=None, cldef=None):
 
 
 def compression_section(co):
-    L = ["## Compression of distance matrices (issue 11)", "",
+    L = ["## Compression of distance matrices", "",
          f"**Machine:** {machine_line(co)}. `bench/scale/bench_compression.py` → "
          "bench/results/compression.json.", "",
          "Rows of real meshes (tests/data/meshes; contiguous sources, as a task writes them), in "
@@ -511,13 +511,13 @@ def plan_section(pl, cl, co):
     sched = tasks * pl["dask_seconds_per_noop_task"]
     bw = cores * n / t * 4 / lz  # compressed bytes/s a node writes
     per_task_s = br * t
-    L = ["## Plan: all pairs on a 1M-vertex mesh (issue 11)", "",
+    L = ["## Plan: all pairs on a 1M-vertex mesh", "",
          f"**Machine:** {machine_line(pl)}; load average "
          f"{', '.join(f'{x:.1f}' for x in pl.get('load_average', []))}. Numbers from "
          "`bench/scale/plan_1m.py` (bench/results/plan_1m.json), `bench/scale/bench_cluster.py` and "
          "`bench/scale/bench_compression.py`; refresh with `python bench/scale/plan_1m.py && python "
-         "bench/suite/make_results_md.py --no-readme` (the vertex renumbering of issue 13 changes the "
-         "per-row time, and the ratio of real meshes).", "",
+         "bench/suite/make_results_md.py --no-readme` after changes to the march or the vertex "
+         "order (they move the per-row time and the compression ratio of real meshes).", "",
          "**Measured** (m) on this machine; **extrapolated** (x) from them by the formula "
          "given.", "",
          "| quantity | value | m/x | how |", "|---|---|---|---|",
@@ -600,7 +600,7 @@ def plan_section(pl, cl, co):
 
 # ---------------------------------------------------------------- document
 def exact_start_section():
-    """The exact start (issue 12.2), from bench/results/exact_start.json and
+    """The exact start, from bench/results/exact_start.json and
     convergence.json (bench/suite/bench_exact_start.py, convergence_exact_start.py)."""
     es_path, cv_path = bl.RESULTS / "exact_start.json", bl.RESULTS / "convergence.json"
     if not es_path.is_file():
@@ -686,7 +686,7 @@ def main():
          "hand; rerun `bash bench/suite/run_all.sh` -->", "",
          f"**Machine:** {machine}.  ",
          f"**Versions:** {versions_line(peers)}.", "",
-         "Metrics (DESIGN.md): mean relative error in percent, `100/N Σ |d−e|/e` over vertices "
+         "Metrics ([docs/methods.md#metrics](../docs/methods.md#metrics)): mean relative error in percent, `100/N Σ |d−e|/e` over vertices "
          "with e > 0, averaged over the sources; max error in percent of the bounding-box "
          "diagonal, `100 max |d−e| / diag`, the worst over the sources. Every method gets the "
          "same source vertices (3 per mesh). Times are medians per source, one thread, "
