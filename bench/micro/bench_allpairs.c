@@ -237,7 +237,7 @@ int main(int argc, char **argv)
         /* tests/data/meshes beside the repository holding this file */
         const char *names[2] = {"camelhead.off", "nefertiti-lowres.obj"};
         const char *file = __FILE__;
-        const char *cut = strstr(file, "/bench/bench_allpairs.c");
+        const char *cut = strstr(file, "/bench/micro/bench_allpairs.c");
         int len = cut ? (int)(cut - file) : 0;
         for (int k = 0; k < 2; k++) {
             snprintf(defaults[k], sizeof defaults[k], "%.*s/tests/data/meshes/%s", len, file,

@@ -3,7 +3,7 @@ in-process (threads backend) against meshfmm.distributed.distance_matrix on
 a LocalCluster writing Zarr, on the same cores; target: the cluster reaches >= 90 % of the in-process entries/s.
 
     MESHFMM_LIBRARY=build/libmeshfmm.so PYTHONPATH=bindings/python \
-        python bench/scale/bench_cluster.py [--rows N] [--repeats 2] [--workers 2]
+        python bench/scale/bench_cluster.py [--rows N] [--repeats 3] [--workers 2]
 
 Default: camelhead (tests/data/meshes, 11,381 vertices), every row (130 M
 entries), float32, 2 worker processes of 1 thread against 2 library threads.
