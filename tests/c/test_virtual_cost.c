@@ -27,7 +27,7 @@
  * The issue's camelhead band (76 of 553 vertices > 20 % low) could not be
  * rebuilt exactly; planes x, y, z at 0.3, 0.5, 0.7 of the box and two
  * iso-distance bands, sources on and off the band, give 0 band vertices
- * > 20 % low now (bench/sweep_cost_bands.py). */
+ * > 20 % low now (bench/studies/sweep_cost_bands.py). */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>

@@ -31,7 +31,7 @@
  * on an 8-vertex flat mesh, 3 % found here with a 2-edge exact start), and
  * from two sources with values a triangle's planar update may be below the
  * Euclidean distance from either (the lower bound, a minimum of two cones, is
- * not convex). bench/oracle_sweep.py holds the default march to 1e-8.
+ * not convex). bench/studies/oracle_sweep.py holds the default march to 1e-8.
  *
  * Input layout (all optional past the end: zeros):
  *   byte 0: nv - 3 (3..66)      byte 1: nf - 1 (1..128)

@@ -1,4 +1,4 @@
-"""Meshes the oracle sweep (bench/oracle_sweep.py) found wrong, kept as
+"""Meshes the oracle sweep (bench/studies/oracle_sweep.py) found wrong, kept as
 regressions: every value must be the length of a real path on the surface,
 so never below the straight line through space from the source."""
 import numpy as np

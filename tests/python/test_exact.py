@@ -1,7 +1,7 @@
 """mfmm_solve_exact through the C ABI (meshfmm._lib): live against
 igl.exact_geodesic (Kirsanov's MMP) on the smallest test mesh, from
 vertices and from face centroids (igl's face sources), and the refusal of a
-cost. The stored references of all meshes are checked by bench/bench_exact.py
+cost. The stored references of all meshes are checked by bench/suite/bench_exact.py
 and tests/c/test_exact.c."""
 
 from __future__ import annotations
@@ -74,7 +74,7 @@ def test_cost_refused():
                                   "decimated-max", "camelhead"])
 def test_mesh_distance_method_exact_equals_stored_igl(name, reference_dir):
     """Mesh.distance(method="exact") against the stored igl.exact_geodesic rows
-    (1e-9 relative; the larger meshes are checked by bench/bench_exact.py)."""
+    (1e-9 relative; the larger meshes are checked by bench/suite/bench_exact.py)."""
     import meshfmm
     from conftest import load
 

@@ -6,7 +6,7 @@ serial row for every matrix backend.
 Seeded random meshes (a few hundred, seconds), the slit closed by slivers of
 a needle shortcut, a flat square rotated into 3D where the exact solver once
 returned 3x the Euclidean distance, and a random flat mesh with slivers where
-it returned less than the Euclidean distance. bench/oracle_sweep.py runs the
+it returned less than the Euclidean distance. bench/studies/oracle_sweep.py runs the
 same checks on 10,000 meshes.
 """
 

@@ -84,7 +84,7 @@ def _ends_at(p, x, h):
 
 @pytest.mark.parametrize("name", ["wingnut.obj", "spot.obj", "decimated-max.obj"])
 def test_paths_end_at_source_sweep(name):
-    """A reduced bench/sweep_paths.py: 30 targets from one reference source,
+    """A reduced bench/studies/sweep_paths.py: 30 targets from one reference source,
     the default call and with sources, and 30 random face-to-face pairs; none
     may end away from the source or stall."""
     V, F = load(name)
