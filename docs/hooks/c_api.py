@@ -130,6 +130,9 @@ def _names(decl: str):
     m = re.match(r"#\s*define\s+(\w+)", d)
     if m:
         return [m.group(1)]
+    m = re.match(r"(struct|enum|union)\s+(\w+)\s*\{", d)
+    if m:  # struct name { ... };
+        return [m.group(2)]
     if d.startswith("typedef") and "{" in d:  # typedef struct/enum x { ... } name;
         m = re.search(r"\}\s*(\w+)", d[d.rfind("}"):])
         return [m.group(1)] if m else []
@@ -167,7 +170,7 @@ def render(header: Path = HEADER) -> str:
     k = 0
     # the opening comment: the header's conventions
     if items and items[0][0] == "comment":
-        md += ["## Conventions", "", "```c", items[0][1], "```", ""]
+        md += ["## Overview", "", "```c", items[0][1], "```", ""]
         k = 1
     pending = None  # a comment waiting for the declaration under it
     group = None  # (names, code lines) of the entry being built
