@@ -13,6 +13,11 @@ import html
 import re
 from pathlib import Path
 
+try:  # a clean "Error: ..." from mkdocs, no traceback
+    from mkdocs.exceptions import PluginError as BuildError
+except ImportError:  # run alone: python docs/hooks/...
+    BuildError = RuntimeError
+
 MARKER = "<!-- c-api -->"
 HEADER = Path(__file__).resolve().parents[2] / "include" / "meshfmm.h"
 
@@ -163,7 +168,7 @@ def _escape_md(text: str) -> str:
 
 def render(header: Path = HEADER) -> str:
     if not header.is_file():
-        raise RuntimeError(f"c-api page: {header} not found")
+        raise BuildError(f"c-api page: {header} not found")
     text = header.read_text(encoding="utf-8")
     items = _scan(text)
     md = []

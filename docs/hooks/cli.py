@@ -17,6 +17,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+try:  # a clean "Error: ..." from mkdocs, no traceback
+    from mkdocs.exceptions import PluginError as BuildError
+except ImportError:  # run alone: python docs/hooks/...
+    BuildError = RuntimeError
+
 MARKER = "<!-- cli -->"
 REPO = Path(__file__).resolve().parents[2]
 
@@ -24,7 +29,7 @@ REPO = Path(__file__).resolve().parents[2]
 def _cli() -> Path:
     cli = Path(os.environ.get("MESHFMM_CLI") or REPO / "build" / "meshfmm")
     if not (cli.is_file() and os.access(cli, os.X_OK)):
-        raise RuntimeError(
+        raise BuildError(
             f"cli page: the meshfmm command line was not found at {cli}. Build it first "
             "(cmake -S . -B build -DCMAKE_BUILD_TYPE=Release && cmake --build build), "
             "or point MESHFMM_CLI at a built meshfmm binary.")
@@ -34,7 +39,7 @@ def _cli() -> Path:
 def _run(argv, env=None) -> str:
     r = subprocess.run(argv, capture_output=True, text=True, env=env, timeout=120)
     if r.returncode != 0:
-        raise RuntimeError(f"cli page: `{' '.join(map(str, argv))}` exited {r.returncode}: "
+        raise BuildError(f"cli page: `{' '.join(map(str, argv))}` exited {r.returncode}: "
                            f"{r.stderr.strip()[:500]}")
     return r.stdout if r.stdout.strip() else r.stderr
 
@@ -72,7 +77,7 @@ def render() -> str:
     md = ["## meshfmm", ""] + _block(top)
     commands = _commands(top)
     if not commands:
-        raise RuntimeError("cli page: `meshfmm --help` lists no commands under \"commands:\"")
+        raise BuildError("cli page: `meshfmm --help` lists no commands under \"commands:\"")
     for c in commands:
         md += [f"## meshfmm {c}", ""] + _block(_run([str(cli), c, "--help"]))
     env = _python_env()

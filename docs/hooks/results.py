@@ -12,13 +12,18 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+try:  # a clean "Error: ..." from mkdocs, no traceback
+    from mkdocs.exceptions import PluginError as BuildError
+except ImportError:  # run alone: python docs/hooks/...
+    BuildError = RuntimeError
+
 MARKER = "<!-- bench-results -->"
 RESULTS = Path(__file__).resolve().parents[2] / "bench" / "RESULTS.md"
 
 
 def render(path: Path = RESULTS) -> str:
     if not path.is_file():
-        raise RuntimeError(f"performance page: {path} not found (bench/suite/run_all.sh writes it)")
+        raise BuildError(f"performance page: {path} not found (bench/suite/run_all.sh writes it)")
     out, fenced = [], False
     for line in path.read_text(encoding="utf-8").splitlines():
         if line.lstrip().startswith("```"):
