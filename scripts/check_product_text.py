@@ -7,6 +7,7 @@ fails (exit 1, one `file:line: what` per finding) on
     "(issue ...", "#12", "PR 7");
   - work-log words: "this session", "this round", "as before this option
     existed", "appended fields", "this commit", ...;
+  - a link of README.md to a file the tree does not hold;
   - a stale DESIGN.md reference (the metrics are in docs/methods.md#metrics);
   - dated measurement notes in code (a date such as 2026-11-23 in src/,
     include/, kernels/ or bindings/: measurements and their dates belong to
@@ -92,6 +93,21 @@ def check_file(rel):
                 break
 
 
+def check_readme_links():
+    """Every relative link of README.md names a file or folder of the tree."""
+    path = os.path.join(ROOT, "README.md")
+    if not os.path.isfile(path):
+        return
+    with open(path, encoding="utf-8") as fh:
+        for i, line in enumerate(fh, 1):
+            for m in re.finditer(r"\]\(([^)\s]+)\)", line):
+                target = m.group(1).split("#", 1)[0]
+                if not target or re.match(r"[a-z]+:", target):
+                    continue
+                if not os.path.exists(os.path.join(ROOT, target)):
+                    yield f"README.md:{i}: link to a missing file: {m.group(1)}"
+
+
 def check_commits():
     def git(*args):
         return subprocess.run(["git", "-C", ROOT, *args], capture_output=True, text=True)
@@ -115,6 +131,7 @@ def main(argv):
     findings = []
     for rel in product_files():
         findings.extend(check_file(rel))
+    findings.extend(check_readme_links())
     if "--no-commits" not in argv:
         findings.extend(check_commits())
     for f in findings:
