@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Checks that the product's text says what and why, not the history of its work.
 
-Product text is src/, include/, kernels/, bindings/, README.md and docs/. It
+Product text is src/, include/, kernels/, bindings/, README.md and docs/
+(with bench/RESULTS.md, which docs/performance.md includes). It
 fails (exit 1, one `file:line: what` per finding) on
   - references to issues or pull requests ("issue 12", "issues 11 and 12",
     "(issue ...", "#12", "PR 7");
@@ -26,7 +27,8 @@ import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-PRODUCT = ["src", "include", "kernels", "bindings", "README.md", "docs"]
+# bench/RESULTS.md is generated, but the performance page shows it as it is
+PRODUCT = ["src", "include", "kernels", "bindings", "README.md", "docs", "bench/RESULTS.md"]
 CODE = ("src", "include", "kernels", "bindings")  # where a date is a measurement log
 TEXT_EXT = {".c", ".h", ".cl", ".py", ".pyi", ".md", ".txt", ".cmake", ".yml", ".yaml",
             ".toml", ".cfg", ".in", ".sh", ".html", ".css", ".js", ".rst"}
@@ -39,6 +41,7 @@ RULES = [
     (r"\bissues?\s+#?\d+", "issue reference"),
     (r"\bissues?\s+(?:and|or)\s+#?\d+", "issue reference"),
     (r"\(issues?\b", "issue reference"),
+    (r"\bissues?-\d+", "issue reference"),  # a heading's anchor
     (r"(?:^|[\s(\[,;])#\d+\b", "issue reference"),
     (r"\b(?:PR|pull request)\s*#?\d+", "pull request reference"),
     # "session" as a period of work; a terminal's or ssh's session is a thing
