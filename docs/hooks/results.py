@@ -3,8 +3,8 @@
 bench/RESULTS.md is written by bench/suite/make_results_md.py from the raw
 results (bench/results/*.json) and never edited by hand; the page's marker
 ``<!-- bench-results -->`` is replaced by it at build time, its headings one
-level down and its links rewritten for the site (../docs/images/X ->
-images/X; other relative links -> the file in the repository, as code).
+level down and its links rewritten for the site (../docs/X -> X, an image or
+a page; other relative links -> the file's path in the repository, as code).
 """
 
 from __future__ import annotations
@@ -31,9 +31,10 @@ def render(path: Path = RESULTS) -> str:
         elif not fenced:
             if line.startswith("#"):
                 line = "#" + line
-            line = line.replace("](../docs/images/", "](images/")
+            line = line.replace("](../docs/", "](")  # images and pages of this site
             # links to repository files (not pages of this site): shown as paths
-            line = re.sub(r"\[([^\]]+)\]\((?!images/|https?:|#)([^)]+)\)", r"\1 (`\2`)", line)
+            line = re.sub(r"\[([^\]]+)\]\((?!images/|https?:|#|[\w-]+\.md\b)([^)]+)\)",
+                          r"\1 (`\2`)", line)
         out.append(line)
     return "\n".join(out)
 
