@@ -5,8 +5,12 @@
 # the repository (or not committed) fails here: the C tests (ctest: cmocka,
 # command line, consumer), the C tests again under AddressSanitizer and
 # UndefinedBehaviorSanitizer, and the Python tests (pytest) against the
-# clone's library. The clone's builds are the only builds (no duplicate in
-# place). Outside a git checkout it runs in place.
+# clone's library. After the C tests, the product checks
+# (scripts/check_product_text.py: no issue numbers or work-log text;
+# scripts/check_rooms.py: the rooms of src/ depend downward) and the
+# documentation (mkdocs build --strict: a broken link, or a page missing
+# from the navigation, fails). The clone's builds are the only builds (no
+# duplicate in place). Outside a git checkout it runs in place.
 # Last, a short run of every libFuzzer harness (tests/fuzz; a crash fails
 # the run; a fixed seed, so that a red run is reproduced by running it again:
 # tests/fuzz/run.sh).
@@ -33,6 +37,16 @@ echo "== C tests (ctest, Release)"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMESHFMM_BUILD_BENCH=OFF >/dev/null
 cmake --build build -j"$jobs" >/dev/null
 ctest --test-dir build --output-on-failure -j"$jobs"
+
+echo "== Product checks"
+python3 scripts/check_product_text.py
+python3 scripts/check_rooms.py
+
+echo "== Documentation (mkdocs build --strict)"
+# the command-line page runs this build's meshfmm; the site goes into build/
+MESHFMM_CLI="$PWD/build/meshfmm" MESHFMM_LIBRARY="$PWD/build/libmeshfmm.so" \
+PYTHONPATH="$PWD/bindings/python" NO_MKDOCS_2_WARNING=1 \
+    .venv/bin/mkdocs build --strict --quiet -d "$PWD/build/site"
 
 echo "== C tests under AddressSanitizer + UndefinedBehaviorSanitizer"
 cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Debug -DMESHFMM_SANITIZE=ON \
