@@ -1974,6 +1974,7 @@ mfmm_status mfmm_solve_exact(mfmm_exact_solver *solver, const mfmm_source *sourc
     free(mapped.block);
     if (info) {
         mfmm_exact_info all;
+        memset(&all, 0, sizeof all);
         ex_fill_info(solver, &all);
         all.struct_size = sizeof all;
         mfmm_write_info(info, &all, sizeof all);
