@@ -1,21 +1,15 @@
 /*
  * meshfmm: geodesic distances and shortest paths on triangle meshes by the
  * Fast Marching Method of Kimmel & Sethian, "Computing geodesic paths on
- * manifolds", PNAS 95 (1998) 8431-8435.
+ * manifolds", PNAS 95 (1998) 8431-8435, with an exact polyhedral solver
+ * beside it.
  *
- * This is the one public header. C99, C ABI. Conventions:
- *   - vertices: float64, (nv, 3) row-major; faces: int32, (nf, 3) row-major,
- *     0-based.
- *   - cost F: |grad T| = F, so a path costs F times its length (a slowness).
- *     Per vertex or per face; finite and > 0. Default 1: geodesic distance.
- *   - unreached vertices (other components, beyond max_distance, not settled
- *     before an early stop) are +inf, never NaN.
- *   - every function returns an mfmm_status; mfmm_status_string() names it.
- *     Functions that validate input also fill an optional mfmm_error with
- *     the offending index and a sentence. The library never prints, aborts
- *     or exits, and keeps no global mutable state.
- *   - objects: an mfmm_mesh is immutable after creation and may be shared by
- *     threads; an mfmm_solver is a workspace for one thread at a time.
+ * The one public header; C99, C ABI. Its sections, essentials first:
+ *   1. conventions and ABI policy     6. exact distances
+ *   2. status and errors              7. paths
+ *   3. mesh                           8. distance matrices (and OpenCL)
+ *   4. sources and costs              9. I/O
+ *   5. solve (the march)             10. advanced: tuning and diagnostics
  */
 #ifndef MESHFMM_H
 #define MESHFMM_H
@@ -35,24 +29,54 @@ extern "C" {
 #define MFMM_API
 #endif
 
+/* ============================================ 1. conventions and ABI policy
+ *
+ * Arrays: vertices are float64 (nv, 3) row-major; faces int32 (nf, 3)
+ * row-major, 0-based; per-vertex results (nv,) in the caller's vertex order.
+ * Cost F: |grad T| = F, so a path costs F times its length (a slowness), per
+ * vertex or per face, finite and > 0; without one F = 1 and T is geodesic
+ * distance. Unreached vertices (another component, beyond max_distance, not
+ * settled before an early stop) are +inf, never NaN.
+ *
+ * Errors: every function that can fail returns an mfmm_status; those that
+ * validate input also fill an optional mfmm_error. The library never prints,
+ * aborts or exits, and keeps no global mutable state.
+ *
+ * Threads: an mfmm_mesh is immutable after creation and may be shared by any
+ * number of threads; a solver (mfmm_solver, mfmm_exact_solver) is a workspace
+ * for one thread at a time; an mfmm_opencl_context may be shared.
+ *
+ * Structs that can grow start with `size_t struct_size`:
+ *   - option structs (inputs): fill them with their _init function, which
+ *     sets struct_size to the sizeof the caller was compiled with, then set
+ *     fields. The library reads the first struct_size bytes and takes its
+ *     defaults for fields beyond them.
+ *   - info structs (outputs: mfmm_mesh_info, mfmm_solve_info, mfmm_exact_info,
+ *     mfmm_matrix_info) have no _init: the caller sets struct_size to their
+ *     sizeof before the call:
+ *         mfmm_mesh_info info = {.struct_size = sizeof info};
+ *     The library writes no more than struct_size bytes and sets struct_size
+ *     to the bytes it wrote (the smaller of the caller's and its own size).
+ * A struct_size smaller than sizeof(size_t), or (for an option struct) larger
+ * than the library's own struct, is refused with MFMM_ERR_BAD_ARGUMENT. A
+ * struct grows only by fields added at its end.
+ *
+ * Versions: the shared library's soname is libmeshfmm.so.0.MINOR while MAJOR
+ * is 0 (a MINOR release may break the API and the ABI; the CMake package then
+ * accepts only the same MINOR: find_package(meshfmm 0.2) takes 0.2.x), and
+ * libmeshfmm.so.MAJOR from 1.0 on (only a MAJOR release breaks the ABI).
+ * PATCH releases never break either. CHANGELOG.md lists every change.
+ * Booleans are int32_t, 0 or 1.
+ */
+
 #define MFMM_VERSION_MAJOR 0
-#define MFMM_VERSION_MINOR 1
+#define MFMM_VERSION_MINOR 2
 #define MFMM_VERSION_PATCH 0
 
-/* ABI policy. The shared library's soname is libmeshfmm.so.MAJOR (the CMake
- * SOVERSION is the major version). While MAJOR is 0, a MINOR release may break
- * the ABI and the API (the CMake package then accepts only the same MINOR:
- * find_package(meshfmm 0.1) takes 0.1.x); PATCH releases never do. From 1.0
- * on, only a MAJOR release breaks the ABI (and changes the soname).
- * Every option struct starts with `size_t struct_size`, which its _init
- * function sets to the sizeof the caller was compiled with: a struct that
- * later grows gains fields at its end, and the library reads a caller's
- * smaller, older struct by its size. Always fill an option struct with its
- * _init function before setting fields. A struct_size the library does not
- * know (not from an _init, or from a newer header than the library) is
- * refused with MFMM_ERR_BAD_ARGUMENT and a message naming both sizes. */
+/* "MAJOR.MINOR.PATCH" of the library linked at run time. Thread-safe. */
+MFMM_API const char *mfmm_version(void);
 
-/* ---------------------------------------------------------------- status */
+/* ==================================================== 2. status and errors */
 
 typedef enum mfmm_status {
     MFMM_OK = 0,
@@ -80,356 +104,267 @@ typedef enum mfmm_status {
     MFMM_STATUS_COUNT
 } mfmm_status;
 
-/* A sentence naming a status, e.g. "a face names one vertex twice". Never NULL. */
+/* A sentence naming a status, e.g. "a face names one vertex twice".
+ * Returns a static string, never NULL (also for unknown values). Thread-safe. */
 MFMM_API const char *mfmm_status_string(mfmm_status status);
 
-/* Details of a failure: filled by functions that take an `mfmm_error *err`
- * (which may be NULL). `index` is the offending vertex, face, source or file
- * line (-1 when none applies); `message` a sentence that names it. On success
- * status is MFMM_OK and message is empty. */
+/* Details of a failure, filled by functions that take an `mfmm_error *err`
+ * (which may be NULL). On success status is MFMM_OK, index -1 and message "". */
 typedef struct mfmm_error {
     mfmm_status status;
-    int64_t index;
-    char message[256];
+    int64_t index;        /* the offending vertex, face, source or file line; -1: none */
+    char message[256];    /* a sentence that names it */
 } mfmm_error;
 
-/* "MAJOR.MINOR.PATCH" of the library linked at run time. */
-MFMM_API const char *mfmm_version(void);
-
-/* ------------------------------------------------------------------ mesh */
+/* ================================================================= 3. mesh */
 
 typedef struct mfmm_mesh mfmm_mesh;
+typedef struct mfmm_mesh_options mfmm_mesh_options; /* section 10 */
 
-typedef struct mfmm_mesh_options {
-    size_t struct_size;   /* sizeof(mfmm_mesh_options), set by the _init function */
-    /* Most faces one unfolding walk may cross to find the virtual edge of an
-     * obtuse corner (paper section 4.2); a walk that needs more fails and the
-     * corner keeps its plain stencil. Default 64; must be >= 1. */
-    int32_t max_unfold_steps;
-    /* 1 (default): the march at F = 1 with unfolding reads per-vertex update
-     * records ("spokes"), built on the first such solve and kept with the
-     * mesh: about 380 bytes per vertex (mfmm_mesh_memory lists them), for a
-     * march 0.63-0.79x as long. 0: never build them; the march walks the
-     * faces instead, with the same results bit for bit (memory first: a
-     * 1M-vertex mesh holds 0.39 GB less). Other values are refused. */
-    int32_t spokes;
-} mfmm_mesh_options;
-
-/* Fills `options` with the defaults. */
-MFMM_API void mfmm_mesh_options_init(mfmm_mesh_options *options);
-
-/* Validates a triangle mesh and precomputes all a solve reuses: vertex
- * adjacency, edge lengths, corner angles, and a virtual edge for every obtuse
- * corner, found by unfolding (section 4.2).
- *   vertices: (nv, 3) float64, row-major; copied.
- *   faces:    (nf, 3) int32, row-major, 0-based; copied.
- *   options:  NULL for defaults.
+/* Validates a triangle mesh and precomputes what every solve reuses (vertex
+ * adjacency, edge lengths, corner angles, a virtual edge for every obtuse
+ * corner found by unfolding, section 4.2).
+ *   vertices: (nv, 3) float64; copied. 1 <= nv <= 715827882.
+ *   faces:    (nf, 3) int32, 0-based; copied. 1 <= nf <= 134217727.
+ *   options:  NULL for defaults (section 10).
  *   out:      receives the mesh; NULL on failure.
- * Refused: nv outside 1 .. 715827882, nf outside 1 .. 134217727
- * (MFMM_ERR_BAD_COUNT), NaN/inf coordinates (MFMM_ERR_NONFINITE_VERTEX),
- * coordinates beyond +-1e100 or a bounding box whose diagonal is below 1e-100
- * (MFMM_ERR_BAD_ARGUMENT: rescale), indices out of
- * range, a face that repeats a vertex. Results do not depend on the mesh's
- * scale (a mesh scaled by s gives distances scaled by s). Accepted: boundaries, several components,
- * unreferenced vertices, non-manifold edges, zero-area and needle faces. A
- * T-junction closed by a zero-area needle A-M-B (M inside edge AB of face
- * A-B-C, or of every face on a non-manifold AB) is closed inside: the
- * faces on AB are split at M and the needle dropped, so
- * distances and paths cross it as the surface does; face ids, per-face
- * costs and points stay the caller's (README, "Imperfect meshes").
- * Inside, vertices are renumbered along a space-filling curve (for memory
- * locality); every function takes and returns the caller's vertex ids and
- * per-vertex arrays in the caller's order, and faces keep their ids, so
- * results do not depend on the order the vertices are given in (but for
- * vertices that share a position). */
+ * Accepted: boundaries, several components, unreferenced vertices,
+ * non-manifold edges, zero-area and needle faces, copies of a face. A
+ * T-junction closed by a zero-area needle A-M-B (M inside edge AB) is closed
+ * inside: the faces on AB are split at M, so distances and paths cross it as
+ * the surface does. Face ids, vertex ids and per-vertex arrays stay the
+ * caller's everywhere (vertices are renumbered inside for locality); results
+ * scale with the mesh and do not depend on the order of the vertices.
+ * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_COUNT (nv or nf out of range);
+ * MFMM_ERR_NONFINITE_VERTEX; MFMM_ERR_INDEX_OUT_OF_RANGE;
+ * MFMM_ERR_REPEATED_VERTEX; MFMM_ERR_BAD_ARGUMENT (a coordinate beyond
+ * +-1e100 or a bounding-box diagonal below 1e-100: rescale; bad options);
+ * MFMM_ERR_OUT_OF_MEMORY. err->index names the vertex or face.
+ * Thread-safe. */
 MFMM_API mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv,
                                       const int32_t *faces, int32_t nf,
                                       const mfmm_mesh_options *options,
                                       mfmm_mesh **out, mfmm_error *err);
 
-/* Frees a mesh; NULL is a no-op. Solvers made for it must be gone first. */
+/* Frees a mesh; NULL is a no-op. Every solver, context call and path on it
+ * must have finished. */
 MFMM_API void mfmm_mesh_destroy(mfmm_mesh *mesh);
 
-/* Counts a mesh's diagnostics, computed once at creation. */
+/* A mesh's diagnostics, computed at creation (an output struct: set
+ * struct_size, section 1). Edge and component counts are of the surface
+ * built (T-junctions closed, copies of a face apart); face counts are of the
+ * faces as given. */
 typedef struct mfmm_mesh_info {
+    size_t struct_size;
     int32_t n_vertices;              /* nv as given */
     int32_t n_faces;                 /* nf as given */
-    int32_t n_edges;                 /* distinct undirected edges (this and the counts
-                                        below but n_degenerate_faces and
-                                        n_duplicate_faces: of the surface built, its
-                                        T-junctions closed, mfmm_mesh_create) */
-    int32_t n_boundary_edges;        /* edges with one face (copies apart) */
-    int32_t n_nonmanifold_edges;     /* edges with three or more faces (copies apart) */
+    int32_t n_edges;                 /* distinct undirected edges */
+    int32_t n_boundary_edges;        /* edges with one face */
+    int32_t n_nonmanifold_edges;     /* edges with three or more faces */
     int32_t n_components;            /* edge-connected components of referenced vertices */
     int32_t n_unreferenced_vertices; /* vertices no face names (always +inf) */
-    int32_t n_degenerate_faces;      /* faces of (numerically) zero area, as given
-                                        (needles closing a T-junction included) */
+    int32_t n_degenerate_faces;      /* faces of (numerically) zero area, needles included */
+    int32_t n_duplicate_faces;       /* faces repeating another face's vertices in any
+                                        order; the march updates through a copy as
+                                        through its original */
     int32_t n_obtuse_corners;        /* corners with an angle > 90 degrees */
     int32_t n_virtual_edges;         /* obtuse corners split by a virtual edge */
-    int32_t n_unfold_failures;       /* obtuse corners whose walk failed (boundary,
-                                        non-manifold edge, or step limit) */
+    int32_t n_unfold_failures;       /* obtuse corners whose unfolding walk failed
+                                        (boundary, non-manifold edge or step limit) */
     double min_edge_length;
     double max_edge_length;
     double mean_edge_length;
     double bbox_diagonal;            /* length of the bounding-box diagonal */
-    int32_t n_duplicate_faces;       /* faces that repeat another face's vertices (in
-                                        any order): copies, not counted in the edges'
-                                        faces (the edges are what the other faces make
-                                        them); the march updates through a copy as
-                                        through its original */
 } mfmm_mesh_info;
 
+/* Fills `info` (up to info->struct_size bytes) with the mesh's diagnostics.
+ * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_ARGUMENT (struct_size too
+ * small). Thread-safe. */
 MFMM_API mfmm_status mfmm_mesh_get_info(const mfmm_mesh *mesh, mfmm_mesh_info *info);
 
-/* The mesh's sizes (convenience; the same numbers as mfmm_mesh_info). */
+/* nv and nf as given; 0 for NULL. Thread-safe. */
 MFMM_API int32_t mfmm_mesh_vertex_count(const mfmm_mesh *mesh);
 MFMM_API int32_t mfmm_mesh_face_count(const mfmm_mesh *mesh);
 
-/* The memory a mesh holds, array by array (workspaces of solvers and
- * matrix calls apart).
- *   names: (max,) receives each array's name, a static string of the
- *          library (never freed);
- *   bytes: (max,) receives its size in bytes;
- *   max:   room in names and bytes; 0 (with NULL arrays) to ask for the count.
- * Returns the number of arrays, all of them even past max; -1 when mesh is
- * NULL, max < 0, or names or bytes is NULL with max > 0. Two entries are
- * built on first use and kept with the mesh, and count 0 until then:
- * "spokes (once built)" (the march's update records, mfmm_mesh_options.spokes)
- * and "exact tables (once built)" (the exact start and mfmm_solve_exact).
- * Safe to call while other threads solve on the mesh. */
-MFMM_API int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes,
-                              int max);
+/* ===================================================== 4. sources and costs */
 
-/* --------------------------------------------------------------- sources */
-
-/* A source: a vertex (face == -1), or a point inside a face given by
- * barycentric coordinates (w0, w1, w2) of the face's corners (>= 0, summing
- * to 1 within 1e-9). `value` is T at the source (usually 0): the result is
- * T(x) = min over sources of (value + cost-weighted distance). By default
- * the march starts from the exact distances of the vertices within
- * exact_start_radius mean edge lengths of each source (see
- * mfmm_solve_options); with that option 0, or where the cost is not uniform
- * near the source, a vertex source starts at its vertex and a point source
- * from straight-segment distances to the vertices near it (through the faces
- * within about two mean edge lengths). Either way a point on an edge or at a
- * corner is a point of every face holding it, so T does not depend on which
- * face names it, and moves continuously with the point. */
+/* A source: a vertex (face == -1), or a point in a face by barycentric
+ * coordinates of its corners (>= 0, summing to 1 within 1e-9); a point on an
+ * edge or at a corner is a point of every face holding it, so T does not
+ * depend on which face names it. The result is T(x) = min over sources of
+ * (value + cost-weighted distance). */
 typedef struct mfmm_source {
     int32_t vertex;     /* vertex id when face == -1; ignored otherwise */
     int32_t face;       /* face id, or -1 for a vertex source */
     double bary[3];     /* barycentric coordinates in the face; ignored for a vertex */
-    double value;       /* initial value of T at the source */
+    double value;       /* T at the source (usually 0) */
 } mfmm_source;
 
 /* Where a cost array lives. */
 typedef enum mfmm_cost_location {
     MFMM_COST_NONE = 0,       /* F = 1 everywhere: geodesic distance */
-    MFMM_COST_PER_VERTEX = 1, /* cost has nv entries; F is linear along each edge
-                                 and local path (trapezoid means, march.h) */
-    MFMM_COST_PER_FACE = 2    /* cost has nf entries; paths refract at region borders */
+    MFMM_COST_PER_VERTEX = 1, /* nv entries; F is linear along each edge */
+    MFMM_COST_PER_FACE = 2    /* nf entries; paths refract at region borders */
 } mfmm_cost_location;
 
-/* ---------------------------------------------------------------- solver */
+/* ===================================================== 5. solve (the march) */
 
 typedef struct mfmm_solver mfmm_solver;
 
-/* A reusable workspace (heap, labels, a touched list) for one mesh and one
- * thread: about 40 bytes per vertex, plus, made by the first solve that uses
- * the exact start, an exact solver's workspace (about 45 bytes per vertex;
- * the mesh's exact tables, about 156 bytes per face, are built once per mesh
- * and shared: see mfmm_exact_solver_create). The first solve without a cost
- * and with unfolding also builds the mesh's spokes (about 380 bytes per
- * vertex: each neighbour's update data, ready in the order the march reads
- * it, which makes that march 0.63-0.79x as long), likewise built once
- * per mesh under a lock and shared by every solver, thread and job on it
- * (if there is no memory for them, the march reads the faces instead and
- * gives the same distances). After that first solve, solving allocates nothing beyond a copy of
- * its arguments in the mesh's internal vertex order (sources, targets, a
- * per-vertex cost), kept and reused while large enough (the exact start's
- * queue grows only for a larger patch than any before). Between solves the
- * workspace is kept clean by resetting only the vertices the
- * last march reached, so a local solve (max_distance, targets) costs in
- * proportion to what it reaches, apart from filling `distances`. */
+/* Makes a reusable workspace for marches on one mesh, for one thread. The
+ * first solve builds what later solves reuse (the exact start's workspace;
+ * the mesh's shared tables, once per mesh, under a lock); after that a solve
+ * allocates only copies of its arguments, and costs in proportion to what it
+ * reaches (max_distance, targets) apart from filling `distances`.
+ *   mesh: the mesh, which must outlive the solver.
+ *   out:  receives the solver; NULL on failure.
+ * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_OUT_OF_MEMORY. Thread-safe. */
 MFMM_API mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out);
 
 /* Frees a solver; NULL is a no-op. */
 MFMM_API void mfmm_solver_destroy(mfmm_solver *solver);
 
+/* The default of exact_start_radius: a radius that grows with the mesh
+ * (MFMM_EXACT_START_RADIUS, section 10). */
+#define MFMM_EXACT_START_AUTO (-1.0)
+
 typedef struct mfmm_solve_options {
-    size_t struct_size;              /* sizeof(mfmm_solve_options), set by the _init function */
-    const double *cost;              /* NULL: F = 1. Finite and > 0, and small enough that
-                                        the largest times the edges' total length stays
-                                        below DBL_MAX / 16 (else distances could overflow
-                                        to +inf, "not reached"): MFMM_ERR_BAD_COST */
+    size_t struct_size;              /* set by mfmm_solve_options_init */
+    const double *cost;              /* NULL (default): F = 1. Finite and > 0, and its
+                                        largest entry times the edges' total length below
+                                        DBL_MAX / 16 */
     mfmm_cost_location cost_location;/* ignored when cost is NULL */
-    double max_distance;             /* stop past it; vertices beyond are +inf. Default +inf;
-                                        NaN or < 0: MFMM_ERR_BAD_ARGUMENT */
-    const int32_t *targets;          /* stop once all these vertices are settled; NULL: none */
+    double max_distance;             /* stop past it; vertices beyond are +inf. Default
+                                        +inf; >= 0 */
+    const int32_t *targets;          /* stop once all these vertices are settled; NULL
+                                        (default): none */
     int32_t n_targets;
     int32_t unfolding;               /* 1 (default): obtuse corners update through their
-                                        virtual edges; 0: plain stencils (for comparison) */
-    /* Appended fields. */
-    /* The exact start: the march starts from the exact polyhedral
-     * distances (mfmm_solve_exact's) of the vertices within this many mean
-     * edge lengths of each source (at least the corners of the faces holding
-     * it), T = value + F * distance, instead of from the source's vertex (a
-     * vertex source) or straight segments (a point source). A first-order
-     * march makes most of its error at the source's point singularity and
-     * carries it on: this start lowers the mean error by about half at the
-     * default (bench/RESULTS.md), for a few hundred microseconds per source.
-     * Exact distances hold for F = 1, so with a cost it applies to a source
-     * only where the cost is one F over the patch (per vertex: every patch
-     * vertex and its neighbours; per face: every face around a patch vertex;
-     * then T = value + F * distance); elsewhere that source takes the
-     * straight start. Default MFMM_EXACT_START_AUTO (a radius that grows
-     * with the mesh, below); 0: the paper's plain start, as before this
-     * option existed. MFMM_EXACT_START_AUTO, or finite and >= 0, else
-     * MFMM_ERR_BAD_ARGUMENT. */
+                                        virtual edges; 0: plain stencils */
+    /* The exact start: the march starts from the exact polyhedral distances
+     * (mfmm_solve_exact's) of the vertices within this many mean edge lengths
+     * of each source (at least the corners of its faces), T = value + F *
+     * distance, instead of from the source's vertex or straight segments to
+     * the vertices near a point source. It removes most of the error a
+     * first-order march makes at the source's point singularity. With a cost
+     * it applies only to a source around which F is one constant (else that
+     * source starts plainly). MFMM_EXACT_START_AUTO (default), or finite and
+     * >= 0; 0: the plain start of the paper. */
     double exact_start_radius;
 } mfmm_solve_options;
 
-/* exact_start_radius's base, in mean edge lengths (chosen by measurement:
- * bench/RESULTS.md, "Exact start"). The patch also holds the vertices just
- * beyond the radius whose exact distances the propagation has found anyway
- * (within a face's height of it). */
-#define MFMM_EXACT_START_RADIUS 7.0
-
-/* exact_start_radius's default: MFMM_EXACT_START_RADIUS mean edge lengths,
- * times sqrt(nv / MFMM_EXACT_START_AUTO_VERTICES) on larger meshes for a
- * march without max_distance (17.5 at 250,000 vertices, 35 at a million).
- * A radius in mean edges covers less of a finer mesh, and the error the
- * source's singularity creates then dominates again (with 7, the mean error
- * over the plain start's is 0.33-0.59 on the meshes of 3-35k vertices, 0.62
- * on igea's 134k, 0.63 on a 251k sine surface); this keeps the patch the same share of the
- * surface, so about the same share of a full march's time. A march with
- * max_distance (a local row) keeps the base radius, so that its cost
- * depends on its reach in mean edges and not on the mesh's size. */
-#define MFMM_EXACT_START_AUTO (-1.0)
-#define MFMM_EXACT_START_AUTO_VERTICES 40000
-
-/* Fills `options` with the defaults: no cost, no limit, no targets, unfolding on,
- * the exact start with its default radius (MFMM_EXACT_START_AUTO). */
+/* Fills `options` with the defaults: no cost, no limit, no targets,
+ * unfolding on, exact_start_radius MFMM_EXACT_START_AUTO. NULL is a no-op. */
 MFMM_API void mfmm_solve_options_init(mfmm_solve_options *options);
 
 /* Marches from the sources and writes T for every vertex.
- *   solver:    from mfmm_solver_create for the mesh being solved.
- *   sources:   n_sources >= 1 sources.
+ *   solver:    from mfmm_solver_create.
+ *   sources:   (n_sources,) n_sources >= 1.
  *   options:   NULL for defaults.
- *   distances: (nv,) float64 out. Settled vertices hold T; all others +inf
- *              (with targets, only settled vertices are final). */
+ *   distances: (nv,) float64 out: T at settled vertices, +inf elsewhere (with
+ *              targets, only settled vertices are final).
+ * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_COUNT; MFMM_ERR_BAD_SOURCE,
+ * MFMM_ERR_BAD_BARYCENTRIC, MFMM_ERR_DEGENERATE_SOURCE (err->index: the
+ * source); MFMM_ERR_BAD_COST (err->index: the entry); MFMM_ERR_BAD_ARGUMENT
+ * (max_distance NaN or < 0, a target out of range, exact_start_radius,
+ * struct_size); MFMM_ERR_OUT_OF_MEMORY.
+ * Thread safety: one call at a time per solver. */
 MFMM_API mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources,
                                 int32_t n_sources, const mfmm_solve_options *options,
                                 double *distances, mfmm_error *err);
 
-/* What the last mfmm_solve on a solver did. */
+/* What the last mfmm_solve on a solver did (an output struct: set
+ * struct_size, section 1). */
 typedef struct mfmm_solve_info {
-    size_t struct_size;      /* set by the caller: sizeof(mfmm_solve_info); the library
-                                writes no more than this many bytes */
-    int64_t start_fallbacks; /* vertices of the exact start whose exact distance failed
-                                a bound every distance meets (at least the straight-line
-                                distance from the source, at most the shortest edge path
-                                to it) and which the march computed instead; 0 unless the
-                                exact solver erred on a degenerate mesh */
+    size_t struct_size;
+    int64_t start_fallbacks; /* exact-start vertices whose exact distance broke a bound
+                                every distance meets (at least the straight-line distance
+                                from the source, at most the shortest edge path) and
+                                which the march computed instead; 0 but on degenerate
+                                meshes */
 } mfmm_solve_info;
 
-/* Fills info about the solver's last mfmm_solve (zeros before the first).
- * MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_ARGUMENT when info->struct_size is
- * smaller than a size_t. Not safe while the solver solves in another thread. */
+/* Fills `info` about the solver's last mfmm_solve (zeros before the first).
+ * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_ARGUMENT (struct_size too
+ * small). Not while the solver solves in another thread. */
 MFMM_API mfmm_status mfmm_solver_get_info(const mfmm_solver *solver, mfmm_solve_info *info);
 
-/* ----------------------------------------------------------------- exact */
+/* ====================================================== 6. exact distances */
 
-/* Exact polyhedral geodesic distance (F = 1): the length of the shortest
- * path on the surface of the piecewise-flat mesh, by window propagation
- * (Chen & Han with the pruning of Xin & Wang, "ICH"; saddles start windows
- * only in their shadow; see src/exact/exact.c). Equal to Kirsanov's MMP
- * (igl.exact_geodesic, gdist) to rounding (about 1e-14 relative), several
- * times faster than gdist. Boundaries are walls a path may run along but not
- * cross; a non-manifold edge joins every face on it to every other (a path
- * crosses from any into any; on degenerate fans, past a budget of windows,
- * they are walls again: info->nonmanifold_walls); paths may pass through
- * saddle, boundary and non-manifold vertices; a zero-area face is passed
- * through along its line (a T-junction closed by a needle joins both sides);
- * copies of a face are no part of the surface. Not for a cost: see
- * mfmm_solve. */
+/* Exact polyhedral geodesic distance (F = 1): the length of the shortest path
+ * on the surface of the piecewise-flat mesh, by window propagation (Chen &
+ * Han with the pruning of Xin & Wang). Equal to Kirsanov's MMP
+ * (igl.exact_geodesic, gdist) to rounding; see docs/methods.md. Boundaries
+ * are walls a path may run along; a path crosses a non-manifold edge from any
+ * face on it into any other (on degenerate folded fans, past a budget of
+ * windows, those edges become walls: mfmm_exact_info.nonmanifold_walls); a
+ * zero-area face is passed along its line; copies of a face are ignored. For
+ * a cost use mfmm_solve. */
 typedef struct mfmm_exact_solver mfmm_exact_solver;
 
-/* A workspace for one mesh and one thread: per-vertex state (about 45
- * bytes per vertex) and a queue of windows (56 bytes each) that grows as
- * needed and is kept for the next solve (mfmm_exact_info.peak_bytes tells
- * the total). The mesh's edge geometry (about 156 bytes per face) is built by
- * the first exact solver or exact start on the mesh, under a lock, kept by the
- * mesh until mfmm_mesh_destroy and shared by every solver and thread on it,
- * so a later job does not pay for it again. Several exact solvers may share
- * one mesh, one per thread. */
+/* Makes a workspace for exact solves on one mesh, for one thread; its window
+ * queue grows as needed and is kept for the next solve. The mesh's edge
+ * tables are built by the first exact solver or exact start on it (under a
+ * lock) and shared by every solver on the mesh.
+ *   mesh: the mesh, which must outlive the solver.
+ *   out:  receives the solver; NULL on failure.
+ * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_OUT_OF_MEMORY. Thread-safe. */
 MFMM_API mfmm_status mfmm_exact_solver_create(const mfmm_mesh *mesh, mfmm_exact_solver **out);
 
 /* Frees an exact solver; NULL is a no-op. */
 MFMM_API void mfmm_exact_solver_destroy(mfmm_exact_solver *solver);
 
 typedef struct mfmm_exact_options {
-    size_t struct_size;   /* sizeof(mfmm_exact_options), set by the _init function */
-    /* Must be NULL: exact distances are for F = 1 (a cost is refused with
-     * MFMM_ERR_BAD_ARGUMENT; use mfmm_solve for weighted distances). */
-    const double *cost;
-    mfmm_cost_location cost_location;
+    size_t struct_size;   /* set by mfmm_exact_options_init */
     double max_distance;  /* vertices farther are +inf and the propagation stops
-                             there (cost grows with the area reached). Default +inf */
-    size_t memory_limit;  /* bytes the solver may hold in all during this solve,
-                             its per-mesh tables included (a larger queue kept
-                             from an earlier solve is released first); needing
-                             more returns MFMM_ERR_MEMORY_LIMIT. 0 (default): no
-                             limit */
+                             there. Default +inf; >= 0 */
+    size_t memory_limit;  /* bytes the solver may hold during the solve, the mesh's
+                             tables included; needing more returns
+                             MFMM_ERR_MEMORY_LIMIT. 0 (default): no limit */
     int (*interrupt)(void *user); /* NULL (default), or called every few milliseconds
                              of propagation: non-zero stops the solve with
-                             MFMM_ERR_CANCELLED (Ctrl-C in a program that solves
-                             large meshes) */
+                             MFMM_ERR_CANCELLED */
     void *user;           /* passed to interrupt */
 } mfmm_exact_options;
 
-/* Fills `options` with the defaults: no cost, no limit on distance or memory,
- * no interrupt. */
+/* Fills `options` with the defaults: no limit on distance or memory, no
+ * interrupt. NULL is a no-op. */
 MFMM_API void mfmm_exact_options_init(mfmm_exact_options *options);
 
-/* What one exact solve did. */
+/* What one exact solve did (an output struct: set struct_size, section 1). */
 typedef struct mfmm_exact_info {
-    int64_t n_windows;        /* windows created */
-    int64_t n_propagated;     /* windows taken from the queue and carried across their face */
-    int64_t n_pseudo_sources; /* vertex sources and saddle / boundary vertices that
-                                 started windows */
-    int64_t peak_windows;     /* most windows queued at once */
-    size_t peak_bytes;        /* most bytes the solver held (tables + queue) */
-    int32_t nonmanifold_walls; /* 1: the windows crossing non-manifold edges passed
-                                  their budget (degenerate folded fans) and the solve
-                                  was redone with those edges as walls, where values
-                                  are then upper bounds; 0: they were crossed */
+    size_t struct_size;
+    int64_t n_windows;         /* windows created */
+    int64_t n_propagated;      /* windows taken from the queue and carried across a face */
+    int64_t n_pseudo_sources;  /* vertex sources and saddle or boundary vertices that
+                                  started windows */
+    int64_t peak_windows;      /* most windows queued at once */
+    size_t peak_bytes;         /* most bytes the solver held (tables and queue) */
+    int32_t nonmanifold_walls; /* 1: windows crossing non-manifold edges passed their
+                                  budget and the solve was redone with those edges as
+                                  walls (values there are upper bounds); 0: crossed */
 } mfmm_exact_info;
 
 /* Exact geodesic distances from the sources to every vertex.
- *   solver:    from mfmm_exact_solver_create for the mesh.
- *   sources:   n_sources >= 1 sources, as for mfmm_solve: a vertex, or a point
- *              in a face by barycentric coordinates (on an edge or at a corner
- *              when some are 0), each with an initial value; the result is
- *              min over sources of value + geodesic distance.
- *   options:   NULL for defaults; cost must be NULL.
- *   distances: (nv,) float64 out. Vertices in no component a source reaches,
- *              unreferenced vertices and vertices beyond max_distance are
- *              +inf (never NaN).
- *   info:      (out) may be NULL.
- * Errors: MFMM_ERR_NULL_POINTER, MFMM_ERR_BAD_COUNT (n_sources < 1),
- * MFMM_ERR_BAD_SOURCE / MFMM_ERR_BAD_BARYCENTRIC / MFMM_ERR_DEGENERATE_SOURCE
- * (err->index is the source), MFMM_ERR_BAD_ARGUMENT (a cost given, or
- * max_distance NaN or < 0), MFMM_ERR_MEMORY_LIMIT, MFMM_ERR_OUT_OF_MEMORY;
- * on error distances are all +inf. */
+ *   solver:    from mfmm_exact_solver_create.
+ *   sources:   (n_sources,) n_sources >= 1, as for mfmm_solve.
+ *   options:   NULL for defaults.
+ *   distances: (nv,) float64 out; +inf where no source reaches and beyond
+ *              max_distance; all +inf on error.
+ *   info:      out, may be NULL.
+ * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_COUNT; MFMM_ERR_BAD_SOURCE,
+ * MFMM_ERR_BAD_BARYCENTRIC, MFMM_ERR_DEGENERATE_SOURCE (err->index: the
+ * source); MFMM_ERR_BAD_ARGUMENT (max_distance NaN or < 0, struct_size);
+ * MFMM_ERR_MEMORY_LIMIT; MFMM_ERR_CANCELLED; MFMM_ERR_OUT_OF_MEMORY.
+ * Thread safety: one call at a time per solver. */
 MFMM_API mfmm_status mfmm_solve_exact(mfmm_exact_solver *solver, const mfmm_source *sources,
                                       int32_t n_sources, const mfmm_exact_options *options,
                                       double *distances, mfmm_exact_info *info,
                                       mfmm_error *err);
 
-/* ----------------------------------------------------------------- paths */
+/* ================================================================ 7. paths */
 
-/* A point on the surface: a face and barycentric coordinates in it, with its
- * position. */
+/* A point on the surface: a face, barycentric coordinates in it, its position. */
 typedef struct mfmm_surface_point {
     int32_t face;
     double bary[3];
@@ -437,256 +372,271 @@ typedef struct mfmm_surface_point {
 } mfmm_surface_point;
 
 typedef struct mfmm_path_options {
-    size_t struct_size;   /* sizeof(mfmm_path_options), set by the _init function */
+    size_t struct_size;   /* set by mfmm_path_options_init */
     int32_t max_points;   /* most points a path may have; default 100000 */
-    /* Sources the distances came from (as given to mfmm_solve): the path ends
-     * exactly at the one the target's distance came from (a vertex source at
-     * its vertex, a face source at its point, straight from the faces near
-     * it). NULL: it ends at a vertex where T is 0 and no neighbour (over an
-     * edge or a virtual edge) is lower; where T stops decreasing above 0 (a
-     * face source, a source value > 0) the call fails rather than end
-     * there. */
+    /* The sources the distances came from: the path ends exactly at the one
+     * the target's distance came from. NULL (default): it ends at a vertex
+     * where T is 0 and no neighbour is lower (where T stops decreasing above
+     * 0, the call fails rather than end there). */
     const mfmm_source *sources;
     int32_t n_sources;
     const double *cost;               /* the cost the distances were solved with, or NULL */
     mfmm_cost_location cost_location;
-    double *weighted_length;          /* out, may be NULL: the cost-weighted length
-                                         (sum of F times segment length; with no cost,
-                                         the Euclidean length) */
+    double *weighted_length;          /* out, may be NULL: the sum of F times segment
+                                         length (without a cost, the length) */
     /* 1 (default): straighten the traced path inside the strip of faces it
-     * crossed (unfolded; the shortest polyline through the shared edges, by the
-     * funnel algorithm), which removes the drift that T's first-order error
-     * gives the gradient. Points where the path passes a vertex between faces
-     * without a shared edge stay fixed. With a cost array the path is not
-     * straightened (a weighted path refracts where the cost changes, which the
-     * traced path does and straight chords do not). Never longer than the
-     * traced path. 0: the traced path of section 5 as it is. */
-    int straighten;
+     * crossed (the shortest polyline through the shared edges, by the funnel
+     * algorithm), removing the drift that T's first-order error gives the
+     * gradient; never longer than the traced path. Not applied with a cost (a
+     * weighted path refracts). 0: the traced path of section 5. */
+    int32_t straighten;
 } mfmm_path_options;
 
 /* Fills `options` with the defaults: 100000 points, no sources, no cost,
- * straighten = 1. */
+ * straighten 1. NULL is a no-op. */
 MFMM_API void mfmm_path_options_init(mfmm_path_options *options);
 
-/* Backtracks from `target` along -grad T to the source (paper section 5):
- * Heun's method on T interpolated by a quadratic over each face and its three
- * neighbours, the face's linear gradient where that fit is ill-posed, and
- * Euler steps at sonic points.
- *   distances: (nv,) from mfmm_solve.
- *   target:    a vertex (face == -1) or a point in a face (value ignored);
- *              not in a zero-area face (MFMM_ERR_DEGENERATE_SOURCE, as for a
- *              source: give the point in a face beside it).
+/* Traces the shortest path from `target` back to the source along -grad T
+ * (paper section 5: Heun's method on T interpolated by a quadratic over each
+ * face and its neighbours, then straightened).
+ *   distances: (nv,) T from mfmm_solve (or mfmm_solve_exact).
+ *   target:    a vertex (face == -1) or a point in a face (value ignored), not
+ *              in a zero-area face.
  *   options:   NULL for defaults.
- *   points:    caller buffer of `capacity` points (NULL when capacity is 0);
- *              receives the polyline from the target to the source: the
- *              target, each edge crossing and vertex passed, and the end.
- *              points[i].face (i > 0) is the face the segment from point i-1
- *              ran through; the target's is its own face.
- *   n_points:  receives the count (the status is MFMM_ERR_BAD_COUNT when
- *              capacity is too small, with *n_points the count needed).
- *   length:    receives the polyline's Euclidean length (may be NULL).
- * Where T has no descent over faces and edges at a vertex (its value came
- * through a virtual edge, section 4.2, or straight from a point source), the
- * path follows that straight segment through the faces it crosses.
- * MFMM_ERR_BAD_COST: options->cost has an entry not finite or not > 0
- * (every entry is checked, as mfmm_solve does; err->index names it).
- * MFMM_ERR_UNREACHED: T(target) is +inf. MFMM_ERR_PATH_STALLED: T stopped
- * decreasing before a source (without sources: above 0), or the path needed
- * more than max_points points; never a path that ends elsewhere. */
+ *   points:    (capacity,) out, NULL when capacity is 0: the polyline from
+ *              the target to the source (the target, each edge crossing and
+ *              vertex passed, the end); points[i].face (i > 0) is the face
+ *              the segment from point i-1 runs through.
+ *   n_points:  out: the count (also on MFMM_ERR_BAD_COUNT: the count needed).
+ *   length:    out, may be NULL: the polyline's Euclidean length.
+ * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_COUNT (capacity too small);
+ * MFMM_ERR_BAD_SOURCE, MFMM_ERR_BAD_BARYCENTRIC, MFMM_ERR_DEGENERATE_SOURCE
+ * (the target or a source); MFMM_ERR_BAD_COST (err->index: the entry);
+ * MFMM_ERR_BAD_ARGUMENT; MFMM_ERR_UNREACHED (T(target) is +inf);
+ * MFMM_ERR_PATH_STALLED (T stopped decreasing before a source, or the path
+ * needed more than max_points points: never a path that ends elsewhere);
+ * MFMM_ERR_OUT_OF_MEMORY. Thread-safe. */
 MFMM_API mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
                                      const mfmm_source *target,
                                      const mfmm_path_options *options,
                                      mfmm_surface_point *points, int32_t capacity,
                                      int32_t *n_points, double *length, mfmm_error *err);
 
-/* --------------------------------------------------------- matrix (rows) */
+/* ================================================== 8. distance matrices */
 
 typedef enum mfmm_backend {
     MFMM_BACKEND_AUTO = 0,   /* OpenCL on a usable device that is not a CPU (or that the
                                 caller named), else threads */
-    MFMM_BACKEND_SERIAL = 1, /* one solver, this thread */
-    MFMM_BACKEND_THREADS = 2,/* one serial solver per thread */
-    MFMM_BACKEND_OPENCL = 3  /* many sources at once on an OpenCL device */
+    MFMM_BACKEND_SERIAL = 1, /* one solver, the calling thread */
+    MFMM_BACKEND_THREADS = 2,/* one solver per thread */
+    MFMM_BACKEND_OPENCL = 3  /* many rows at once on an OpenCL device */
 } mfmm_backend;
 
-/* Name of a backend: "auto", "serial", "threads", "opencl". */
+/* "auto", "serial", "threads", "opencl" ("unknown" otherwise). Thread-safe. */
 MFMM_API const char *mfmm_backend_name(mfmm_backend backend);
-
-/* An OpenCL device with meshfmm's program built for it (building takes
- * 0.03 s with warm caches, about 1 s cold). Make one and pass it in
- * mfmm_matrix_options.opencl to build once for many calls. Thread-safe: each
- * call makes its own queue and kernel.
- *
- * OpenCL is loaded at run time: the library does not link libOpenCL, and
- * opens the ICD loader (libOpenCL.so.1) only when a context is made, so
- * meshfmm loads and solves on a machine without any OpenCL, and only the
- * OpenCL backend needs it. The context holds the loader's function table (no
- * global state). */
-typedef struct mfmm_opencl_context mfmm_opencl_context;
-
-/* How to make an OpenCL context. Every field NULL means the default, which
- * an environment variable may set; a field set here wins over the environment.
- *   device:    an index over all platforms' devices in order ("0", "1", ...),
- *              or a case-insensitive substring of a device name ("pthread",
- *              "NVIDIA"). NULL: $MESHFMM_OPENCL_DEVICE, else the first CPU
- *              device, else the first device.
- *   cache_dir: the folder for the built program binary. NULL:
- *              $MESHFMM_CACHE_DIR, else $XDG_CACHE_HOME/meshfmm, else
- *              $HOME/.cache/meshfmm. "" : no disk cache (always build).
- *              Entries are files fmm_rows-<key>.bin, <key> a hash of the kernel
- *              source, build options, library version, platform, device and
- *              driver versions, so a binary from another build or driver is
- *              never loaded; a damaged entry is rebuilt from source and
- *              replaced. Deleting the folder (or its fmm_rows-*.bin files)
- *              clears the cache; it is refilled on the next build.
- *   library:   the OpenCL ICD loader to dlopen. NULL: $MESHFMM_OPENCL_LIBRARY,
- *              else "libOpenCL.so.1". */
-typedef struct mfmm_opencl_options {
-    size_t struct_size;      /* sizeof(mfmm_opencl_options), set by the _init function */
-    const char *device;
-    const char *cache_dir;
-    const char *library;
-} mfmm_opencl_options;
-
-/* Fills `options` with the defaults (all NULL: the environment, then the
- * built-in defaults). */
-MFMM_API void mfmm_opencl_options_init(mfmm_opencl_options *options);
-
-/* Loads OpenCL, selects the device and builds the program (from the disk
- * cache when it holds a valid binary for this exact build and driver).
- *   options: NULL for defaults (see mfmm_opencl_options).
- *   out:     receives the context; NULL on failure.
- * MFMM_ERR_NO_OPENCL when the loader cannot be opened, no device matches or
- * works, or meshfmm was built without the OpenCL headers; MFMM_ERR_OPENCL_BUILD
- * when the program does not build. The mfmm_error says which. */
-MFMM_API mfmm_status mfmm_opencl_context_create(const mfmm_opencl_options *options,
-                                                mfmm_opencl_context **out, mfmm_error *err);
-
-/* Frees a context; NULL is a no-op. No call may be using it. */
-MFMM_API void mfmm_opencl_context_destroy(mfmm_opencl_context *context);
-
-/* The name of the context's device ("" for NULL). */
-MFMM_API const char *mfmm_opencl_context_device_name(const mfmm_opencl_context *context);
 
 typedef enum mfmm_dtype {
     MFMM_FLOAT32 = 0,
     MFMM_FLOAT64 = 1
 } mfmm_dtype;
 
-/* Receives finished rows: rows [first_row, first_row + n_rows) of the matrix,
- * n_rows x nv values (n_targets with targets) of the requested dtype,
- * row-major, valid during the call. Rows arrive in order. Return 0 to go on, non-zero to cancel
- * (mfmm_distance_matrix then returns MFMM_ERR_CANCELLED). */
+/* Receives finished rows [first_row, first_row + n_rows), n_rows x width
+ * values of the job's dtype, row-major, valid during the call; rows arrive in
+ * order. Returns 0 to go on, non-zero to cancel (MFMM_ERR_CANCELLED). */
 typedef int (*mfmm_rows_callback)(void *user, int32_t first_row, int32_t n_rows,
                                   const void *rows);
 
-/* Receives finished rows as a CSR block (sparse output, see
- * mfmm_matrix_options.on_sparse): rows [first_row, first_row + n_rows);
- * row i's entries are indices[indptr[i] .. indptr[i+1]) (column ids,
- * ascending) with values[same range] of the requested dtype. indptr has
- * n_rows + 1 entries and starts at 0 for each block. Valid during the call;
- * rows arrive in order. Return 0 to go on, non-zero to cancel. */
+/* Receives finished rows [first_row, first_row + n_rows) as a CSR block: row
+ * i's entries are indices[indptr[i] .. indptr[i+1]) (column ids, ascending)
+ * with values[same range] of the job's dtype; indptr has n_rows + 1 entries
+ * and starts at 0. Valid during the call; rows arrive in order. Returns 0 to
+ * go on, non-zero to cancel (MFMM_ERR_CANCELLED). */
 typedef int (*mfmm_sparse_callback)(void *user, int32_t first_row, int32_t n_rows,
                                     const int64_t *indptr, const int32_t *indices,
                                     const void *values);
 
+typedef struct mfmm_opencl_context mfmm_opencl_context;
+typedef struct mfmm_opencl_options mfmm_opencl_options;
+
 typedef struct mfmm_matrix_options {
-    size_t struct_size;              /* sizeof(mfmm_matrix_options), set by the _init function */
+    size_t struct_size;              /* set by mfmm_matrix_options_init */
     mfmm_backend backend;            /* default MFMM_BACKEND_AUTO */
-    mfmm_dtype dtype;                /* output type; arithmetic is always float64. Default
-                                        float32, refused (MFMM_ERR_BAD_ARGUMENT) where a
-                                        distance could pass FLT_MAX: the edges' total length
-                                        times the largest cost, or max_distance if less */
+    mfmm_dtype dtype;                /* of the output; arithmetic is float64. Default
+                                        float32, refused where a distance could pass
+                                        FLT_MAX */
     const double *cost;              /* as in mfmm_solve_options */
     mfmm_cost_location cost_location;
-    double max_distance;             /* default +inf; NaN or < 0: MFMM_ERR_BAD_ARGUMENT */
-    int32_t unfolding;               /* default 1 */
-    int32_t n_threads;               /* threads backend; 0: all cores */
-    size_t memory_limit;             /* bytes the library may use for workspaces and
-                                        blocks in flight; 0: a default from the device */
-    void *out;                       /* n_sources x nv (n_targets with targets) buffer of
-                                        dtype to fill, or NULL */
-    mfmm_rows_callback on_rows;      /* called with each finished block, or NULL */
-    void *user;                      /* passed to on_rows */
-    mfmm_backend backend_used;       /* out: the backend that ran */
-    mfmm_opencl_context *opencl;     /* for the OpenCL backend: a context to reuse, or
-                                        NULL to make one for this call */
+    double max_distance;             /* default +inf; >= 0 */
+    const int32_t *targets;          /* NULL (default): every vertex is a column (width
+                                        nv). Else (n_targets,) vertex ids, any order,
+                                        repeats allowed: column j is the distance to
+                                        targets[j], and each row's march stops once its
+                                        targets are settled */
+    int32_t n_targets;
+    int32_t unfolding;               /* default 1, as in mfmm_solve_options */
+    double exact_start_radius;       /* as in mfmm_solve_options, on every backend */
+    int32_t n_threads;               /* threads backend; 0 (default): all cores */
+    size_t memory_limit;             /* bytes for workspaces and blocks in flight; 0
+                                        (default): a default of the library */
+    void *out;                       /* (n_sources, width) of dtype to fill, or NULL */
+    mfmm_rows_callback on_rows;      /* dense rows, block by block, or NULL */
+    mfmm_sparse_callback on_sparse;  /* sparse rows: only the finite entries (the
+                                        source's own 0 included); out and on_rows must
+                                        then be NULL; not on OPENCL */
+    void *user;                      /* passed to on_rows and on_sparse */
+    mfmm_opencl_context *opencl;     /* OpenCL: a context to reuse, or NULL to make one
+                                        for the call */
     const mfmm_opencl_options *opencl_options; /* how to make the call's context when
                                         opencl is NULL; NULL: defaults */
-    char fallback_reason[256];       /* out: with backend AUTO, why threads ran instead of
-                                        OpenCL (the OpenCL error, or that OpenCL could not
-                                        keep every core busy); "" when OpenCL ran */
-    /* Rectangular and sparse jobs (appended fields). */
-    const int32_t *targets;          /* NULL: every vertex is a column (rows nv wide).
-                                        Else n_targets >= 1 vertex ids: rows are n_targets
-                                        wide, column j the distance to targets[j] (any
-                                        order, duplicates allowed), and each row's march
-                                        stops once all its targets are settled */
-    int32_t n_targets;
-    int64_t vertices_settled;        /* out: vertices settled over all rows by the serial and
-                                        threads backends (the work done); 0 from OpenCL */
-    /* Sparse output: rows go to on_sparse as CSR blocks holding only the
-     * finite entries (distance <= max_distance; the source's own 0 is an
-     * explicit entry), built from each march's touched list, so memory and
-     * time follow the entries, never n_sources x nv. out and on_rows must be
-     * NULL. Serial and threads backends; OPENCL fails with
-     * MFMM_ERR_BAD_ARGUMENT, AUTO runs threads. */
-    mfmm_sparse_callback on_sparse;
-    /* as in mfmm_solve_options (appended field): each row's march starts from
-     * the exact distances within this many mean edge lengths of its source, on
-     * every backend (OpenCL: computed on the host, uploaded with the batch).
-     * Default MFMM_EXACT_START_AUTO; 0: the plain start */
-    double exact_start_radius;
-    int64_t start_fallbacks;         /* out: over all rows, on every backend, as
-                                        mfmm_solve_info.start_fallbacks */
 } mfmm_matrix_options;
 
+/* Fills `options` with the defaults (auto backend, float32, no cost, no limit,
+ * every vertex a column, unfolding on, MFMM_EXACT_START_AUTO, all cores, no
+ * output). NULL is a no-op. */
 MFMM_API void mfmm_matrix_options_init(mfmm_matrix_options *options);
 
-/* One row per source: row i holds the distances from vertex sources[i] to
- * every vertex (equal to mfmm_solve's), or to options->targets (an
- * n_sources x n_targets matrix, see mfmm_matrix_options.targets; on every
- * backend, OpenCL's kernel marching each row to its targets too), densely
- * (out, on_rows: n_sources x width values, width = n_targets or nv) or
- * sparsely (on_sparse; not on OpenCL: OPENCL fails with
- * MFMM_ERR_BAD_ARGUMENT and AUTO runs threads, fallback_reason says so). sources NULL: all vertices, in order
- * (n_sources must then be nv). Rows go to options->out, to options->on_rows,
- * or both; the library holds only the blocks in flight, never n_sources x nv.
- * With backend AUTO, threads run instead of OpenCL when OpenCL fails (from the
- * first row not yet delivered), and when OpenCL could not keep every compute
- * unit busy (a batch of rows smaller than the device's compute units within
- * memory_limit), and when the device is a CPU that the caller did not name
- * (mfmm_opencl_options.device or MESHFMM_OPENCL_DEVICE): on the same cores
- * the threads backend runs the same rows faster (README, "Command line");
- * options->backend_used tells which ran and
- * options->fallback_reason why. OpenCL: the device and program cache are
- * options->opencl's, else options->opencl_options' (see
- * mfmm_opencl_options). A batch holds at least one row per compute unit
- * (each row needs about 37 bytes per vertex for float32 output) unless
- * memory_limit is set and smaller. Float64 rows equal mfmm_solve's bit for bit
- * (OpenCL: built without contraction or relaxed math; tested on PoCL). */
+/* What one mfmm_distance_matrix call did (an output struct: set
+ * struct_size, section 1). */
+typedef struct mfmm_matrix_info {
+    size_t struct_size;
+    mfmm_backend backend_used;    /* the backend that ran (the last one, after a
+                                     fallback) */
+    char backend_reason[256];     /* why another backend than the one asked for ran (the
+                                     OpenCL error, a CPU device, too few rows per compute
+                                     unit, sparse rows); "" when the requested one ran */
+    int64_t vertices_settled;     /* vertices settled over all rows by the serial and
+                                     threads backends; 0 from OpenCL */
+    int64_t start_fallbacks;      /* over all rows, as mfmm_solve_info.start_fallbacks */
+} mfmm_matrix_info;
+
+/* Computes one row per source: row i holds the distances from vertex
+ * sources[i] to every vertex (equal to mfmm_solve's), or to options->targets.
+ *   mesh:      the mesh.
+ *   sources:   (n_sources,) vertex ids; NULL: every vertex in order
+ *              (n_sources must be nv).
+ *   options:   required: out, on_rows (or both), or on_sparse.
+ *   info:      out, may be NULL; filled also on failure.
+ * Rows go to the buffer and callbacks in order; the library holds only the
+ * blocks in flight. With MFMM_BACKEND_AUTO the threads backend runs instead
+ * of OpenCL (from the first row not yet delivered) when OpenCL fails, when
+ * the device is a CPU the caller did not name, when a batch would not keep
+ * every compute unit busy within memory_limit, and for sparse rows
+ * (info->backend_reason says why). Float64 rows equal mfmm_solve's bit for
+ * bit on every backend.
+ * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_COUNT (n_sources, n_targets);
+ * MFMM_ERR_BAD_SOURCE (err->index: the row); MFMM_ERR_BAD_COST;
+ * MFMM_ERR_BAD_ARGUMENT (no output, sparse with dense or on OPENCL, a
+ * target, dtype, backend, max_distance, float32 range, struct_size);
+ * MFMM_ERR_CANCELLED; MFMM_ERR_NO_OPENCL, MFMM_ERR_OPENCL_BUILD,
+ * MFMM_ERR_OPENCL_RUNTIME (backend OPENCL); MFMM_ERR_OUT_OF_MEMORY.
+ * Thread-safe (calls on one mesh may run at once; callbacks run on the
+ * calling thread). */
 MFMM_API mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
-                                          int32_t n_sources, mfmm_matrix_options *options,
-                                          mfmm_error *err);
+                                          int32_t n_sources,
+                                          const mfmm_matrix_options *options,
+                                          mfmm_matrix_info *info, mfmm_error *err);
 
-/* ------------------------------------------------------------------- I/O */
+/* An OpenCL device with meshfmm's program built for it: make one and pass it
+ * in mfmm_matrix_options.opencl to build once for many calls. OpenCL is
+ * loaded at run time (the library does not link libOpenCL; it opens the ICD
+ * loader only when a context is made), so everything else works on a machine
+ * without OpenCL. */
+struct mfmm_opencl_options {
+    size_t struct_size;      /* set by mfmm_opencl_options_init */
+    /* Device: an index over all platforms' devices in order ("0", "1", ...) or
+     * a case-insensitive substring of a device name ("pthread", "NVIDIA").
+     * NULL: $MESHFMM_OPENCL_DEVICE, else the first CPU device, else the first. */
+    const char *device;
+    /* Folder of the built program binaries (files fmm_rows-<key>.bin, keyed by
+     * kernel source, build options, library, platform, device and driver
+     * versions; a damaged entry is rebuilt). NULL: $MESHFMM_CACHE_DIR, else
+     * $XDG_CACHE_HOME/meshfmm, else $HOME/.cache/meshfmm. "": no disk cache. */
+    const char *cache_dir;
+    /* The OpenCL ICD loader to open. NULL: $MESHFMM_OPENCL_LIBRARY, else
+     * "libOpenCL.so.1". */
+    const char *library;
+};
 
-/* Reads a triangle mesh: OBJ (v/vt/vn indices, negative indices, polygons
- * fan-triangulated), OFF (CRLF too), PLY (ascii, binary little/big endian;
- * faces or tristrips), STL (binary or ascii, told apart by binary STL's
- * 84 + 50 n size; corners welded into vertices by exact position, facets
- * with coinciding corners dropped). The format comes from the extension
- * (case-insensitive), else from the content; other formats (glTF, FBX,
- * 3DS, DAE, ...) fail with MFMM_ERR_PARSE and a sentence naming the formats
- * read. Only regular files are read (a directory, FIFO or device fails at
- * once with MFMM_ERR_IO). Numbers are read the same whatever the locale
- * (correctly rounded). On success *vertices is (nv,3) float64 and *faces
- * (nf,3) int32, both allocated by the library: free them with mfmm_free. */
+/* Fills `options` with the defaults (all NULL: the environment, then the
+ * built-in defaults). NULL is a no-op. */
+MFMM_API void mfmm_opencl_options_init(mfmm_opencl_options *options);
+
+/* Loads OpenCL, selects the device and builds the program (or loads it from
+ * the disk cache), checking it against the serial solver on a small mesh.
+ *   options: NULL for defaults.
+ *   out:     receives the context; NULL on failure.
+ * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_ARGUMENT (struct_size);
+ * MFMM_ERR_NO_OPENCL (no loader, no matching or working device, or built
+ * without OpenCL headers); MFMM_ERR_OPENCL_BUILD; MFMM_ERR_OPENCL_RUNTIME;
+ * MFMM_ERR_OUT_OF_MEMORY. Thread-safe. */
+MFMM_API mfmm_status mfmm_opencl_context_create(const mfmm_opencl_options *options,
+                                                mfmm_opencl_context **out, mfmm_error *err);
+
+/* Frees a context; NULL is a no-op. No call may be using it. */
+MFMM_API void mfmm_opencl_context_destroy(mfmm_opencl_context *context);
+
+/* The name of the context's device ("" for NULL). Thread-safe. */
+MFMM_API const char *mfmm_opencl_context_device_name(const mfmm_opencl_context *context);
+
+/* ================================================================== 9. I/O */
+
+/* Reads a triangle mesh file: OBJ, OFF, PLY (ascii and binary; faces or
+ * tristrips) or STL (binary or ascii; corners welded by exact position,
+ * facets with coinciding corners dropped); polygons are fan-triangulated.
+ * The format comes from the extension, else from the content. Numbers are
+ * read the same in every locale.
+ *   path:     a regular file.
+ *   vertices: out: (nv, 3) float64, allocated by the library (mfmm_free).
+ *   faces:    out: (nf, 3) int32, allocated by the library (mfmm_free).
+ * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_IO (cannot open or read, not a
+ * regular file); MFMM_ERR_PARSE (malformed or another format; err->index: the
+ * line); MFMM_ERR_BAD_COUNT; MFMM_ERR_OUT_OF_MEMORY. Thread-safe. */
 MFMM_API mfmm_status mfmm_load_mesh(const char *path, double **vertices, int32_t *nv,
                                     int32_t **faces, int32_t *nf, mfmm_error *err);
 
-/* Frees memory the library handed out (mfmm_load_mesh). NULL is a no-op. */
+/* Frees memory the library handed out (mfmm_load_mesh); NULL is a no-op. */
 MFMM_API void mfmm_free(void *pointer);
+
+/* ============================================ 10. advanced: tuning, memory
+ * Knobs with good defaults, and diagnostics; most programs need none. */
+
+struct mfmm_mesh_options {
+    size_t struct_size;        /* set by mfmm_mesh_options_init */
+    /* Most faces one unfolding walk may cross to find the virtual edge of an
+     * obtuse corner (section 4.2); a walk that needs more fails and the corner
+     * keeps its plain stencil. Default 64; >= 1. */
+    int32_t max_unfold_steps;
+    /* 1 (default): marches at F = 1 with unfolding read per-vertex update
+     * records ("spokes"), built by the first such solve and kept with the
+     * mesh, for a shorter march. 0: never build them (less memory); the
+     * results are the same bit for bit. */
+    int32_t spokes;
+};
+
+/* Fills `options` with the defaults. NULL is a no-op. */
+MFMM_API void mfmm_mesh_options_init(mfmm_mesh_options *options);
+
+/* exact_start_radius's base under MFMM_EXACT_START_AUTO, in mean edge
+ * lengths. The default radius is this times sqrt(nv /
+ * MFMM_EXACT_START_AUTO_VERTICES) on meshes larger than that (e.g. 17.5 at
+ * 250,000 vertices), so that the patch keeps the same share of a finer
+ * surface; a march with a finite max_distance keeps the base radius, so that
+ * its cost follows its reach. The patch also holds the vertices just beyond
+ * the radius whose exact distances the propagation found anyway. */
+#define MFMM_EXACT_START_RADIUS 7.0
+#define MFMM_EXACT_START_AUTO_VERTICES 40000
+
+/* The memory a mesh holds, array by array (solvers' and calls' workspaces
+ * apart); entries built on first use ("spokes (once built)", "exact tables
+ * (once built)") count 0 until then.
+ *   names: (max,) out: each array's name, a static string of the library.
+ *   bytes: (max,) out: its size in bytes.
+ *   max:   room in names and bytes; 0 (with NULL arrays) to ask for the count.
+ * Returns the number of arrays (all of them, even past max); -1 when mesh is
+ * NULL, max < 0, or names or bytes is NULL with max > 0. Thread-safe, also
+ * while other threads solve on the mesh. */
+MFMM_API int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes,
+                              int max);
 
 #ifdef __cplusplus
 }

@@ -107,6 +107,7 @@ static void run_child(const char *path, mfmm_backend backend, int threads, int32
     for (int32_t i = 0; i < n_rows; i++)
         src[i] = (int32_t)((int64_t)i * nv / n_rows);
     mfmm_matrix_options o;
+    mfmm_matrix_info oi = {.struct_size = sizeof oi};
     mfmm_matrix_options_init(&o);
     o.backend = backend;
     o.n_threads = threads;
@@ -122,13 +123,13 @@ static void run_child(const char *path, mfmm_backend backend, int threads, int32
         o.opencl = ctx;
         int64_t warm = 0;
         o.user = &warm;
-        mfmm_distance_matrix(mesh, src, 2, &o, &err);
+        mfmm_distance_matrix(mesh, src, 2, &o, &oi, &err);
         o.user = &r.rows;
     }
     reset_peak();
     long before = status_kb("VmRSS");
     double c0 = cpu_seconds(), t0 = now();
-    mfmm_status st = mfmm_distance_matrix(mesh, src, n_rows, &o, &err);
+    mfmm_status st = mfmm_distance_matrix(mesh, src, n_rows, &o, &oi, &err);
     r.seconds = now() - t0;
     r.cpu = cpu_seconds() - c0;
     r.run_kb = status_kb("VmHWM") - before;

@@ -55,13 +55,13 @@ static int bench(const char *path, double edges, int n_sources)
         fprintf(stderr, "%s: cannot build the mesh or solver\n", path);
         return 1;
     }
-    mfmm_mesh_info mi;
+    mfmm_mesh_info mi = {.struct_size = sizeof mi};
     mfmm_mesh_get_info(mesh, &mi);
     double radius = edges * mi.mean_edge_length;
     /* sources: referenced vertices, spread evenly */
     int32_t first = F[0];
     mfmm_source full_src = {first, -1, {0, 0, 0}, 0.0};
-    mfmm_exact_info info;
+    mfmm_exact_info info = {.struct_size = sizeof info};
     double t0 = now();
     mfmm_solve_exact(ws, &full_src, 1, NULL, d, &info, NULL);
     double t_full = now() - t0;

@@ -421,11 +421,12 @@ int cmd_allpairs(int argc, char **argv)
     mfmm_error err;
     /* auto: the library runs OpenCL, or threads (from the first row not
      * delivered) when OpenCL fails or cannot keep every core busy */
-    mfmm_status st = mfmm_distance_matrix(mesh, src, (int32_t)n_src, &o, &err);
-    mfmm_backend used = o.backend_used;
-    if (o.fallback_reason[0] && !tgt && !sparse && !quiet)
+    mfmm_matrix_info info = {.struct_size = sizeof info};
+    mfmm_status st = mfmm_distance_matrix(mesh, src, (int32_t)n_src, &o, &info, &err);
+    mfmm_backend used = info.backend_used;
+    if (info.backend_reason[0] && !tgt && !sparse && !quiet)
         fprintf(stderr, "meshfmm allpairs: OpenCL not used (%s); falling back to threads\n",
-                o.fallback_reason);
+                info.backend_reason);
     if (cli_interrupted()) {
         if (sparse)
             cli_npz_abort(&s.z);

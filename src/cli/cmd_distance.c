@@ -63,7 +63,7 @@ static double *solve_exact(const mfmm_mesh *mesh, const cli_sources_and_cost *o,
     mfmm_exact_options eo;
     mfmm_exact_options_init(&eo);
     eo.max_distance = max_d;
-    mfmm_exact_info info;
+    mfmm_exact_info info = {.struct_size = sizeof info};
     st = mfmm_solve_exact(solver, o->src, o->n_src, &eo, dist, &info, &err);
     mfmm_exact_solver_destroy(solver);
     if (st != MFMM_OK) {

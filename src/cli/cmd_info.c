@@ -73,7 +73,7 @@ int cmd_info(int argc, char **argv)
     mfmm_mesh *mesh = cli_load_mesh(path, &opt, NULL);
     if (!mesh)
         return CLI_FAIL;
-    mfmm_mesh_info m;
+    mfmm_mesh_info m = {.struct_size = sizeof m};
     mfmm_status st = mfmm_mesh_get_info(mesh, &m);
     /* the built mesh's bytes (the tables a first solve adds are 0 here) */
     const char *names[32];

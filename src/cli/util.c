@@ -366,7 +366,7 @@ mfmm_mesh *cli_load_mesh(const char *path, const mfmm_mesh_options *options,
     }
     mfmm_mesh *mesh = NULL;
     st = mfmm_mesh_create(V, nv, F, nf, options, &mesh, &err);
-    mfmm_mesh_info info;
+    mfmm_mesh_info info = {.struct_size = sizeof info};
     if (st == MFMM_OK && in_no_face && mfmm_mesh_get_info(mesh, &info) == MFMM_OK &&
         info.n_unreferenced_vertices > 0) {
         /* (F's ids are in range: the mesh was built from it) */

@@ -493,9 +493,8 @@ mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *
     mfmm_mesh_options opt;
     mfmm_mesh_options_init(&opt);
     if (options) {
-        if (mfmm_check_struct_size(options, sizeof opt, "mfmm_mesh_options", err) != MFMM_OK)
+        if (mfmm_read_options(&opt, options, sizeof opt, "mfmm_mesh_options", err) != MFMM_OK)
             return MFMM_ERR_BAD_ARGUMENT;
-        opt = *options;
     }
     if (opt.max_unfold_steps < 1)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "max_unfold_steps must be >= 1 (got %ld)",
@@ -613,8 +612,9 @@ mfmm_status mfmm_mesh_get_info(const mfmm_mesh *mesh, mfmm_mesh_info *info)
 {
     if (!mesh || !info)
         return MFMM_ERR_NULL_POINTER;
-    *info = mesh->info;
-    return MFMM_OK;
+    mfmm_mesh_info all = mesh->info;
+    all.struct_size = sizeof all;
+    return mfmm_write_info(info, &all, sizeof all);
 }
 
 int32_t mfmm_mesh_vertex_count(const mfmm_mesh *mesh)

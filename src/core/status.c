@@ -70,12 +70,43 @@ mfmm_status mfmm_check_struct_size(const void *options, size_t known, const char
 {
     size_t given;
     memcpy(&given, options, sizeof given);
-    if (given == known)
+    if (given >= sizeof given && given <= known)
         return MFMM_OK;
     return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
-                     "%s.struct_size is %zu, but this library (meshfmm %s) knows only %zu: "
+                     "%s.struct_size is %zu, but this library (meshfmm %s) reads %zu to %zu: "
                      "fill it with %s_init (a header of another version?)",
-                     type, given, mfmm_version(), known, type);
+                     type, given, mfmm_version(), sizeof given, known, type);
+}
+
+mfmm_status mfmm_read_options(void *dst, const void *options, size_t known, const char *type,
+                              mfmm_error *err)
+{
+    if (mfmm_check_struct_size(options, known, type, err) != MFMM_OK)
+        return MFMM_ERR_BAD_ARGUMENT;
+    size_t given;
+    memcpy(&given, options, sizeof given);
+    memcpy(dst, options, given); /* fields past the caller's struct keep dst's defaults */
+    memcpy(dst, &known, sizeof known);
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_check_info_size(const void *info)
+{
+    size_t given;
+    memcpy(&given, info, sizeof given);
+    return given >= sizeof given ? MFMM_OK : MFMM_ERR_BAD_ARGUMENT;
+}
+
+mfmm_status mfmm_write_info(void *info, const void *all, size_t known)
+{
+    size_t given;
+    memcpy(&given, info, sizeof given);
+    if (given < sizeof given)
+        return MFMM_ERR_BAD_ARGUMENT;
+    size_t n = given < known ? given : known;
+    memcpy(info, all, n);
+    memcpy(info, &n, sizeof n);
+    return MFMM_OK;
 }
 
 void mfmm_ok(mfmm_error *err)

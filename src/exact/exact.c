@@ -264,8 +264,6 @@ void mfmm_exact_options_init(mfmm_exact_options *options)
         return;
     memset(options, 0, sizeof *options);
     options->struct_size = sizeof *options;
-    options->cost = NULL;
-    options->cost_location = MFMM_COST_NONE;
     options->max_distance = INFINITY;
     options->memory_limit = 0;
     options->interrupt = NULL;
@@ -1933,8 +1931,13 @@ mfmm_status mfmm_solve_exact(mfmm_exact_solver *solver, const mfmm_source *sourc
                              double *distances, mfmm_exact_info *info, mfmm_error *err)
 {
     mfmm_ok(err);
-    if (info)
-        memset(info, 0, sizeof *info);
+    mfmm_exact_info none;
+    memset(&none, 0, sizeof none);
+    none.struct_size = sizeof none;
+    if (info && mfmm_write_info(info, &none, sizeof none) != MFMM_OK)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "info->struct_size is below sizeof(size_t): set it to "
+                         "sizeof(mfmm_exact_info)");
     if (!solver || !distances)
         return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "%s is NULL",
                          !solver ? "solver" : "distances");
@@ -1945,17 +1948,12 @@ mfmm_status mfmm_solve_exact(mfmm_exact_solver *solver, const mfmm_source *sourc
     if (n_sources < 1)
         return mfmm_fail(err, MFMM_ERR_BAD_COUNT, -1, "n_sources is %ld; at least one is needed",
                          (long)n_sources);
-    mfmm_exact_options defaults;
-    if (!options) {
-        mfmm_exact_options_init(&defaults);
-        options = &defaults;
-    }
-    if (mfmm_check_struct_size(options, sizeof *options, "mfmm_exact_options", err) != MFMM_OK)
+    mfmm_exact_options opt;
+    mfmm_exact_options_init(&opt);
+    if (options &&
+        mfmm_read_options(&opt, options, sizeof opt, "mfmm_exact_options", err) != MFMM_OK)
         return MFMM_ERR_BAD_ARGUMENT;
-    if (options->cost)
-        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
-                         "mfmm_solve_exact computes geodesic distance (F = 1) and takes no cost; "
-                         "use mfmm_solve for weighted distances");
+    options = &opt;
     double max_d = options->max_distance;
     if (isnan(max_d) || max_d < 0.0)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "max_distance is %g; it must be >= 0",
@@ -1974,7 +1972,13 @@ mfmm_status mfmm_solve_exact(mfmm_exact_solver *solver, const mfmm_source *sourc
     solver->interrupt = NULL;
     solver->interrupt_user = NULL;
     free(mapped.block);
-    ex_fill_info(solver, info);
+    if (info) {
+        mfmm_exact_info all;
+        memset(&all, 0, sizeof all);
+        ex_fill_info(solver, &all);
+        all.struct_size = sizeof all;
+        mfmm_write_info(info, &all, sizeof all);
+    }
     if (st == MFMM_ERR_CANCELLED)
         return mfmm_fail(err, st, -1, "the exact solve was interrupted");
     if (st != MFMM_OK) {

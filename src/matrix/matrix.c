@@ -41,7 +41,6 @@ void mfmm_matrix_options_init(mfmm_matrix_options *options)
     options->out = NULL;
     options->on_rows = NULL;
     options->user = NULL;
-    options->backend_used = MFMM_BACKEND_AUTO;
     options->opencl = NULL;
     options->exact_start_radius = MFMM_EXACT_START_AUTO;
 }
@@ -223,9 +222,9 @@ static mfmm_status run_serial(const mfmm_rows_job *job, int32_t start, mfmm_erro
                 goto done;
             }
             settled += k;
-            job->opt->start_fallbacks += mfmm_solver_start_fallbacks(solver);
+            job->info->start_fallbacks += mfmm_solver_start_fallbacks(solver);
         }
-        job->opt->vertices_settled = settled;
+        job->info->vertices_settled = settled;
         mfmm_status bst;
         if (deliver_block(job, first, n, base, &bst)) {
             st = block_failed(bst, first, err);
@@ -404,7 +403,7 @@ static mfmm_status run_threads(const mfmm_rows_job *job, int32_t start, mfmm_err
             break;
         pthread_mutex_unlock(&p.mu);
         int32_t first = start + b * p.block;
-        job->opt->vertices_settled = p.settled;
+        job->info->vertices_settled = p.settled;
         mfmm_status bst;
         int cancel = deliver_block(job, first, n, row_dest(&p, first), &bst);
         pthread_mutex_lock(&p.mu);
@@ -421,8 +420,8 @@ static mfmm_status run_threads(const mfmm_rows_job *job, int32_t start, mfmm_err
     pthread_mutex_unlock(&p.mu);
     for (int i = 0; i < started; i++)
         pthread_join(tid[i], NULL);
-    job->opt->vertices_settled = p.settled;
-    job->opt->start_fallbacks += p.fallbacks;
+    job->info->vertices_settled = p.settled;
+    job->info->start_fallbacks += p.fallbacks;
     if (p.ring && job->sparse) /* rows of blocks not delivered (a failure) */
         mfmm_sparse_rows_free((mfmm_sparse_row *)(void *)p.ring, 2 * p.block);
     if (st == MFMM_OK && p.fail != MFMM_OK) {
@@ -440,23 +439,44 @@ static mfmm_status run_threads(const mfmm_rows_job *job, int32_t start, mfmm_err
 
 /* ---- the entry point ---- */
 
+static mfmm_status matrix_run(const mfmm_mesh *mesh, const int32_t *sources, int32_t n_sources,
+                              const mfmm_matrix_options *options, mfmm_matrix_info *info,
+                              mfmm_error *err);
+
 mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
-                                 int32_t n_sources, mfmm_matrix_options *options,
-                                 mfmm_error *err)
+                                 int32_t n_sources, const mfmm_matrix_options *options,
+                                 mfmm_matrix_info *info, mfmm_error *err)
 {
     mfmm_ok(err);
+    if (info && mfmm_check_info_size(info) != MFMM_OK)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "info->struct_size is below sizeof(size_t): set it to "
+                         "sizeof(mfmm_matrix_info)");
+    /* the results, written to the caller's info (its struct_size) on return */
+    mfmm_matrix_info all;
+    memset(&all, 0, sizeof all);
+    all.struct_size = sizeof all;
+    mfmm_status st = matrix_run(mesh, sources, n_sources, options, &all, err);
+    if (info)
+        mfmm_write_info(info, &all, sizeof all);
+    return st;
+}
+
+static mfmm_status matrix_run(const mfmm_mesh *mesh, const int32_t *sources, int32_t n_sources,
+                              const mfmm_matrix_options *options, mfmm_matrix_info *info,
+                              mfmm_error *err)
+{
     if (!mesh)
         return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "mesh is NULL");
     if (!options)
         return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "options is NULL");
-    mfmm_matrix_options *o = options;
-    if (mfmm_check_struct_size(o, sizeof *o, "mfmm_matrix_options", err) != MFMM_OK)
+    mfmm_matrix_options opt;
+    mfmm_matrix_options_init(&opt);
+    if (mfmm_read_options(&opt, options, sizeof opt, "mfmm_matrix_options", err) != MFMM_OK)
         return MFMM_ERR_BAD_ARGUMENT;
-    o->backend_used = o->backend;
-    o->fallback_reason[0] = '\0';
+    const mfmm_matrix_options *o = &opt;
+    info->backend_used = o->backend;
     int32_t nv = mesh->nv;
-    o->vertices_settled = 0;
-    o->start_fallbacks = 0;
     if (!o->out && !o->on_rows && !o->on_sparse)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
                          "options give neither an out buffer nor an on_rows or on_sparse callback");
@@ -584,6 +604,7 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
     job.sources = sources;
     job.n_sources = n_sources;
     job.opt = o;
+    job.info = info;
     job.cost = cost;
     job.cost_location = cost_location;
     job.elem_size = o->dtype == MFMM_FLOAT64 ? sizeof(double) : sizeof(float);
@@ -610,20 +631,20 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
                 * threads from the first row not delivered, saying why */
         int32_t done = 0;
         if (job.sparse) {
-            o->backend_used = MFMM_BACKEND_THREADS;
-            snprintf(o->fallback_reason, sizeof o->fallback_reason,
+            info->backend_used = MFMM_BACKEND_THREADS;
+            snprintf(info->backend_reason, sizeof info->backend_reason,
                      "the OpenCL backend computes dense rows only, not sparse rows");
             st = run_threads(&job, 0, err);
             break;
         }
         mfmm_error cl_err;
-        o->backend_used = MFMM_BACKEND_OPENCL;
+        info->backend_used = MFMM_BACKEND_OPENCL;
         job.full_batches = 1;
         st = mfmm_opencl_rows(&job, 0, &done, &cl_err);
         if (st == MFMM_ERR_NO_OPENCL || st == MFMM_ERR_OPENCL_BUILD ||
             st == MFMM_ERR_OPENCL_RUNTIME || st == MFMM_ERR_OUT_OF_MEMORY) {
-            o->backend_used = MFMM_BACKEND_THREADS;
-            snprintf(o->fallback_reason, sizeof o->fallback_reason, "%s", cl_err.message);
+            info->backend_used = MFMM_BACKEND_THREADS;
+            snprintf(info->backend_reason, sizeof info->backend_reason, "%s", cl_err.message);
             st = run_threads(&job, done, err);
         } else if (st != MFMM_OK && err) {
             *err = cl_err;

@@ -23,16 +23,19 @@ void mfmm_opencl_options_init(mfmm_opencl_options *options)
     options->library = NULL;
 }
 
-/* mfmm_opencl_context_create's argument checks, with or without OpenCL. */
+/* mfmm_opencl_context_create's argument checks, with or without OpenCL;
+ * opt receives the options (the defaults past the caller's struct_size). */
 static mfmm_status check_create_args(const mfmm_opencl_options *options,
-                                     mfmm_opencl_context **out, mfmm_error *err)
+                                     mfmm_opencl_options *opt, mfmm_opencl_context **out,
+                                     mfmm_error *err)
 {
     mfmm_ok(err);
+    mfmm_opencl_options_init(opt);
     if (!out)
         return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "out (the context pointer) is NULL");
     *out = NULL;
-    if (options && mfmm_check_struct_size(options, sizeof *options, "mfmm_opencl_options",
-                                          err) != MFMM_OK)
+    if (options && mfmm_read_options(opt, options, sizeof *opt, "mfmm_opencl_options", err) !=
+                       MFMM_OK)
         return MFMM_ERR_BAD_ARGUMENT;
     return MFMM_OK;
 }
@@ -42,7 +45,8 @@ static mfmm_status check_create_args(const mfmm_opencl_options *options,
 mfmm_status mfmm_opencl_context_create(const mfmm_opencl_options *options,
                                        mfmm_opencl_context **out, mfmm_error *err)
 {
-    mfmm_status st = check_create_args(options, out, err);
+    mfmm_opencl_options opt;
+    mfmm_status st = check_create_args(options, &opt, out, err);
     if (st != MFMM_OK)
         return st;
     return mfmm_fail(err, MFMM_ERR_NO_OPENCL, -1,
@@ -654,19 +658,20 @@ struct mfmm_opencl_context {
 static mfmm_status context_create(const mfmm_opencl_options *options, const mfmm_rows_job *job,
                                   mfmm_opencl_context **out, mfmm_error *err)
 {
-    mfmm_status st = check_create_args(options, out, err);
+    mfmm_opencl_options opt;
+    mfmm_status st = check_create_args(options, &opt, out, err);
     if (st != MFMM_OK)
         return st;
     mfmm_opencl_context *ctx = calloc(1, sizeof *ctx);
     if (!ctx)
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
-    st = mfmm_cl_api_load(&ctx->api, options ? options->library : NULL, err);
+    st = mfmm_cl_api_load(&ctx->api, opt.library, err);
     if (st != MFMM_OK) {
         free(ctx);
         return st;
     }
     ctx->cl.api = &ctx->api;
-    st = ocl_open(&ctx->cl, options, job, err);
+    st = ocl_open(&ctx->cl, &opt, job, err);
     if (st != MFMM_OK) {
         mfmm_opencl_context_destroy(ctx);
         return st;
@@ -1151,7 +1156,7 @@ done:
             api->clReleaseMemObject(mem[i]);
     free(host);
     free(uniform);
-    job->opt->start_fallbacks += sb.fallbacks;
+    job->info->start_fallbacks += sb.fallbacks;
     free(sb.idx);
     free(sb.val);
     mfmm_exact_ws_destroy(ews);
@@ -1229,12 +1234,15 @@ static mfmm_status self_test(ocl *cl, mfmm_error *err)
         mfmm_matrix_options o;
         mfmm_matrix_options_init(&o);
         o.out = &got;
+        mfmm_matrix_info info;
+        memset(&info, 0, sizeof info);
         mfmm_rows_job job;
         memset(&job, 0, sizeof job);
         job.mesh = mesh;
         job.sources = sources;
         job.n_sources = NV;
         job.opt = &o;
+        job.info = &info;
         job.elem_size = f64 ? sizeof(double) : sizeof(float);
         job.budget = MFMM_DEFAULT_BUDGET;
         job.width = NV;

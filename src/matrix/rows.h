@@ -11,7 +11,9 @@ typedef struct mfmm_rows_job {
     const mfmm_mesh *mesh;
     const int32_t *sources;   /* n_sources vertex ids (never NULL here) */
     int32_t n_sources;
-    mfmm_matrix_options *opt; /* the caller's: vertices_settled is written back */
+    const mfmm_matrix_options *opt; /* the options, all fields (defaults past the
+                                       caller's struct_size) */
+    mfmm_matrix_info *info;   /* the call's results, all fields */
     const double *cost;       /* NULL when F = 1 */
     int cost_location;        /* 0 none, 1 per vertex, 2 per face */
     size_t elem_size;         /* 4 or 8 */

@@ -822,7 +822,7 @@ mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
 {
     mfmm_path_options defaults;
     mfmm_path_options_init(&defaults);
-    const mfmm_path_options *o = options ? options : &defaults;
+    const mfmm_path_options *o = &defaults;
     if (n_points)
         *n_points = 0;
     if (length)
@@ -835,8 +835,8 @@ mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
         return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "target is NULL");
     if (!n_points)
         return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "n_points is NULL");
-    if (options && mfmm_check_struct_size(options, sizeof *options, "mfmm_path_options", err) !=
-                       MFMM_OK)
+    if (options && mfmm_read_options(&defaults, options, sizeof defaults, "mfmm_path_options",
+                                     err) != MFMM_OK)
         return MFMM_ERR_BAD_ARGUMENT;
     if (capacity < 0)
         return mfmm_fail(err, MFMM_ERR_BAD_COUNT, capacity, "capacity %d is negative",

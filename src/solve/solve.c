@@ -112,9 +112,8 @@ mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources, int32_t 
     mfmm_solve_options opt;
     mfmm_solve_options_init(&opt);
     if (options) {
-        if (mfmm_check_struct_size(options, sizeof opt, "mfmm_solve_options", err) != MFMM_OK)
+        if (mfmm_read_options(&opt, options, sizeof opt, "mfmm_solve_options", err) != MFMM_OK)
             return MFMM_ERR_BAD_ARGUMENT;
-        opt = *options;
     }
     if (!opt.cost)
         opt.cost_location = MFMM_COST_NONE;
@@ -197,16 +196,11 @@ mfmm_status mfmm_solver_get_info(const mfmm_solver *solver, mfmm_solve_info *inf
 {
     if (!solver || !info)
         return MFMM_ERR_NULL_POINTER;
-    size_t size;
-    memcpy(&size, info, sizeof size);
-    if (size < sizeof size)
-        return MFMM_ERR_BAD_ARGUMENT;
     mfmm_solve_info all;
     memset(&all, 0, sizeof all);
-    all.struct_size = size < sizeof all ? size : sizeof all;
+    all.struct_size = sizeof all;
     all.start_fallbacks = solver->start_fallbacks;
-    memcpy(info, &all, all.struct_size);
-    return MFMM_OK;
+    return mfmm_write_info(info, &all, sizeof all);
 }
 
 /* One march into T (the caller's +inf-filled row, or the solver's own T);

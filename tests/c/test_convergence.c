@@ -110,7 +110,7 @@ static void test_obtuse_lattice_needs_unfolding(void **state)
         int n = 20 << i;
         mfmm_gen_mesh g = mfmm_gen_lattice(n, 3.0);
         mfmm_mesh *mesh = tm_make(&g);
-        mfmm_mesh_info info;
+        mfmm_mesh_info info = {.struct_size = sizeof info};
         mfmm_mesh_get_info(mesh, &info);
         assert_true(info.n_obtuse_corners >= g.nf * 9 / 10);
         assert_true(info.n_virtual_edges >= info.n_obtuse_corners * 9 / 10);

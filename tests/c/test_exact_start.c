@@ -48,6 +48,7 @@ static mfmm_mesh *load_with_ws(const char *name, int32_t *nv, int32_t *nf, int32
                                mfmm_mesh_info *info, mfmm_exact_ws **ws)
 {
     mfmm_mesh *mesh = tm_load_data(name, nv, nf, F);
+    info->struct_size = sizeof *info;
     mfmm_mesh_get_info(mesh, info);
     *ws = NULL;
     assert_int_equal(mfmm_exact_ws_create(mesh, ws), MFMM_OK);
@@ -63,7 +64,7 @@ static void test_patch_is_exact(void **state)
                            "meshes/beetle.obj", "meshes/decimated-max.obj"};
     for (size_t m = 0; m < sizeof names / sizeof names[0]; m++) {
         int32_t nv = 0, nf = 0, *F = NULL;
-        mfmm_mesh_info info;
+        mfmm_mesh_info info = {.struct_size = sizeof info};
         mfmm_exact_ws *ws = NULL;
         mfmm_mesh *mesh = load_with_ws(names[m], &nv, &nf, &F, &info, &ws);
         mfmm_solver *solver = NULL;
@@ -167,7 +168,7 @@ static void test_patch_settles_early(void **state)
                            "meshes/decimated-max.obj", "meshes/fertility_FE_10k.off"};
     for (size_t m = 0; m < sizeof names / sizeof names[0]; m++) {
         int32_t nv = 0, nf = 0, *F = NULL;
-        mfmm_mesh_info info;
+        mfmm_mesh_info info = {.struct_size = sizeof info};
         mfmm_exact_ws *ws = NULL;
         mfmm_mesh *mesh = load_with_ws(names[m], &nv, &nf, &F, &info, &ws);
         double *a = malloc((size_t)nv * sizeof *a), *b = malloc((size_t)nv * sizeof *b);
@@ -273,7 +274,7 @@ static void test_shared_tables(void **state)
     (void)state;
     int32_t nv = 0, nf = 0, *F = NULL;
     mfmm_mesh *mesh = tm_load_data("meshes/camelhead.off", &nv, &nf, &F);
-    mfmm_mesh_info info;
+    mfmm_mesh_info info = {.struct_size = sizeof info};
     mfmm_mesh_get_info(mesh, &info);
     mfmm_exact_tables *t = NULL;
     mfmm_exact_ws *own = NULL, *a = NULL, *b = NULL;
@@ -319,13 +320,14 @@ static void test_shared_tables(void **state)
     assert_non_null(out);
     for (int job = 0; job < 2; job++) {
         mfmm_matrix_options o;
+        mfmm_matrix_info oi = {.struct_size = sizeof oi};
         mfmm_matrix_options_init(&o);
         o.backend = MFMM_BACKEND_THREADS;
         o.n_threads = 2;
         o.dtype = MFMM_FLOAT64;
         o.out = out;
         mfmm_error err;
-        assert_int_equal(mfmm_distance_matrix(mesh, rows, 4, &o, &err), MFMM_OK);
+        assert_int_equal(mfmm_distance_matrix(mesh, rows, 4, &o, &oi, &err), MFMM_OK);
         assert_ptr_equal(mesh->exact_tables, kept);
     }
     free(out);
@@ -404,7 +406,7 @@ static void test_saddle_corner_continuous(void **state)
     (void)state;
     int32_t nv = 0, nf = 0, *F = NULL;
     mfmm_mesh *mesh = tm_load_data("meshes/hand_lowres.obj", &nv, &nf, &F);
-    mfmm_mesh_info info;
+    mfmm_mesh_info info = {.struct_size = sizeof info};
     mfmm_mesh_get_info(mesh, &info);
     mfmm_solver *solver = NULL;
     assert_int_equal(mfmm_solver_create(mesh, &solver), MFMM_OK);
@@ -524,7 +526,7 @@ static void test_auto_radius(void **state)
     mo.dtype = MFMM_FLOAT64;
     mo.out = d_row;
     mfmm_error err;
-    if (mfmm_distance_matrix(fx.mesh, &src, 1, &mo, &err) != MFMM_OK)
+    if (mfmm_distance_matrix(fx.mesh, &src, 1, &mo, NULL, &err) != MFMM_OK)
         fail_msg("mfmm_distance_matrix: %s", err.message);
     assert_true(rows_equal(d_row, d_auto, nv));
     /* with max_distance, the base radius */
@@ -553,7 +555,7 @@ static void test_patch_check(void **state)
 {
     (void)state;
     int32_t nv = 0, nf = 0, *F = NULL;
-    mfmm_mesh_info info;
+    mfmm_mesh_info info = {.struct_size = sizeof info};
     mfmm_exact_ws *ws = NULL;
     mfmm_mesh *mesh = load_with_ws("meshes/spot.obj", &nv, &nf, &F, &info, &ws);
     for (int face = 0; face < 2; face++) {
@@ -626,7 +628,7 @@ static void test_bad_radius(void **state)
         mo.exact_start_radius = bad[k];
         mo.out = fx.d;
         int32_t src = 3;
-        assert_int_equal(mfmm_distance_matrix(fx.mesh, &src, 1, &mo, &err), MFMM_ERR_BAD_ARGUMENT);
+        assert_int_equal(mfmm_distance_matrix(fx.mesh, &src, 1, &mo, NULL, &err), MFMM_ERR_BAD_ARGUMENT);
     }
     tm_fixture_free(&fx);
 }

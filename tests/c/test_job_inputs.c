@@ -33,7 +33,7 @@ static void test_max_distance_refused(void **state)
         mo.out = fx.d;
         mo.max_distance = bad[i];
         int32_t src = 0;
-        assert_int_equal(mfmm_distance_matrix(fx.mesh, &src, 1, &mo, &err), MFMM_ERR_BAD_ARGUMENT);
+        assert_int_equal(mfmm_distance_matrix(fx.mesh, &src, 1, &mo, NULL, &err), MFMM_ERR_BAD_ARGUMENT);
         assert_non_null(strstr(err.message, "max_distance"));
     }
     /* 0 is a limit like any other: only the sources settle */
@@ -84,7 +84,7 @@ static void check_alias(mfmm_backend backend)
     mo.n_threads = 2;
     mo.memory_limit = 1; /* as small as it goes: one row a block */
     mfmm_error err;
-    mfmm_status st = mfmm_distance_matrix(fx.mesh, (const int32_t *)out, N, &mo, &err);
+    mfmm_status st = mfmm_distance_matrix(fx.mesh, (const int32_t *)out, N, &mo, NULL, &err);
     if (backend == MFMM_BACKEND_OPENCL && st == MFMM_ERR_NO_OPENCL) {
         free(out);
         free(ref);

@@ -34,6 +34,7 @@ static void check_backend(const mfmm_mesh *mesh, const int32_t *src, int32_t n,
     char *out = use_out ? malloc(total * esz) : NULL;
     tm_collect c = {use_cb ? malloc(total * esz) : NULL, nv * esz, 0, 0, -1};
     mfmm_matrix_options o;
+    mfmm_matrix_info oi = {.struct_size = sizeof oi};
     mfmm_matrix_options_init(&o);
     o.backend = backend;
     o.dtype = dtype;
@@ -50,7 +51,7 @@ static void check_backend(const mfmm_mesh *mesh, const int32_t *src, int32_t n,
         o.max_distance = so->max_distance;
     }
     mfmm_error err;
-    mfmm_status st = mfmm_distance_matrix(mesh, src, n, &o, &err);
+    mfmm_status st = mfmm_distance_matrix(mesh, src, n, &o, &oi, &err);
     if (st != MFMM_OK)
         fail_msg("%s: %s", mfmm_backend_name(backend), err.message);
     assert_int_equal(err.status, MFMM_OK);
@@ -205,6 +206,7 @@ static void test_targets_and_sparse(void **state)
             for (int dt = 0; dt < 2; dt++) {
                 size_t esz = dt ? 8 : 4;
                 mfmm_matrix_options o;
+                mfmm_matrix_info oi = {.struct_size = sizeof oi};
                 mfmm_matrix_options_init(&o);
                 o.backend = be;
                 o.n_threads = b + 1;
@@ -215,8 +217,8 @@ static void test_targets_and_sparse(void **state)
                 double *full = malloc((size_t)N_SOME * (size_t)nv * esz);
                 assert_non_null(full);
                 o.out = full;
-                assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, NULL), MFMM_OK);
-                int64_t full_settled = o.vertices_settled;
+                assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &oi, NULL), MFMM_OK);
+                int64_t full_settled = oi.vertices_settled;
                 assert_true(full_settled > 0);
                 free(full);
                 /* target columns */
@@ -226,14 +228,14 @@ static void test_targets_and_sparse(void **state)
                 o.targets = targets;
                 o.n_targets = 5;
                 mfmm_error err;
-                if (mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &err) != MFMM_OK)
+                if (mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &oi, &err) != MFMM_OK)
                     fail_msg("%s", err.message);
                 if (dt)
                     assert_memory_equal(out, tref, (size_t)N_SOME * 5 * 8);
                 else
                     tm_assert_float32_of(out, tref, (size_t)N_SOME * 5);
                 if (li == 0)
-                    assert_true(o.vertices_settled < full_settled);
+                    assert_true(oi.vertices_settled < full_settled);
                 free(out);
                 /* sparse, full width and target columns */
                 for (int t = 0; t < 2; t++) {
@@ -243,20 +245,20 @@ static void test_targets_and_sparse(void **state)
                     o.n_targets = t ? 5 : 0;
                     o.on_sparse = on_sparse;
                     o.user = &c;
-                    if (mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &err) != MFMM_OK)
+                    if (mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &oi, &err) != MFMM_OK)
                         fail_msg("%s", err.message);
                     assert_int_equal(c.next, N_SOME);
                     assert_true(c.nnz >= N_SOME);
                 }
                 /* OpenCL refuses, auto runs threads */
                 o.backend = MFMM_BACKEND_OPENCL;
-                assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, NULL),
+                assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &oi, NULL),
                                  MFMM_ERR_BAD_ARGUMENT);
                 sp_check c = {tref, 5, 0, esz, 0};
                 o.user = &c;
                 o.backend = MFMM_BACKEND_AUTO;
-                assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, NULL), MFMM_OK);
-                assert_int_equal(o.backend_used, MFMM_BACKEND_THREADS);
+                assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &oi, NULL), MFMM_OK);
+                assert_int_equal(oi.backend_used, MFMM_BACKEND_THREADS);
                 assert_int_equal(c.next, N_SOME);
             }
         }
@@ -265,14 +267,15 @@ static void test_targets_and_sparse(void **state)
     }
     int32_t bad[1] = {nv};
     mfmm_matrix_options o;
+    mfmm_matrix_info oi = {.struct_size = sizeof oi};
     mfmm_matrix_options_init(&o);
     double one[4];
     o.out = one;
     o.targets = bad;
     o.n_targets = 1;
-    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, 1, &o, NULL), MFMM_ERR_BAD_ARGUMENT);
+    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, 1, &o, &oi, NULL), MFMM_ERR_BAD_ARGUMENT);
     o.n_targets = 0;
-    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, 1, &o, NULL), MFMM_ERR_BAD_COUNT);
+    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, 1, &o, &oi, NULL), MFMM_ERR_BAD_COUNT);
     mfmm_mesh_destroy(mesh);
     mfmm_gen_free(&g);
 }
@@ -288,17 +291,18 @@ static void test_no_opencl_fallback(void **state)
     double *out = malloc(total * sizeof *out);
     assert_non_null(out);
     mfmm_matrix_options o;
+    mfmm_matrix_info oi = {.struct_size = sizeof oi};
     mfmm_matrix_options_init(&o);
     o.dtype = MFMM_FLOAT64;
     o.out = out;
     mfmm_error err;
     assert_int_equal(o.backend, MFMM_BACKEND_AUTO);
-    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &err), MFMM_OK);
-    assert_int_equal(o.backend_used, MFMM_BACKEND_THREADS);
+    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &oi, &err), MFMM_OK);
+    assert_int_equal(oi.backend_used, MFMM_BACKEND_THREADS);
     assert_memory_equal(out, ref, total * sizeof *out);
 
     o.backend = MFMM_BACKEND_OPENCL;
-    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &err),
+    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &oi, &err),
                      MFMM_ERR_NO_OPENCL);
     assert_int_equal(err.status, MFMM_ERR_NO_OPENCL);
     assert_true(strlen(err.message) > 0);
@@ -323,6 +327,7 @@ static void test_cancel(void **state)
         tm_collect c = {malloc((size_t)nv * (size_t)nv * 4), (size_t)nv * 4, 0, 0, 2};
         assert_non_null(c.buf);
         mfmm_matrix_options o;
+        mfmm_matrix_info oi = {.struct_size = sizeof oi};
         mfmm_matrix_options_init(&o);
         o.backend = backends[b];
         o.n_threads = 2;
@@ -330,7 +335,7 @@ static void test_cancel(void **state)
         o.on_rows = on_rows;
         o.user = &c;
         mfmm_error err;
-        assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &err), MFMM_ERR_CANCELLED);
+        assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &oi, &err), MFMM_ERR_CANCELLED);
         assert_int_equal(err.status, MFMM_ERR_CANCELLED);
         assert_int_equal(c.calls, 2); /* nothing after the callback said stop */
         assert_true(c.next < nv);
@@ -358,6 +363,7 @@ static void test_bad_arguments(void **state)
     assert_non_null(out);
     int32_t got = 0;
     mfmm_matrix_options o;
+    mfmm_matrix_info oi = {.struct_size = sizeof oi};
     mfmm_error err;
     int32_t src[3] = {0, 3, 2};
 
@@ -376,19 +382,19 @@ static void test_bad_arguments(void **state)
     } while (0)
 
     RESET();
-    EXPECT(MFMM_ERR_NULL_POINTER, mfmm_distance_matrix(NULL, src, 3, &o, &err));
-    EXPECT(MFMM_ERR_NULL_POINTER, mfmm_distance_matrix(mesh, src, 3, NULL, &err));
+    EXPECT(MFMM_ERR_NULL_POINTER, mfmm_distance_matrix(NULL, src, 3, &o, &oi, &err));
+    EXPECT(MFMM_ERR_NULL_POINTER, mfmm_distance_matrix(mesh, src, 3, NULL, &oi, &err));
     o.out = NULL;
-    EXPECT(MFMM_ERR_BAD_ARGUMENT, mfmm_distance_matrix(mesh, src, 3, &o, &err));
+    EXPECT(MFMM_ERR_BAD_ARGUMENT, mfmm_distance_matrix(mesh, src, 3, &o, &oi, &err));
     RESET();
-    EXPECT(MFMM_ERR_BAD_COUNT, mfmm_distance_matrix(mesh, src, 0, &o, &err));
-    EXPECT(MFMM_ERR_BAD_COUNT, mfmm_distance_matrix(mesh, src, -2, &o, &err));
-    EXPECT(MFMM_ERR_BAD_COUNT, mfmm_distance_matrix(mesh, NULL, nv - 1, &o, &err));
+    EXPECT(MFMM_ERR_BAD_COUNT, mfmm_distance_matrix(mesh, src, 0, &o, &oi, &err));
+    EXPECT(MFMM_ERR_BAD_COUNT, mfmm_distance_matrix(mesh, src, -2, &o, &oi, &err));
+    EXPECT(MFMM_ERR_BAD_COUNT, mfmm_distance_matrix(mesh, NULL, nv - 1, &o, &oi, &err));
     src[1] = nv;
-    EXPECT(MFMM_ERR_BAD_SOURCE, mfmm_distance_matrix(mesh, src, 3, &o, &err));
+    EXPECT(MFMM_ERR_BAD_SOURCE, mfmm_distance_matrix(mesh, src, 3, &o, &oi, &err));
     assert_int_equal(err.index, 1);
     src[1] = -1;
-    EXPECT(MFMM_ERR_BAD_SOURCE, mfmm_distance_matrix(mesh, src, 3, &o, &err));
+    EXPECT(MFMM_ERR_BAD_SOURCE, mfmm_distance_matrix(mesh, src, 3, &o, &oi, &err));
     src[1] = 3;
     double *cost = malloc((size_t)g.nf * sizeof *cost);
     assert_non_null(cost);
@@ -397,35 +403,35 @@ static void test_bad_arguments(void **state)
     cost[5] = NAN;
     o.cost = cost;
     o.cost_location = MFMM_COST_PER_FACE;
-    EXPECT(MFMM_ERR_BAD_COST, mfmm_distance_matrix(mesh, src, 3, &o, &err));
+    EXPECT(MFMM_ERR_BAD_COST, mfmm_distance_matrix(mesh, src, 3, &o, &oi, &err));
     assert_int_equal(err.index, 5);
     cost[5] = 0.0;
-    EXPECT(MFMM_ERR_BAD_COST, mfmm_distance_matrix(mesh, src, 3, &o, &err));
+    EXPECT(MFMM_ERR_BAD_COST, mfmm_distance_matrix(mesh, src, 3, &o, &oi, &err));
     cost[5] = 1.0;
     o.cost_location = MFMM_COST_NONE;
-    EXPECT(MFMM_ERR_BAD_ARGUMENT, mfmm_distance_matrix(mesh, src, 3, &o, &err));
+    EXPECT(MFMM_ERR_BAD_ARGUMENT, mfmm_distance_matrix(mesh, src, 3, &o, &oi, &err));
     o.cost_location = (mfmm_cost_location)7;
-    EXPECT(MFMM_ERR_BAD_ARGUMENT, mfmm_distance_matrix(mesh, src, 3, &o, &err));
+    EXPECT(MFMM_ERR_BAD_ARGUMENT, mfmm_distance_matrix(mesh, src, 3, &o, &oi, &err));
     RESET();
     o.dtype = (mfmm_dtype)3;
-    EXPECT(MFMM_ERR_BAD_ARGUMENT, mfmm_distance_matrix(mesh, src, 3, &o, &err));
+    EXPECT(MFMM_ERR_BAD_ARGUMENT, mfmm_distance_matrix(mesh, src, 3, &o, &oi, &err));
     RESET();
     o.backend = (mfmm_backend)9;
-    EXPECT(MFMM_ERR_BAD_ARGUMENT, mfmm_distance_matrix(mesh, src, 3, &o, &err));
+    EXPECT(MFMM_ERR_BAD_ARGUMENT, mfmm_distance_matrix(mesh, src, 3, &o, &oi, &err));
     RESET();
     o.max_distance = NAN;
-    EXPECT(MFMM_ERR_BAD_ARGUMENT, mfmm_distance_matrix(mesh, src, 3, &o, &err));
+    EXPECT(MFMM_ERR_BAD_ARGUMENT, mfmm_distance_matrix(mesh, src, 3, &o, &oi, &err));
     RESET();
     o.n_threads = -1;
     o.backend = MFMM_BACKEND_THREADS;
-    EXPECT(MFMM_ERR_BAD_ARGUMENT, mfmm_distance_matrix(mesh, src, 3, &o, &err));
+    EXPECT(MFMM_ERR_BAD_ARGUMENT, mfmm_distance_matrix(mesh, src, 3, &o, &oi, &err));
     /* a NULL err is fine; valid calls still run */
     RESET();
-    assert_int_equal(mfmm_distance_matrix(mesh, src, -1, &o, NULL), MFMM_ERR_BAD_COUNT);
+    assert_int_equal(mfmm_distance_matrix(mesh, src, -1, &o, &oi, NULL), MFMM_ERR_BAD_COUNT);
     o.out = NULL;
     o.on_rows = count_rows;
     o.user = &got;
-    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, NULL), MFMM_OK);
+    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &oi, NULL), MFMM_OK);
     assert_int_equal(got, nv);
 #undef EXPECT
 #undef RESET
@@ -443,6 +449,7 @@ static void test_names_and_defaults(void **state)
     assert_string_equal(mfmm_backend_name(MFMM_BACKEND_THREADS), "threads");
     assert_string_equal(mfmm_backend_name(MFMM_BACKEND_OPENCL), "opencl");
     mfmm_matrix_options o;
+    mfmm_matrix_info oi = {.struct_size = sizeof oi};
     mfmm_matrix_options_init(&o);
     assert_int_equal(o.backend, MFMM_BACKEND_AUTO);
     assert_int_equal(o.dtype, MFMM_FLOAT32);
@@ -487,28 +494,29 @@ static void test_no_opencl_loader(void **state)
     double *out = malloc(total * sizeof *out);
     assert_non_null(out);
     mfmm_matrix_options o;
+    mfmm_matrix_info oi = {.struct_size = sizeof oi};
     mfmm_matrix_options_init(&o);
     o.dtype = MFMM_FLOAT64;
     o.out = out;
     o.opencl_options = &co;
     o.backend = MFMM_BACKEND_OPENCL;
-    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &err),
+    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &oi, &err),
                      MFMM_ERR_NO_OPENCL);
     o.backend = MFMM_BACKEND_AUTO;
-    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &err), MFMM_OK);
-    assert_int_equal(o.backend_used, MFMM_BACKEND_THREADS);
+    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &oi, &err), MFMM_OK);
+    assert_int_equal(oi.backend_used, MFMM_BACKEND_THREADS);
     assert_memory_equal(out, ref, total * sizeof *out);
 #ifdef MESHFMM_TEST_HAVE_CL
-    assert_non_null(strstr(o.fallback_reason, "cannot load the OpenCL library"));
+    assert_non_null(strstr(oi.backend_reason, "cannot load the OpenCL library"));
 #else
-    assert_true(strlen(o.fallback_reason) > 0);
+    assert_true(strlen(oi.backend_reason) > 0);
 #endif
     /* the environment names the loader when the options do not */
     setenv("MESHFMM_OPENCL_LIBRARY", "libmeshfmm-no-such-opencl.so.1", 1);
     o.opencl_options = NULL;
     memset(out, 0, total * sizeof *out);
-    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &err), MFMM_OK);
-    assert_int_equal(o.backend_used, MFMM_BACKEND_THREADS);
+    assert_int_equal(mfmm_distance_matrix(mesh, some_sources, N_SOME, &o, &oi, &err), MFMM_OK);
+    assert_int_equal(oi.backend_used, MFMM_BACKEND_THREADS);
     assert_memory_equal(out, ref, total * sizeof *out);
     unsetenv("MESHFMM_OPENCL_LIBRARY");
     free(out);
@@ -526,6 +534,7 @@ static void test_struct_size(void **state)
     mfmm_mesh *mesh = tm_make(&g);
     mfmm_error err;
     mfmm_matrix_options o;
+    mfmm_matrix_info oi = {.struct_size = sizeof oi};
     mfmm_matrix_options_init(&o);
     assert_int_equal(o.struct_size, sizeof o);
     double *out = malloc((size_t)g.nv * sizeof *out);
@@ -535,12 +544,12 @@ static void test_struct_size(void **state)
     o.backend = MFMM_BACKEND_SERIAL;
     int32_t src = 0;
     o.struct_size = sizeof o + 8;
-    assert_int_equal(mfmm_distance_matrix(mesh, &src, 1, &o, &err), MFMM_ERR_BAD_ARGUMENT);
+    assert_int_equal(mfmm_distance_matrix(mesh, &src, 1, &o, &oi, &err), MFMM_ERR_BAD_ARGUMENT);
     assert_non_null(strstr(err.message, "mfmm_matrix_options.struct_size"));
     o.struct_size = 0;
-    assert_int_equal(mfmm_distance_matrix(mesh, &src, 1, &o, &err), MFMM_ERR_BAD_ARGUMENT);
+    assert_int_equal(mfmm_distance_matrix(mesh, &src, 1, &o, &oi, &err), MFMM_ERR_BAD_ARGUMENT);
     o.struct_size = sizeof o;
-    assert_int_equal(mfmm_distance_matrix(mesh, &src, 1, &o, &err), MFMM_OK);
+    assert_int_equal(mfmm_distance_matrix(mesh, &src, 1, &o, &oi, &err), MFMM_OK);
 
     mfmm_solve_options so;
     mfmm_solve_options_init(&so);
@@ -559,7 +568,7 @@ static void test_struct_size(void **state)
     mfmm_mesh_options mo;
     mfmm_mesh_options_init(&mo);
     assert_int_equal(mo.struct_size, sizeof mo);
-    mo.struct_size = sizeof mo - 1;
+    mo.struct_size = 4; /* below sizeof(size_t) */
     mfmm_mesh *m2 = NULL;
     assert_int_equal(mfmm_mesh_create(g.V, g.nv, g.F, g.nf, &mo, &m2, &err),
                      MFMM_ERR_BAD_ARGUMENT);

@@ -51,6 +51,7 @@ static int check_opencl(const mfmm_mesh *mesh, const int32_t *src, int32_t n, co
     tm_collect c = {malloc(total * esz), (size_t)nv * esz, 0, 0, -1};
     assert_non_null(c.buf);
     mfmm_matrix_options o;
+    mfmm_matrix_info oi = {.struct_size = sizeof oi};
     mfmm_matrix_options_init(&o);
     o.backend = MFMM_BACKEND_OPENCL;
     o.dtype = dtype;
@@ -69,14 +70,14 @@ static int check_opencl(const mfmm_mesh *mesh, const int32_t *src, int32_t n, co
         o.exact_start_radius = so->exact_start_radius;
     }
     mfmm_error err;
-    mfmm_status st = mfmm_distance_matrix(mesh, src, n, &o, &err);
+    mfmm_status st = mfmm_distance_matrix(mesh, src, n, &o, &oi, &err);
     if (st == MFMM_ERR_NO_OPENCL) {
         free(c.buf);
         return 0;
     }
     if (st != MFMM_OK)
         fail_msg("opencl: %s", err.message);
-    assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL);
+    assert_int_equal(oi.backend_used, MFMM_BACKEND_OPENCL);
     if (dtype == MFMM_FLOAT64) {
         const double *d = (const double *)c.buf;
         for (size_t i = 0; i < total; i++)
@@ -178,7 +179,7 @@ static void test_shared_meshes(void **state)
     for (int m = 0; m < 2; m++) {
         int32_t nf = 0;
         mfmm_mesh *mesh = tm_load_data(names[m], NULL, &nf, NULL);
-        mfmm_mesh_info info;
+        mfmm_mesh_info info = {.struct_size = sizeof info};
         assert_int_equal(mfmm_mesh_get_info(mesh, &info), MFMM_OK);
         if (m == 0)
             assert_true(info.n_boundary_edges > 0);
@@ -475,13 +476,14 @@ static void test_cache_altered_entries(void **state)
     double *out = malloc(6 * (size_t)g.nv * sizeof *out);
     assert_non_null(out);
     mfmm_matrix_options o;
+    mfmm_matrix_info oi = {.struct_size = sizeof oi};
     mfmm_matrix_options_init(&o);
     o.dtype = MFMM_FLOAT64;
     o.out = out;
     mfmm_error err;
-    assert_int_equal(mfmm_distance_matrix(mesh, src, 6, &o, &err), MFMM_OK);
+    assert_int_equal(mfmm_distance_matrix(mesh, src, 6, &o, &oi, &err), MFMM_OK);
     unsetenv("MESHFMM_OPENCL_DEVICE");
-    assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL);
+    assert_int_equal(oi.backend_used, MFMM_BACKEND_OPENCL);
     assert_memory_equal(out, ref, 6 * (size_t)g.nv * sizeof *out);
     free(out);
     free(noise);
@@ -524,12 +526,13 @@ static void test_batches_fill_compute_units(void **state)
     mfmm_mesh *mesh = tm_make(&g);
     int32_t src[4] = {0, 1000, 125000, 250000};
     mfmm_matrix_options o;
+    mfmm_matrix_info oi = {.struct_size = sizeof oi};
     mfmm_matrix_options_init(&o);
     o.backend = MFMM_BACKEND_OPENCL;
     o.max_distance = 1e-9; /* each row stops at its source: the batch size is what counts */
     o.on_rows = first_batch;
     mfmm_error err;
-    if (mfmm_distance_matrix(mesh, src, 4, &o, &err) != MFMM_OK)
+    if (mfmm_distance_matrix(mesh, src, 4, &o, &oi, &err) != MFMM_OK)
         fail_msg("%s", err.message);
     assert_true(batch_first_n >= 2);
     mfmm_mesh_destroy(mesh);
@@ -547,21 +550,21 @@ static void test_batches_fill_compute_units(void **state)
     o.out = out;
     int cpu = device_is_cpu();
     if (cpu) { /* a CPU device, not named: threads, saying why */
-        assert_int_equal(mfmm_distance_matrix(mesh, src, 2, &o, &err), MFMM_OK);
-        assert_int_equal(o.backend_used, MFMM_BACKEND_THREADS);
-        assert_non_null(strstr(o.fallback_reason, "is a CPU"));
+        assert_int_equal(mfmm_distance_matrix(mesh, src, 2, &o, &oi, &err), MFMM_OK);
+        assert_int_equal(oi.backend_used, MFMM_BACKEND_THREADS);
+        assert_non_null(strstr(oi.backend_reason, "is a CPU"));
         assert_memory_equal(out, ref, 2 * (size_t)nv * sizeof *out);
         setenv("MESHFMM_OPENCL_DEVICE", "0", 1); /* named: auto may take it */
     }
     o.memory_limit = (size_t)nv * 40; /* one row at a time */
-    assert_int_equal(mfmm_distance_matrix(mesh, src, 2, &o, &err), MFMM_OK);
-    assert_int_equal(o.backend_used, MFMM_BACKEND_THREADS);
-    assert_non_null(strstr(o.fallback_reason, "compute units"));
+    assert_int_equal(mfmm_distance_matrix(mesh, src, 2, &o, &oi, &err), MFMM_OK);
+    assert_int_equal(oi.backend_used, MFMM_BACKEND_THREADS);
+    assert_non_null(strstr(oi.backend_reason, "compute units"));
     assert_memory_equal(out, ref, 2 * (size_t)nv * sizeof *out);
     o.memory_limit = 0; /* the default: OpenCL, no reason */
-    assert_int_equal(mfmm_distance_matrix(mesh, src, 2, &o, &err), MFMM_OK);
-    assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL);
-    assert_string_equal(o.fallback_reason, "");
+    assert_int_equal(mfmm_distance_matrix(mesh, src, 2, &o, &oi, &err), MFMM_OK);
+    assert_int_equal(oi.backend_used, MFMM_BACKEND_OPENCL);
+    assert_string_equal(oi.backend_reason, "");
     assert_memory_equal(out, ref, 2 * (size_t)nv * sizeof *out);
     unsetenv("MESHFMM_OPENCL_DEVICE");
     free(out);
@@ -598,6 +601,7 @@ static void test_targets(void **state)
             char *ref = malloc(bytes), *got = malloc(bytes);
             assert_true(ref && got);
             mfmm_matrix_options o;
+            mfmm_matrix_info oi = {.struct_size = sizeof oi};
             mfmm_matrix_options_init(&o);
             o.dtype = dt ? MFMM_FLOAT64 : MFMM_FLOAT32;
             o.targets = tg;
@@ -610,7 +614,7 @@ static void test_targets(void **state)
                 o.max_distance = 0.5;
             o.backend = MFMM_BACKEND_SERIAL;
             o.out = ref;
-            assert_int_equal(mfmm_distance_matrix(mesh, src, n, &o, NULL), MFMM_OK);
+            assert_int_equal(mfmm_distance_matrix(mesh, src, n, &o, &oi, NULL), MFMM_OK);
             o.backend = MFMM_BACKEND_OPENCL;
             tm_collect c = {got, 6 * esz, 0, 0, -1};
             if (k == 0) {
@@ -622,7 +626,7 @@ static void test_targets(void **state)
                 o.out = got;
             }
             mfmm_error err;
-            mfmm_status st = mfmm_distance_matrix(mesh, src, n, &o, &err);
+            mfmm_status st = mfmm_distance_matrix(mesh, src, n, &o, &oi, &err);
             if (st == MFMM_ERR_NO_OPENCL) {
                 free(ref);
                 free(got);
@@ -633,7 +637,7 @@ static void test_targets(void **state)
             }
             if (st != MFMM_OK)
                 fail_msg("opencl targets: %s", err.message);
-            assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL);
+            assert_int_equal(oi.backend_used, MFMM_BACKEND_OPENCL);
             assert_memory_equal(got, ref, bytes);
             free(ref);
             free(got);
@@ -688,7 +692,7 @@ static void test_opencl_options(void **state)
     assert_int_equal(mfmm_opencl_context_create(&co, &ctx, &err), MFMM_ERR_NO_OPENCL);
     assert_non_null(strstr(err.message, "no-such-device-name"));
     co.device = NULL;
-    co.struct_size = sizeof co - 8;
+    co.struct_size = sizeof co + 8; /* a newer header than the library */
     assert_int_equal(mfmm_opencl_context_create(&co, &ctx, &err), MFMM_ERR_BAD_ARGUMENT);
     assert_non_null(strstr(err.message, "struct_size"));
     assert_null(ctx);
@@ -707,27 +711,28 @@ static void test_device_selection_and_cancel(void **state)
     double *out = malloc((size_t)nv * (size_t)nv * sizeof *out);
     assert_non_null(out);
     mfmm_matrix_options o;
+    mfmm_matrix_info oi = {.struct_size = sizeof oi};
     mfmm_matrix_options_init(&o);
     o.backend = MFMM_BACKEND_OPENCL;
     o.out = out;
     mfmm_error err;
     setenv("MESHFMM_OPENCL_DEVICE", "0", 1);
-    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &err), MFMM_OK);
+    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &oi, &err), MFMM_OK);
     setenv("MESHFMM_OPENCL_DEVICE", "999", 1);
-    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &err), MFMM_ERR_NO_OPENCL);
+    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &oi, &err), MFMM_ERR_NO_OPENCL);
     assert_non_null(strstr(err.message, "MESHFMM_OPENCL_DEVICE"));
     setenv("MESHFMM_OPENCL_DEVICE", "no-such-device-name", 1);
-    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &err), MFMM_ERR_NO_OPENCL);
+    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &oi, &err), MFMM_ERR_NO_OPENCL);
     o.backend = MFMM_BACKEND_AUTO;
-    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &err), MFMM_OK);
-    assert_int_equal(o.backend_used, MFMM_BACKEND_THREADS);
+    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &oi, &err), MFMM_OK);
+    assert_int_equal(oi.backend_used, MFMM_BACKEND_THREADS);
     unsetenv("MESHFMM_OPENCL_DEVICE");
-    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &err), MFMM_OK);
-    assert_int_equal(o.backend_used,
+    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &oi, &err), MFMM_OK);
+    assert_int_equal(oi.backend_used,
                      device_is_cpu() ? MFMM_BACKEND_THREADS : MFMM_BACKEND_OPENCL);
     setenv("MESHFMM_OPENCL_DEVICE", "0", 1); /* named: auto takes it */
-    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &err), MFMM_OK);
-    assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL);
+    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &oi, &err), MFMM_OK);
+    assert_int_equal(oi.backend_used, MFMM_BACKEND_OPENCL);
 
     /* cancel after the second batch */
     tm_collect c = {(char *)out, (size_t)nv * 4, 0, 0, 2};
@@ -735,8 +740,8 @@ static void test_device_selection_and_cancel(void **state)
     o.on_rows = tm_collect_rows;
     o.user = &c;
     o.memory_limit = (size_t)nv * 60 * 4; /* a few rows per batch */
-    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &err), MFMM_ERR_CANCELLED);
-    assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL); /* no fallback after a cancel */
+    assert_int_equal(mfmm_distance_matrix(mesh, NULL, nv, &o, &oi, &err), MFMM_ERR_CANCELLED);
+    assert_int_equal(oi.backend_used, MFMM_BACKEND_OPENCL); /* no fallback after a cancel */
     unsetenv("MESHFMM_OPENCL_DEVICE");
     assert_int_equal(c.calls, 2);
     assert_true(c.next < nv);
@@ -785,15 +790,16 @@ static void test_reused_context(void **state)
     assert_non_null(out);
     for (int call = 0; call < 3; call++) {
         mfmm_matrix_options o;
+        mfmm_matrix_info oi = {.struct_size = sizeof oi};
         mfmm_matrix_options_init(&o);
         o.backend = MFMM_BACKEND_OPENCL;
         o.dtype = MFMM_FLOAT64;
         o.opencl = ctx;
         o.out = out;
         memset(out, 0, 7 * (size_t)g.nv * sizeof *out);
-        if (mfmm_distance_matrix(mesh, src, 7, &o, &err) != MFMM_OK)
+        if (mfmm_distance_matrix(mesh, src, 7, &o, &oi, &err) != MFMM_OK)
             fail_msg("call %d: %s", call, err.message);
-        assert_int_equal(o.backend_used, MFMM_BACKEND_OPENCL);
+        assert_int_equal(oi.backend_used, MFMM_BACKEND_OPENCL);
         assert_memory_equal(out, ref, 7 * (size_t)g.nv * sizeof *out);
     }
     free(out);

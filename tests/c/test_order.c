@@ -235,8 +235,8 @@ static void check_mesh(mfmm_gen_mesh g, uint32_t seed)
             ob.cost = fcb;
         oa.out = ra;
         ob.out = rb;
-        assert_int_equal(mfmm_distance_matrix(ma, rs_a, NS, &oa, NULL), MFMM_OK);
-        assert_int_equal(mfmm_distance_matrix(mb, rs_b, NS, &ob, NULL), MFMM_OK);
+        assert_int_equal(mfmm_distance_matrix(ma, rs_a, NS, &oa, NULL, NULL), MFMM_OK);
+        assert_int_equal(mfmm_distance_matrix(mb, rs_b, NS, &ob, NULL, NULL), MFMM_OK);
         size_t esz = kind == 2 ? sizeof(float) : sizeof(double);
         for (int i = 0; i < NS; i++) {
             if (kind == 3) {
@@ -319,8 +319,8 @@ static void test_shuffled_sparse(void **state)
     ob = oa;
     oa.user = &ra;
     ob.user = &rb;
-    assert_int_equal(mfmm_distance_matrix(ma, src_a, 8, &oa, NULL), MFMM_OK);
-    assert_int_equal(mfmm_distance_matrix(mb, src_b, 8, &ob, NULL), MFMM_OK);
+    assert_int_equal(mfmm_distance_matrix(ma, src_a, 8, &oa, NULL, NULL), MFMM_OK);
+    assert_int_equal(mfmm_distance_matrix(mb, src_b, 8, &ob, NULL, NULL), MFMM_OK);
     for (int i = 0; i < 8; i++) {
         assert_int_equal(ra.n[i], rb.n[i]);
         assert_true(ra.n[i] > 5);

@@ -39,7 +39,7 @@ static void check_mesh(const char *file, int32_t want_components, int32_t want_u
 {
     int32_t *F = NULL, nv = 0, nf = 0;
     mfmm_mesh *mesh = tm_load_data(file, &nv, &nf, &F);
-    mfmm_mesh_info info;
+    mfmm_mesh_info info = {.struct_size = sizeof info};
     mfmm_mesh_get_info(mesh, &info);
     print_message("%-24s nv=%6d nf=%6d components=%d boundary=%d nonmanifold=%d unref=%d "
                   "obtuse=%d virtual=%d failed=%d degenerate=%d\n",

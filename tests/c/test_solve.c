@@ -122,7 +122,7 @@ static void test_components(void **state)
         two.F[3 * a.nf + i] = a.F[i] + a.nv;
     }
     tm_fixture fx = tm_fixture_make(two, 0);
-    mfmm_mesh_info info;
+    mfmm_mesh_info info = {.struct_size = sizeof info};
     mfmm_mesh_get_info(fx.mesh, &info);
     assert_int_equal(info.n_components, 2);
     assert_int_equal(info.n_unreferenced_vertices, 1);
@@ -327,7 +327,7 @@ static void test_scale_invariance(void **state)
         for (int32_t i = 0; i < 3 * g.nv; i++)
             g.V[i] = V0[i] * scales[k];
         mfmm_mesh *mesh = tm_make(&g);
-        mfmm_mesh_info info;
+        mfmm_mesh_info info = {.struct_size = sizeof info};
         mfmm_mesh_get_info(mesh, &info);
         assert_int_equal(info.n_degenerate_faces, 0);
         mfmm_solver *solver = NULL;
@@ -412,7 +412,7 @@ static void test_degenerate_faces_accepted(void **state)
     int32_t F[3 * 3] = {0, 3, 2, 3, 1, 2, 0, 3, 1}; /* the last has zero area */
     mfmm_mesh *mesh = NULL;
     assert_int_equal(mfmm_mesh_create(V, 5, F, 3, NULL, &mesh, NULL), MFMM_OK);
-    mfmm_mesh_info info;
+    mfmm_mesh_info info = {.struct_size = sizeof info};
     mfmm_mesh_get_info(mesh, &info);
     assert_int_equal(info.n_degenerate_faces, 1);
     mfmm_solver *solver = NULL;

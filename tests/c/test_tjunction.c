@@ -65,7 +65,7 @@ static void check_rows(const double *v, int32_t nv, const int32_t *f, int32_t nf
                        const int32_t *h, int32_t nh, int32_t n_needles)
 {
     mfmm_mesh *m = make(v, nv, f, nf), *r = make(v, nv, h, nh);
-    mfmm_mesh_info info;
+    mfmm_mesh_info info = {.struct_size = sizeof info};
     assert_int_equal(mfmm_mesh_get_info(m, &info), MFMM_OK);
     assert_int_equal(info.n_faces, nf);
     assert_int_equal(mfmm_mesh_face_count(m), nf);
@@ -136,8 +136,8 @@ static void test_per_face_cost(void **state)
     moh.cost = cost_h;
     mo.out = a;
     moh.out = b;
-    assert_int_equal(mfmm_distance_matrix(m, NULL, 6, &mo, NULL), MFMM_OK);
-    assert_int_equal(mfmm_distance_matrix(r, NULL, 6, &moh, NULL), MFMM_OK);
+    assert_int_equal(mfmm_distance_matrix(m, NULL, 6, &mo, NULL, NULL), MFMM_OK);
+    assert_int_equal(mfmm_distance_matrix(r, NULL, 6, &moh, NULL, NULL), MFMM_OK);
     assert_memory_equal(a, b, sizeof a);
     /* a cost array is as long as the input's faces: a bad entry at the
      * needle is still refused */

@@ -1,5 +1,6 @@
 // meshfmm.h from C++: extern "C" linkage, the option structs' _init
-// functions, and a solve on the unit square (prints as the README example).
+// functions, output structs, and a solve on the unit square (prints as the
+// README example).
 #include <meshfmm.h>
 
 #include <cstdio>
@@ -31,6 +32,24 @@ int main()
         std::fprintf(stderr, "solve: %s\n", err.message);
         return 1;
     }
+    // an output struct from C++ (no designated initializers in C++11)
+    mfmm_mesh_info mi = mfmm_mesh_info();
+    mi.struct_size = sizeof mi;
+    if (mfmm_mesh_get_info(mesh, &mi) != MFMM_OK || mi.n_vertices != 4)
+        return 1;
+    // the same row through the const options and the info of a matrix job
+    std::vector<double> row(4);
+    mfmm_matrix_options xo;
+    mfmm_matrix_options_init(&xo);
+    xo.backend = MFMM_BACKEND_SERIAL;
+    xo.dtype = MFMM_FLOAT64;
+    xo.out = row.data();
+    const int32_t first = 0;
+    mfmm_matrix_info info = mfmm_matrix_info();
+    info.struct_size = sizeof info;
+    if (mfmm_distance_matrix(mesh, &first, 1, &xo, &info, &err) != MFMM_OK ||
+        info.backend_used != MFMM_BACKEND_SERIAL || row != d)
+        return 1;
     for (int v = 0; v < 4; v++)
         std::printf("%d %.12f\n", v, d[v]);
     mfmm_solver_destroy(solver);

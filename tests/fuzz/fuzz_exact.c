@@ -222,7 +222,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     mfmm_exact_solver *ex = NULL;
     if (!e || !d || !lo || !hi || mfmm_exact_solver_create(mesh, &ex) != MFMM_OK)
         goto done;
-    mfmm_exact_info info;
+    mfmm_exact_info info = {.struct_size = sizeof info};
     mfmm_status st = mfmm_solve_exact(ex, src, n_src, &eo, e, &info, &err);
     if (st == MFMM_ERR_DEGENERATE_SOURCE || st == MFMM_ERR_MEMORY_LIMIT ||
         st == MFMM_ERR_BAD_BARYCENTRIC)

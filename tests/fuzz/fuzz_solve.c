@@ -161,7 +161,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (size_t b = 0; b < sizeof backends / sizeof backends[0]; b++) {
         mo.backend = backends[b];
         memset(rows, 0xff, (size_t)n_src * nv * sizeof *rows);
-        mfmm_status st = mfmm_distance_matrix(mesh, src_ids, n_src, &mo, &err);
+        mfmm_status st = mfmm_distance_matrix(mesh, src_ids, n_src, &mo, NULL, &err);
         if (st != MFMM_OK) {
             if (have_ref && st != MFMM_ERR_OUT_OF_MEMORY && st != MFMM_ERR_NO_OPENCL &&
                 st != MFMM_ERR_OPENCL_BUILD && st != MFMM_ERR_OPENCL_RUNTIME)

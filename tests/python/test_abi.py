@@ -20,11 +20,13 @@ STRUCTS = {
     "mfmm_mesh_info": _lib.mfmm_mesh_info,
     "mfmm_source": _lib.mfmm_source,
     "mfmm_solve_options": _lib.mfmm_solve_options,
+    "mfmm_solve_info": _lib.mfmm_solve_info,
     "mfmm_exact_options": _lib.mfmm_exact_options,
     "mfmm_exact_info": _lib.mfmm_exact_info,
     "mfmm_surface_point": _lib.mfmm_surface_point,
     "mfmm_path_options": _lib.mfmm_path_options,
     "mfmm_matrix_options": _lib.mfmm_matrix_options,
+    "mfmm_matrix_info": _lib.mfmm_matrix_info,
     "mfmm_opencl_options": _lib.mfmm_opencl_options,
 }
 ENUMS = ["mfmm_status", "mfmm_cost_location", "mfmm_backend", "mfmm_dtype"]
@@ -50,7 +52,8 @@ def c_layout(tmp_path_factory):
     # enum values the binding hard-codes
     for const in ["MFMM_STATUS_COUNT", "MFMM_ERR_PARSE", "MFMM_ERR_OUT_OF_MEMORY",
                   "MFMM_ERR_CANCELLED", "MFMM_ERR_IO", "MFMM_COST_PER_FACE",
-                  "MFMM_BACKEND_OPENCL", "MFMM_FLOAT64"]:
+                  "MFMM_BACKEND_OPENCL", "MFMM_FLOAT64", "MFMM_VERSION_MAJOR",
+                  "MFMM_VERSION_MINOR"]:
         lines.append(f'  printf(",\\"{const}\\": %d", (int){const});')
     lines += ['  printf("}\\n");', "  return 0;", "}"]
     d = tmp_path_factory.mktemp("abi")
@@ -81,6 +84,19 @@ def test_enums_and_callback(c_layout):
     assert c_layout["MFMM_COST_PER_FACE"] == _lib.MFMM_COST_PER_FACE
     assert c_layout["MFMM_BACKEND_OPENCL"] == _lib.MFMM_BACKEND_OPENCL
     assert c_layout["MFMM_FLOAT64"] == _lib.MFMM_FLOAT64
+    # the mirrors are of this header's ABI, and the loaded library speaks it
+    assert (c_layout["MFMM_VERSION_MAJOR"], c_layout["MFMM_VERSION_MINOR"]) == _lib.ABI_VERSION
+    assert tuple(int(x) for x in _lib.version().split(".")[:2]) == _lib.ABI_VERSION
+
+
+def test_struct_size_first_and_set():
+    """Every struct that can grow starts with struct_size, and a new mirror
+    has it set to its sizeof (output structs are passed as they are)."""
+    for name, st in STRUCTS.items():
+        if st._fields_[0][0] != "struct_size":
+            assert name in ("mfmm_error", "mfmm_source", "mfmm_surface_point"), name
+            continue
+        assert st().struct_size == ctypes.sizeof(st), name
 
 
 def test_numpy_record_layouts():

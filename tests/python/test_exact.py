@@ -56,18 +56,10 @@ def test_live_against_igl():
         np.testing.assert_allclose(d, ref, rtol=1e-12, atol=0)
 
 
-def test_cost_refused():
-    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=np.float64)
-    F = np.array([[0, 1, 2]], dtype=np.int32)
-    cost = np.ones(1)
-    opt = _lib.mfmm_exact_options()
-    _lib.mfmm_exact_options_init(ctypes.byref(opt))
-    opt.cost = cost.ctypes.data
-    opt.cost_location = _lib.MFMM_COST_PER_FACE
-    st, d, _, err = _solve_exact(V, F, _lib.mfmm_source(0, -1, (0.0, 0.0, 0.0), 0.0), opt)
-    assert st == _lib.MFMM_ERR_BAD_ARGUMENT
-    assert b"cost" in err.message
-    assert np.isinf(d).all()
+def test_exact_options_take_no_cost():
+    """Exact distances are for F = 1: the options have no cost to refuse."""
+    names = [name for name, _ in _lib.mfmm_exact_options._fields_]
+    assert "cost" not in names and "cost_location" not in names
 
 
 @pytest.mark.parametrize("name", ["hand_lowres", "spot", "wingnut", "fertility_FE_10k",

@@ -29,7 +29,7 @@ from ctypes import (
     c_void_p,
 )
 from pathlib import Path
-from typing import Optional
+from typing import Any, NamedTuple, Optional, Tuple
 
 import numpy as np
 
@@ -116,7 +116,24 @@ MFMM_FLOAT64 = 1
 c_enum = c_int
 
 
+# The ABI these mirrors describe (meshfmm.h MFMM_VERSION_MAJOR.MINOR): while
+# MAJOR is 0 every MINOR release may change it, so a library of another
+# MAJOR.MINOR is refused at import.
+ABI_VERSION = (0, 2)
+
+
 # ------------------------------------------------------------ struct mirrors
+class _Sized(Structure):
+    """A struct that starts with struct_size: a new instance has it set to
+    its sizeof (option structs are then filled by their C _init function;
+    output structs are passed as they are)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        if not self.struct_size:
+            self.struct_size = ctypes.sizeof(self)
+
+
 class mfmm_error(Structure):
     _fields_ = [
         ("status", c_enum),
@@ -126,13 +143,15 @@ class mfmm_error(Structure):
 
 
 # Option structs start with struct_size (set by their C _init function, which
-# the package always calls before setting fields).
-class mfmm_mesh_options(Structure):
+# the package always calls before setting fields); output structs too (set
+# to their sizeof on creation, see _Sized).
+class mfmm_mesh_options(_Sized):
     _fields_ = [("struct_size", c_size_t), ("max_unfold_steps", c_int32), ("spokes", c_int32)]
 
 
-class mfmm_mesh_info(Structure):
+class mfmm_mesh_info(_Sized):
     _fields_ = [
+        ("struct_size", c_size_t),
         ("n_vertices", c_int32),
         ("n_faces", c_int32),
         ("n_edges", c_int32),
@@ -141,6 +160,7 @@ class mfmm_mesh_info(Structure):
         ("n_components", c_int32),
         ("n_unreferenced_vertices", c_int32),
         ("n_degenerate_faces", c_int32),
+        ("n_duplicate_faces", c_int32),
         ("n_obtuse_corners", c_int32),
         ("n_virtual_edges", c_int32),
         ("n_unfold_failures", c_int32),
@@ -148,7 +168,6 @@ class mfmm_mesh_info(Structure):
         ("max_edge_length", c_double),
         ("mean_edge_length", c_double),
         ("bbox_diagonal", c_double),
-        ("n_duplicate_faces", c_int32),
     ]
 
 
@@ -161,7 +180,7 @@ class mfmm_source(Structure):
     ]
 
 
-class mfmm_solve_options(Structure):
+class mfmm_solve_options(_Sized):
     _fields_ = [
         ("struct_size", c_size_t),
         ("cost", c_void_p),  # const double *
@@ -170,15 +189,17 @@ class mfmm_solve_options(Structure):
         ("targets", c_void_p),  # const int32_t *
         ("n_targets", c_int32),
         ("unfolding", c_int32),
-        ("exact_start_radius", c_double),  # appended: the exact start, in mean edge lengths
+        ("exact_start_radius", c_double),  # the exact start, in mean edge lengths
     ]
 
 
-class mfmm_exact_options(Structure):
+class mfmm_solve_info(_Sized):
+    _fields_ = [("struct_size", c_size_t), ("start_fallbacks", c_int64)]
+
+
+class mfmm_exact_options(_Sized):
     _fields_ = [
         ("struct_size", c_size_t),
-        ("cost", c_void_p),  # const double *; must be NULL
-        ("cost_location", c_enum),
         ("max_distance", c_double),
         ("memory_limit", c_size_t),
         ("interrupt", CFUNCTYPE(c_int, c_void_p)),  # non-zero stops the solve
@@ -186,8 +207,9 @@ class mfmm_exact_options(Structure):
     ]
 
 
-class mfmm_exact_info(Structure):
+class mfmm_exact_info(_Sized):
     _fields_ = [
+        ("struct_size", c_size_t),
         ("n_windows", c_int64),
         ("n_propagated", c_int64),
         ("n_pseudo_sources", c_int64),
@@ -205,7 +227,7 @@ class mfmm_surface_point(Structure):
     ]
 
 
-class mfmm_path_options(Structure):
+class mfmm_path_options(_Sized):
     _fields_ = [
         ("struct_size", c_size_t),
         ("max_points", c_int32),
@@ -214,7 +236,7 @@ class mfmm_path_options(Structure):
         ("cost", c_void_p),  # const double *
         ("cost_location", c_enum),
         ("weighted_length", c_void_p),  # double * (out), may be NULL
-        ("straighten", c_int),
+        ("straighten", c_int32),
     ]
 
 
@@ -225,7 +247,7 @@ mfmm_rows_callback = CFUNCTYPE(c_int, c_void_p, c_int32, c_int32, c_void_p)
 mfmm_sparse_callback = CFUNCTYPE(c_int, c_void_p, c_int32, c_int32, c_void_p, c_void_p, c_void_p)
 
 
-class mfmm_opencl_options(Structure):
+class mfmm_opencl_options(_Sized):
     _fields_ = [
         ("struct_size", c_size_t),
         ("device", c_char_p),
@@ -234,7 +256,7 @@ class mfmm_opencl_options(Structure):
     ]
 
 
-class mfmm_matrix_options(Structure):
+class mfmm_matrix_options(_Sized):
     _fields_ = [
         ("struct_size", c_size_t),
         ("backend", c_enum),
@@ -242,22 +264,28 @@ class mfmm_matrix_options(Structure):
         ("cost", c_void_p),  # const double *
         ("cost_location", c_enum),
         ("max_distance", c_double),
+        ("targets", c_void_p),  # const int32_t *: target columns, or NULL
+        ("n_targets", c_int32),
         ("unfolding", c_int32),
+        ("exact_start_radius", c_double),
         ("n_threads", c_int32),
         ("memory_limit", c_size_t),
         ("out", c_void_p),
         ("on_rows", mfmm_rows_callback),
+        ("on_sparse", mfmm_sparse_callback),
         ("user", c_void_p),
-        ("backend_used", c_enum),
         ("opencl", c_void_p),  # mfmm_opencl_context *
         ("opencl_options", c_void_p),  # const mfmm_opencl_options *
-        ("fallback_reason", c_char * 256),  # out: why AUTO ran threads
-        ("targets", c_void_p),  # const int32_t *: target columns, or NULL
-        ("n_targets", c_int32),
-        ("vertices_settled", c_int64),  # out
-        ("on_sparse", mfmm_sparse_callback),
-        ("exact_start_radius", c_double),  # appended: as in mfmm_solve_options
-        ("start_fallbacks", c_int64),  # out
+    ]
+
+
+class mfmm_matrix_info(_Sized):
+    _fields_ = [
+        ("struct_size", c_size_t),
+        ("backend_used", c_enum),
+        ("backend_reason", c_char * 256),  # why another backend than the one asked for ran
+        ("vertices_settled", c_int64),
+        ("start_fallbacks", c_int64),
     ]
 
 
@@ -302,8 +330,11 @@ def _candidates() -> list:
     else:
         names = ["libmeshfmm.so"]
     found = [here / n for n in names]
-    # A versioned file (libmeshfmm.so.0.1.0) if a build installed one.
-    found += sorted(here.glob("libmeshfmm.so.*"))
+    # the soname of the ABI mirrored here (libmeshfmm.so.0.2), then any
+    # versioned file a build installed (libmeshfmm.so.0.2.0)
+    if sys.platform not in ("win32", "darwin"):
+        found.append(here / ("libmeshfmm.so." + ".".join(map(str, ABI_VERSION))))
+        found += sorted(here.glob("libmeshfmm.so.*"))
     return found
 
 
@@ -330,9 +361,21 @@ def _find_library() -> str:
 def _load() -> ctypes.CDLL:
     path = _find_library()
     try:
-        return ctypes.CDLL(path)
+        found = ctypes.CDLL(path)
     except OSError as exc:
         raise ImportError(f"meshfmm: cannot load the shared library {path!r}: {exc}") from exc
+    try:
+        fn = found.mfmm_version
+        fn.restype = c_char_p
+        fn.argtypes = []
+        have = fn().decode("ascii")
+    except (AttributeError, UnicodeDecodeError) as exc:
+        raise ImportError(f"meshfmm: {path!r} is not a meshfmm library: {exc}") from exc
+    if tuple(int(x) for x in have.split(".")[:2]) != ABI_VERSION:
+        want = ".".join(map(str, ABI_VERSION))
+        raise ImportError(f"meshfmm: {path!r} is meshfmm {have}, but this package speaks the "
+                          f"ABI of meshfmm {want}.x (build the library of this tree)")
+    return found
 
 
 lib = _load()
@@ -392,6 +435,7 @@ mfmm_solve = _proto(
     # solver, sources (mfmm_source *), n_sources, options, distances (double *), err
     [c_void_p, c_void_p, c_int32, P(mfmm_solve_options), c_void_p, P(mfmm_error)],
 )
+mfmm_solver_get_info = _proto("mfmm_solver_get_info", c_enum, [c_void_p, P(mfmm_solve_info)])
 # exact
 mfmm_exact_solver_create = _proto("mfmm_exact_solver_create", c_enum, [c_void_p, P(c_void_p)])
 mfmm_exact_solver_destroy = _proto("mfmm_exact_solver_destroy", None, [c_void_p])
@@ -428,9 +472,34 @@ mfmm_matrix_options_init = _proto("mfmm_matrix_options_init", None, [P(mfmm_matr
 mfmm_distance_matrix = _proto(
     "mfmm_distance_matrix",
     c_enum,
-    # mesh, sources (int32_t *), n_sources, options, err
-    [c_void_p, c_void_p, c_int32, P(mfmm_matrix_options), P(mfmm_error)],
+    # mesh, sources (int32_t *), n_sources, options, info, err
+    [c_void_p, c_void_p, c_int32, P(mfmm_matrix_options), P(mfmm_matrix_info), P(mfmm_error)],
 )
+
+
+class MatrixCallInfo(NamedTuple):
+    """What one mfmm_distance_matrix call did (its mfmm_matrix_info)."""
+
+    backend_used: Optional[str]  # "serial", "threads" or "opencl"
+    reason: str                  # why another backend than the one asked for ran; ""
+    vertices_settled: int        # serial and threads backends; 0 from OpenCL
+    start_fallbacks: int
+
+
+def distance_matrix(mesh: Any, sources: Any, n_sources: int, options: mfmm_matrix_options,
+                    err: mfmm_error) -> Tuple[int, MatrixCallInfo]:
+    """Calls mfmm_distance_matrix; returns its status and what the call did
+    (per call: nothing is kept on the mesh)."""
+    info = mfmm_matrix_info()
+    status = mfmm_distance_matrix(mesh, sources, n_sources, ctypes.byref(options),
+                                  ctypes.byref(info), ctypes.byref(err))
+    name = mfmm_backend_name(info.backend_used)
+    return status, MatrixCallInfo(
+        backend_used=name.decode("ascii") if name else None,
+        reason=info.backend_reason.decode("utf-8", "replace"),
+        vertices_settled=int(info.vertices_settled),
+        start_fallbacks=int(info.start_fallbacks),
+    )
 # I/O
 mfmm_opencl_options_init = _proto("mfmm_opencl_options_init", None, [P(mfmm_opencl_options)])
 mfmm_opencl_context_create = _proto(

@@ -413,7 +413,8 @@ class Mesh:
         self._nf = nf
         info = _lib.mfmm_mesh_info()
         _lib.check(_lib.mfmm_mesh_get_info(self._ptr, byref(info)))
-        self._info = MeshInfo(**{name: getattr(info, name) for name, _ in info._fields_})
+        self._info = MeshInfo(**{name: getattr(info, name) for name, _ in info._fields_
+                                 if name != "struct_size"})
         self._opts_template = _lib.mfmm_solve_options()
         _lib.mfmm_solve_options_init(byref(self._opts_template))
 
@@ -1057,8 +1058,8 @@ class Mesh:
         mesh_ptr = self._enter()
         try:
             with _sigint_as_flag(interrupted):
-                status = _lib.mfmm_distance_matrix(
-                    mesh_ptr, None if src is None else _addr(src), n_rows, byref(opts), byref(err)
+                status, call = _lib.distance_matrix(
+                    mesh_ptr, None if src is None else _addr(src), n_rows, opts, err
                 )
         finally:
             self._leave()
@@ -1067,10 +1068,9 @@ class Mesh:
         if interrupted:
             raise KeyboardInterrupt
         _lib.check(status, err)
-        name = _lib.mfmm_backend_name(opts.backend_used)
-        self.backend_used = name.decode("ascii") if name else None
-        self.fallback_reason = opts.fallback_reason.decode("utf-8", "replace")
-        self.vertices_settled = int(opts.vertices_settled)
+        self.backend_used = call.backend_used
+        self.fallback_reason = call.reason
+        self.vertices_settled = call.vertices_settled
         if sparse:
             return _csr_from_pieces(pieces, (n_rows, width), dt)
         if symmetric:
