@@ -463,19 +463,22 @@ def test_distance_matrix_smoke(tmp_path):
     V, F = grid(10)
     m = meshfmm.Mesh(V, F)
     try:
-        D = m.distance_matrix([0, 60], backend="serial", dtype="float64")
+        D, info = m.distance_matrix([0, 60], backend="serial", dtype="float64",
+                                    return_info=True)
     except NotImplementedError as exc:
         pytest.skip(str(exc))
     assert D.shape == (2, 121) and D.dtype == np.float64
     np.testing.assert_array_equal(D[0], m.distance(0))
     np.testing.assert_array_equal(D[1], m.distance(60))
-    assert m.backend_used == "serial"
+    assert info == meshfmm.MatrixInfo("serial", "", info.vertices_settled, 0)
+    assert info.vertices_settled > 0
+    assert not hasattr(m, "backend_used")
     mm = np.lib.format.open_memmap(tmp_path / "all.npy", mode="w+", dtype=np.float32,
                                    shape=(121, 121))
     seen = []
-    out = m.distance_matrix(out=mm, backend="threads", n_threads=2,
-                            progress=lambda done, n: seen.append((done, n)))
-    assert out is mm and m.backend_used == "threads"
+    out, info = m.distance_matrix(out=mm, backend="threads", n_threads=2, return_info=True,
+                                  progress=lambda done, n: seen.append((done, n)))
+    assert out is mm and info.backend == "threads"
     mm.flush()
     back = np.load(tmp_path / "all.npy", mmap_mode="r")
     np.testing.assert_array_equal(back[60], m.distance(60).astype(np.float32))
@@ -506,10 +509,10 @@ def test_opencl_errors_map_to_openclerror(tmp_path):
         except meshfmm.OpenCLError as exc:
             assert isinstance(exc, RuntimeError) and str(exc), exc
             print("OpenCLError", exc)
-        D = m.distance_matrix([0, 1], backend="auto", dtype="float64")
-        assert m.backend_used in ("threads", "serial"), m.backend_used
+        D, info = m.distance_matrix([0, 1], backend="auto", dtype="float64", return_info=True)
+        assert info.backend in ("threads", "serial"), info
         assert (D[1] == m.distance(1)).all()
-        print("fallback", m.backend_used)
+        print("fallback", info.backend)
         """
     ) % str(Path(__file__).parent)
     env = dict(os.environ, OCL_ICD_VENDORS=str(tmp_path), OPENCL_VENDOR_PATH=str(tmp_path))

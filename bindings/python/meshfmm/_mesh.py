@@ -1,303 +1,32 @@
-"""Mesh, SurfacePoint, GeodesicPath and load_mesh: the Python face of libmeshfmm.
+"""The Mesh class and load_mesh: the Python face of libmeshfmm.
 
-All foreign calls go through :mod:`meshfmm._lib`.
+Mesh is a thin facade: argument coercion lives in :mod:`meshfmm._args`, the
+matrix paths in :mod:`meshfmm._dense` and :mod:`meshfmm._sparse` over the row
+job of :mod:`meshfmm._rows`; all foreign calls go through :mod:`meshfmm._lib`.
 """
 
 from __future__ import annotations
 
-import atexit
-import collections.abc
 import contextlib
 import ctypes
-import dataclasses
 import errno
 import math
 import numbers
-import operator
 import os
-import signal
 import threading
 from ctypes import byref
-from typing import Any, Callable, Dict, Iterator, List, NamedTuple, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterator, List, Optional, Tuple, Union
 
 import numpy as np
 
-from . import _lib
+from . import _args, _dense, _lib, _rows, _sparse
+from ._interrupt import sigint_as_flag
 from ._lib import MeshError
+from ._types import GeodesicPath, MatrixInfo, MeshInfo, SourceLike, SurfacePoint
 
-__all__ = ["Mesh", "MeshInfo", "SurfacePoint", "GeodesicPath", "load_mesh"]
-
-_I32_MIN = -(2**31)
-_I32_MAX = 2**31 - 1
+__all__ = ["Mesh", "MeshInfo", "SurfacePoint", "GeodesicPath", "MatrixInfo", "load_mesh"]
 
 
-class SurfacePoint(NamedTuple):
-    """A point inside a face: ``face`` id and barycentric coordinates ``bary``
-    (three numbers >= 0 summing to 1, weights of the face's corners in the
-    order the face lists them). Usable as a source of :meth:`Mesh.distance`
-    and as a target of :meth:`Mesh.geodesic_path`."""
-
-    face: int
-    bary: Sequence[float]
-
-
-SourceLike = Union[int, SurfacePoint, Sequence[Union[int, SurfacePoint]], np.ndarray]
-
-
-@dataclasses.dataclass(frozen=True)
-class MeshInfo:
-    """Diagnostics of a mesh, computed once when it was created
-    (``mfmm_mesh_info``)."""
-
-    n_vertices: int  #: vertices as given
-    n_faces: int  #: faces as given
-    n_edges: int  #: distinct undirected edges (of the surface built: T-junctions closed)
-    n_boundary_edges: int  #: edges with one face
-    n_nonmanifold_edges: int  #: edges with three or more faces
-    n_components: int  #: edge-connected components of referenced vertices
-    n_unreferenced_vertices: int  #: vertices no face names (always +inf)
-    n_degenerate_faces: int  #: faces of (numerically) zero area, as given (needles included)
-    n_obtuse_corners: int  #: corners with an angle > 90 degrees
-    n_virtual_edges: int  #: obtuse corners split by a virtual edge (unfolding)
-    n_unfold_failures: int  #: obtuse corners whose unfolding walk failed
-    min_edge_length: float
-    max_edge_length: float
-    mean_edge_length: float
-    bbox_diagonal: float  #: length of the bounding-box diagonal
-    n_duplicate_faces: int  #: faces repeating another's vertices (copies; not walls)
-
-    def as_dict(self) -> dict:
-        """The fields as a plain dict."""
-        return dataclasses.asdict(self)
-
-
-@dataclasses.dataclass(frozen=True)
-class GeodesicPath:
-    """A polyline on the surface from a target back to its source.
-
-    ``points`` (k,3) positions, ``faces`` (k,) the face each point lies in,
-    ``barycentric`` (k,3) its coordinates in that face, ``length`` the
-    polyline's Euclidean length, ``weighted_length`` its cost-weighted length
-    (sum of F times segment length; equal to ``length`` without a cost).
-    Point 0 is the target, point k-1 the source; ``faces[i]`` (i > 0) is the
-    face the segment from point i-1 runs through.
-    """
-
-    points: np.ndarray
-    faces: np.ndarray
-    barycentric: np.ndarray
-    length: float
-    weighted_length: float
-
-    def __len__(self) -> int:
-        return int(self.faces.shape[0])
-
-
-# ------------------------------------------------------------------ helpers
-def _addr(a: np.ndarray) -> int:
-    """Address of an ndarray's first element. (ctypes.c_char.from_buffer is
-    several times faster than ndarray.ctypes.data, but needs a writable,
-    non-empty buffer.)"""
-    try:
-        return ctypes.addressof(ctypes.c_char.from_buffer(a))
-    except (TypeError, ValueError):
-        return a.__array_interface__["data"][0]
-
-
-def _is_int(x: Any) -> bool:
-    return isinstance(x, (int, np.integer)) and not isinstance(x, (bool, np.bool_))
-
-
-def _flag(x: Any, what: str) -> bool:
-    """A yes/no option: True or False (numpy's bools too). Anything else is a
-    TypeError: 'no', 0 or None read as truth values would pass silently."""
-    if not isinstance(x, (bool, np.bool_)):
-        raise TypeError(f"{what} must be True or False, got {x!r}")
-    return bool(x)
-
-
-def _size(x: Any, what: str) -> int:
-    """A byte count for a C size_t: an integer in [0, 2**64)."""
-    if not _is_int(x):
-        raise TypeError(f"{what} must be an integer number of bytes, got {x!r}")
-    i = int(x)
-    if not (0 <= i < 2**64):
-        raise ValueError(f"{what} must be in [0, 2**64), got {i}")
-    return i
-
-
-def _as_index(x: Any, what: str) -> int:
-    if not _is_int(x):
-        raise TypeError(f"{what} must be an integer, got {type(x).__name__}")
-    i = int(x)
-    if not (_I32_MIN <= i <= _I32_MAX):
-        raise ValueError(f"{what} {i} is out of range (not a 32-bit index)")
-    return i
-
-
-def _bary(b: Any, what: str) -> np.ndarray:
-    try:
-        arr = np.asarray(b, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"{what}: barycentric coordinates must be 3 numbers, got {b!r}") from None
-    if arr.shape != (3,):
-        raise ValueError(
-            f"{what}: barycentric coordinates must be 3 numbers, got shape {arr.shape}"
-        )
-    return arr
-
-
-def _source_records(sources: Any, what: str = "source") -> np.ndarray:
-    """Any accepted form of sources -> a C-contiguous array of mfmm_source."""
-    if isinstance(sources, SurfacePoint):
-        sources = [sources]
-    elif _is_int(sources):
-        rec = np.zeros(1, dtype=_lib.SOURCE_DTYPE)
-        rec["vertex"] = _as_index(sources, what)
-        rec["face"] = -1
-        return rec
-    if isinstance(sources, np.ndarray):
-        if sources.dtype.kind not in "iu":
-            raise TypeError(f"{what}s as an array must be integer vertex ids, got dtype {sources.dtype}")
-        ids = sources.reshape(-1)
-        if ids.size == 0:
-            raise ValueError(f"at least one {what} is needed")
-        if ids.min() < _I32_MIN or ids.max() > _I32_MAX:
-            bad = ids[(ids < _I32_MIN) | (ids > _I32_MAX)][0]
-            raise ValueError(f"{what} {bad} is out of range (not a 32-bit index)")
-        rec = np.zeros(ids.size, dtype=_lib.SOURCE_DTYPE)
-        rec["vertex"] = ids
-        rec["face"] = -1
-        return rec
-    if (isinstance(sources, (str, bytes, collections.abc.Mapping))
-            or not hasattr(sources, "__len__")):
-        raise TypeError(
-            f"{what}s must be a vertex id, a SurfacePoint or a sequence of those, "
-            f"got {type(sources).__name__}"
-        )
-    n = len(sources)
-    if n == 0:
-        raise ValueError(f"at least one {what} is needed")
-    if all(_is_int(s) for s in sources):  # vertex ids only: filled at once
-        ids = [int(s) for s in sources]
-        for i, v in enumerate(ids):
-            if not (_I32_MIN <= v <= _I32_MAX):
-                raise ValueError(f"{what} {i}: vertex {v} is out of range (not a 32-bit index)")
-        rec = np.zeros(n, dtype=_lib.SOURCE_DTYPE)
-        rec["vertex"] = ids
-        rec["face"] = -1
-        return rec
-    rec = np.zeros(n, dtype=_lib.SOURCE_DTYPE)
-    for i, s in enumerate(sources):
-        if isinstance(s, SurfacePoint):
-            face = _as_index(s.face, f"{what} {i}: face")
-            if face < 0:
-                raise ValueError(f"{what} {i}: face {face} is out of range (face ids are >= 0)")
-            rec["face"][i] = face
-            rec["vertex"][i] = -1
-            rec["bary"][i] = _bary(s.bary, f"{what} {i}")
-        elif _is_int(s):
-            rec["vertex"][i] = _as_index(s, f"{what} {i}: vertex")
-            rec["face"][i] = -1
-        else:
-            raise TypeError(
-                f"{what} {i} must be a vertex id or a SurfacePoint, got {type(s).__name__}"
-            )
-    return rec
-
-
-def _target_record(target: Any) -> _lib.mfmm_source:
-    src = _lib.mfmm_source()
-    if isinstance(target, SurfacePoint):
-        src.vertex = -1
-        src.face = _as_index(target.face, "target face")
-        if src.face < 0:
-            raise ValueError(f"target face {src.face} is out of range (face ids are >= 0)")
-        b = _bary(target.bary, "target")
-        src.bary[0], src.bary[1], src.bary[2] = float(b[0]), float(b[1]), float(b[2])
-    elif _is_int(target):
-        src.vertex = _as_index(target, "target vertex")
-        src.face = -1
-    else:
-        raise TypeError(f"target must be a vertex id or a SurfacePoint, got {type(target).__name__}")
-    return src
-
-
-_COST_LOCATIONS = {"vertex": _lib.MFMM_COST_PER_VERTEX, "face": _lib.MFMM_COST_PER_FACE}
-
-
-def _cost_array(cost: Any, cost_location: Optional[str], nv: int, nf: int) -> Tuple[Optional[np.ndarray], int]:
-    if cost is None:
-        if cost_location is not None and cost_location not in _COST_LOCATIONS:
-            raise ValueError(f"cost_location must be 'vertex' or 'face', got {cost_location!r}")
-        return None, _lib.MFMM_COST_NONE
-    c = np.asarray(cost)
-    if c.dtype.kind not in "iuf":
-        raise ValueError(f"cost must be an array of numbers, got dtype {c.dtype}")
-    c = np.ascontiguousarray(c, dtype=np.float64)
-    if c.ndim != 1:
-        raise ValueError(f"cost must be 1-D, (n_vertices,) or (n_faces,), got shape {c.shape}")
-    if cost_location is None:
-        if c.shape[0] == nv and nv == nf:
-            raise ValueError(
-                f"the mesh has as many vertices as faces ({nv}): say cost_location='vertex' or 'face'"
-            )
-        if c.shape[0] == nv:
-            loc = _lib.MFMM_COST_PER_VERTEX
-        elif c.shape[0] == nf:
-            loc = _lib.MFMM_COST_PER_FACE
-        else:
-            raise ValueError(
-                f"cost has {c.shape[0]} entries; the mesh has {nv} vertices and {nf} faces"
-            )
-    else:
-        if cost_location not in _COST_LOCATIONS:
-            raise ValueError(f"cost_location must be 'vertex' or 'face', got {cost_location!r}")
-        loc = _COST_LOCATIONS[cost_location]
-        want = nv if loc == _lib.MFMM_COST_PER_VERTEX else nf
-        if c.shape[0] != want:
-            raise ValueError(
-                f"cost per {cost_location} must have {want} entries, got {c.shape[0]}"
-            )
-    return c, loc
-
-
-def _exact_start(x: Any) -> Optional[float]:
-    """The exact_start option: True or "auto" (the library's default radius,
-    MFMM_EXACT_START_AUTO) -> None, False -> 0.0 (the paper's plain start), a
-    number -> that radius in mean edge lengths (finite, >= 0)."""
-    if x is True or (isinstance(x, str) and x == "auto"):
-        return None
-    if x is False:
-        return 0.0
-    if isinstance(x, (bool, np.bool_)):
-        return None if x else 0.0
-    if isinstance(x, (str, bytes)) or not isinstance(x, (int, float, np.integer, np.floating)):
-        raise ValueError(f"exact_start must be True, 'auto', False or a radius in mean edge "
-                         f"lengths, not {x!r}")
-    r = float(x)
-    if not np.isfinite(r) or r < 0:
-        raise ValueError(f"exact_start radius must be finite and >= 0, not {r}")
-    return r
-
-
-def _max_distance(x: Any) -> float:
-    """max_distance as a C double: None -> +inf; a real number >= 0 (+inf
-    allowed). Strings, bools and other types are a TypeError (no silent
-    float("2.5")); NaN and negative values a ValueError."""
-    if x is None:
-        return math.inf
-    if isinstance(x, (bool, np.bool_)) or not isinstance(x, numbers.Real):
-        raise TypeError(f"max_distance must be a real number or None, got {type(x).__name__} {x!r}")
-    d = float(x)
-    if math.isnan(d):
-        raise ValueError("max_distance is NaN; give a number >= 0, or None for no limit")
-    if d < 0:
-        raise ValueError(f"max_distance must be >= 0, got {d!r}")
-    return d
-
-
-# --------------------------------------------------------------------- mesh
 class Mesh:
     """An immutable triangle mesh, validated and preprocessed by the C core.
 
@@ -351,7 +80,7 @@ class Mesh:
                 )
             V, F = V.vertices, V.faces
         self._max_unfold_steps = max_unfold_steps
-        self._spokes = _flag(spokes, "spokes")
+        self._spokes = _args.flag(spokes, "spokes")
         self._lock = threading.Lock()
         # _leave notifies it when the last call in flight ends (close waits on it)
         self._idle = threading.Condition(self._lock)
@@ -361,12 +90,6 @@ class Mesh:
         self._close_waiters = 0  # close() calls waiting for the calls in flight
         self._solvers: List[int] = []
         self._exact_solvers: List[int] = []
-        #: Name of the backend that ran the last :meth:`distance_matrix` call
-        #: ("serial", "threads" or "opencl"), None before the first.
-        self.backend_used: Optional[str] = None
-        #: Why the last "auto" call ran threads instead of OpenCL ("" when it
-        #: did not fall back), from the library's fallback_reason.
-        self.fallback_reason: str = ""
 
         Va = np.asarray(V)
         if Va.dtype.kind not in "iuf":
@@ -381,12 +104,12 @@ class Mesh:
         if Fa.ndim != 2 or Fa.shape[1] != 3:
             raise MeshError(f"faces must have shape (m, 3), got {Fa.shape}")
         nv, nf = Va.shape[0], Fa.shape[0]
-        if nv > _I32_MAX or nf > _I32_MAX:
+        if nv > _args.I32_MAX or nf > _args.I32_MAX:
             raise MeshError(f"too many vertices or faces for 32-bit indices ({nv}, {nf})")
         if nf and Fa.dtype.itemsize >= 4 and Fa.dtype != np.int32:
             lo, hi = Fa.min(), Fa.max()
-            if lo < _I32_MIN or hi > _I32_MAX:
-                bad = np.argwhere((Fa < _I32_MIN) | (Fa > _I32_MAX))[0]
+            if lo < _args.I32_MIN or hi > _args.I32_MAX:
+                bad = np.argwhere((Fa < _args.I32_MIN) | (Fa > _args.I32_MAX))[0]
                 raise MeshError(
                     f"face {bad[0]} names vertex {Fa[bad[0], bad[1]]}, out of range "
                     f"(the mesh has {nv} vertices)"
@@ -400,12 +123,12 @@ class Mesh:
         opts = _lib.mfmm_mesh_options()
         _lib.mfmm_mesh_options_init(byref(opts))
         if max_unfold_steps is not None:
-            opts.max_unfold_steps = _as_index(max_unfold_steps, "max_unfold_steps")
+            opts.max_unfold_steps = _args.index(max_unfold_steps, "max_unfold_steps")
         opts.spokes = int(self._spokes)
         err = _lib.mfmm_error()
         out = ctypes.c_void_p()
         status = _lib.mfmm_mesh_create(
-            _addr(self._V), nv, _addr(self._F), nf, byref(opts), byref(out), byref(err)
+            _args.addr(self._V), nv, _args.addr(self._F), nf, byref(opts), byref(out), byref(err)
         )
         _lib.check(status, err, mesh=True)
         self._ptr = out.value
@@ -577,6 +300,16 @@ class Mesh:
         if freed is not None:
             _free(*freed)
 
+    @contextlib.contextmanager
+    def _in_call(self) -> Iterator[int]:
+        """The C mesh pointer for one call in flight (ValueError when the mesh
+        is closed); close() waits for the call to leave."""
+        ptr = self._enter()
+        try:
+            yield ptr
+        finally:
+            self._leave()
+
     def _take_solver(self, mesh_ptr: int) -> int:
         try:
             return self._solvers.pop()  # atomic under the GIL
@@ -680,7 +413,7 @@ class Mesh:
         Unreached vertices (other components, beyond max_distance) are +inf.
         Raises ValueError (bad source, barycentric coordinates, cost, ...).
         """
-        unfolding = _flag(unfolding, "unfolding")
+        unfolding = _args.flag(unfolding, "unfolding")
         if method == "exact":
             if cost is not None or targets is not None or not unfolding or exact_start is not True:
                 raise ValueError("method='exact' computes geodesic distance: it takes no cost, "
@@ -688,28 +421,28 @@ class Mesh:
             return self._distance_exact(sources, max_distance)
         if method != "fmm":
             raise ValueError(f"method must be 'fmm' or 'exact', not {method!r}")
-        if _is_int(sources):  # the common case, kept cheap (see bench_python.py)
-            one = _lib.mfmm_source(_as_index(sources, "source"), -1)
+        if _args.is_int(sources):  # the common case, kept cheap (see bench_python.py)
+            one = _lib.mfmm_source(_args.index(sources, "source"), -1)
             src_addr, n_src = ctypes.addressof(one), 1
         else:
-            src = _source_records(sources)
-            src_addr, n_src = _addr(src), src.shape[0]
+            src = _args.source_records(sources)
+            src_addr, n_src = _args.addr(src), src.shape[0]
         opts = None
-        radius = _exact_start(exact_start)
+        radius = _args.exact_start_radius(exact_start)
         if (cost is not None or max_distance is not None or targets is not None
                 or not unfolding or cost_location is not None or radius is not None):
             opts = _lib.mfmm_solve_options.from_buffer_copy(self._opts_template)
-            c, loc = _cost_array(cost, cost_location, self._nv, self._nf)
+            c, loc = _args.cost_array(cost, cost_location, self._nv, self._nf)
             if c is not None:
-                opts.cost = _addr(c)
+                opts.cost = _args.addr(c)
                 opts.cost_location = loc
             if max_distance is not None:
-                opts.max_distance = _max_distance(max_distance)
+                opts.max_distance = _args.max_distance(max_distance)
             if targets is not None:
-                t = _index_array(targets, "target")
+                t = _args.index_array(targets, "target")
                 if t.shape[0] == 0:
                     raise ValueError("targets must hold at least one vertex id (None: every vertex)")
-                opts.targets = _addr(t)
+                opts.targets = _args.addr(t)
                 opts.n_targets = t.shape[0]
             if not unfolding:
                 opts.unfolding = 0
@@ -722,7 +455,7 @@ class Mesh:
         mesh_ptr = self._enter()
         try:
             solver = self._take_solver(mesh_ptr)
-            status = _lib.mfmm_solve(solver, src_addr, n_src, opts, _addr(out), byref(err))
+            status = _lib.mfmm_solve(solver, src_addr, n_src, opts, _args.addr(out), byref(err))
         finally:
             if solver is not None:
                 self._solvers.append(solver)
@@ -732,11 +465,11 @@ class Mesh:
         return out
 
     def _distance_exact(self, sources: SourceLike, max_distance: Optional[float]) -> np.ndarray:
-        src = _source_records(sources)
+        src = _args.source_records(sources)
         opts = _lib.mfmm_exact_options()
         _lib.mfmm_exact_options_init(byref(opts))
         if max_distance is not None:
-            opts.max_distance = _max_distance(max_distance)
+            opts.max_distance = _args.max_distance(max_distance)
         out = np.empty(self._nv, dtype=np.float64)
         err = _lib.mfmm_error()
         info = _lib.mfmm_exact_info()
@@ -753,9 +486,9 @@ class Mesh:
                 ptr = ctypes.c_void_p()
                 _lib.check(_lib.mfmm_exact_solver_create(mesh_ptr, byref(ptr)))
                 solver = ptr.value
-            with _sigint_as_flag(interrupted):
-                status = _lib.mfmm_solve_exact(solver, _addr(src), src.shape[0], byref(opts),
-                                               _addr(out), byref(info), byref(err))
+            with sigint_as_flag(interrupted):
+                status = _lib.mfmm_solve_exact(solver, _args.addr(src), src.shape[0], byref(opts),
+                                               _args.addr(out), byref(info), byref(err))
         finally:
             if solver is not None:
                 self._exact_solvers.append(solver)
@@ -804,20 +537,20 @@ class Mesh:
         d = np.ascontiguousarray(distances, dtype=np.float64)
         if d.shape != (self._nv,):
             raise ValueError(f"distances must have shape ({self._nv},), got {d.shape}")
-        tgt = _target_record(target)
+        tgt = _args.target_record(target)
         opts = _lib.mfmm_path_options()
         _lib.mfmm_path_options_init(byref(opts))
         if max_points is not None:
-            opts.max_points = _as_index(max_points, "max_points")
-        opts.straighten = 1 if _flag(straighten, "straighten") else 0
+            opts.max_points = _args.index(max_points, "max_points")
+        opts.straighten = 1 if _args.flag(straighten, "straighten") else 0
         src = None
         if sources is not None:
-            src = _source_records(sources)
-            opts.sources = _addr(src)
+            src = _args.source_records(sources)
+            opts.sources = _args.addr(src)
             opts.n_sources = src.shape[0]
-        c, loc = _cost_array(cost, cost_location, self._nv, self._nf)
+        c, loc = _args.cost_array(cost, cost_location, self._nv, self._nf)
         if c is not None:
-            opts.cost = _addr(c)
+            opts.cost = _args.addr(c)
             opts.cost_location = loc
         capacity = 1024
         n = ctypes.c_int32(0)
@@ -830,7 +563,7 @@ class Mesh:
             while True:
                 buf = np.empty(capacity, dtype=_lib.SURFACE_POINT_DTYPE)
                 status = _lib.mfmm_trace_path(
-                    mesh_ptr, _addr(d), byref(tgt), byref(opts), _addr(buf), capacity,
+                    mesh_ptr, _args.addr(d), byref(tgt), byref(opts), _args.addr(buf), capacity,
                     byref(n), byref(length), byref(err),
                 )
                 if status == _lib.MFMM_ERR_BAD_COUNT and n.value > capacity:
@@ -868,234 +601,138 @@ class Mesh:
         targets: Any = None,
         sparse: bool = False,
         symmetric: bool = False,
+        return_info: bool = False,
     ) -> Any:
-        """Distances from many vertex sources: row i holds the distances from
-        ``sources[i]`` to every vertex (equal to :meth:`distance`'s), or to
-        ``targets``.
+        """Distances from many vertex sources, one row per source.
 
-        sources: vertex ids; None for all vertices in order (an N x N matrix).
-        backend: "auto" (OpenCL on a usable device that is not a CPU, or
-            that MESHFMM_OPENCL_DEVICE names; else threads, which run the same
-            rows faster on a CPU),
-            "opencl", "threads" or "serial". The backend that ran is stored in
-            :attr:`backend_used`.
-        dtype: "float32" or "float64" output (arithmetic is always float64).
-        out: a preallocated C-contiguous writable array (a numpy.memmap
-            works) of shape (len(sources) or n_vertices, n_vertices) and the
-            given dtype, written in place and returned; None allocates one.
-        max_distance, cost, cost_location, unfolding, exact_start: as in
-            :meth:`distance` (every backend starts each row alike; OpenCL rows
-            still equal the serial rows bit for bit).
-        n_threads: threads for the threads backend, 0 for all cores.
-        memory_limit: bytes the library may use for blocks in flight (0: default).
-        progress: called as ``progress(rows_done, n_rows)`` as blocks of rows
-            finish; an exception it raises (or Ctrl-C) stops the computation
-            and propagates.
-        targets: vertex ids (T of them, any order, duplicates allowed): the
-            result is len(sources) x T, column j the distance to
-            ``targets[j]``, and each row's march stops once all its targets
-            are settled (landmark matrices cost far less than full rows).
-            None: every vertex. Every backend, OpenCL included.
-        sparse: return a ``scipy.sparse.csr_matrix`` of the finite entries
-            only (with ``max_distance=r``: the pairs within r; the diagonal
-            holds explicit zeros), sorted column ids; memory O(nnz), never
-            S x N. Needs max_distance (a sparse full matrix is dense). Not on
-            OpenCL ("auto" runs threads); ``out`` must be None.
-        symmetric: for a square result (sources None, or sources equal to
-            targets) return (D + D^T) / 2, symmetrised in place (no copy of
-            D); dense only.
+        Row i holds the distances from ``sources[i]`` to every vertex (equal
+        to :meth:`distance`'s), or to ``targets``.
 
-        After the call, :attr:`vertices_settled` holds the vertices the
-        marches settled in all (the work done; 0 from OpenCL).
+        Parameters
+        ----------
+        sources : array_like of int, shape (S,), optional
+            Vertex ids; None (default) for every vertex in order (an N x N
+            matrix).
+        backend : {"auto", "opencl", "threads", "serial"}
+            "auto" runs OpenCL on a usable device that is not a CPU (or that
+            ``MESHFMM_OPENCL_DEVICE`` names), else threads, which run the
+            same rows faster on a CPU. ``return_info=True`` tells which ran.
+        dtype : {"float32", "float64"}
+            Output dtype; the arithmetic is float64 either way.
+        out : numpy.ndarray, shape (S, N) or (S, T), optional
+            A preallocated C-contiguous writable array (a ``numpy.memmap``
+            works) of the given dtype, written in place and returned; None
+            allocates one.
+        max_distance, cost, cost_location, unfolding, exact_start
+            As in :meth:`distance`. Every backend starts each row alike;
+            OpenCL rows equal the serial rows bit for bit.
+        n_threads : int
+            Threads of the threads backend; 0 for all cores.
+        memory_limit : int
+            Bytes the library may use for blocks in flight; 0 for its default.
+        progress : callable, optional
+            Called as ``progress(rows_done, n_rows)`` as blocks of rows
+            finish. An exception it raises (or Ctrl-C) stops the job and
+            propagates.
+        targets : array_like of int, shape (T,), optional
+            Vertex ids in any order, duplicates allowed: the result is S x T,
+            column j the distance to ``targets[j]``, and each row's march
+            stops once its targets are settled (landmark matrices cost far
+            less than full rows). None: every vertex. Every backend.
+        sparse : bool
+            Return a ``scipy.sparse.csr_matrix`` of the finite entries only
+            (with ``max_distance=r``: the pairs within r; the diagonal holds
+            explicit zeros), column ids sorted; memory O(nnz), never S x N.
+            Needs a finite max_distance. Not on OpenCL ("auto" runs threads);
+            ``out`` must be None.
+        symmetric : bool
+            For a square result (sources None, or equal to targets) return
+            (D + D^T) / 2, symmetrised in place without a copy. Dense only.
+        return_info : bool
+            Also return the call's :class:`MatrixInfo`.
 
-        Raises OpenCLError when backend="opencl" cannot run, ValueError for
-        bad arguments.
+        Returns
+        -------
+        D : numpy.ndarray of dtype, shape (S, N) or (S, T), or scipy.sparse.csr_matrix
+            The distances; unreached entries are +inf (dense) or absent
+            (sparse). ``out`` itself when given.
+        info : MatrixInfo
+            Only with ``return_info=True``: the backend that ran, why "auto"
+            fell back, the vertices settled and the exact start's fallbacks.
+
+        Raises
+        ------
+        OpenCLError
+            ``backend="opencl"`` cannot run.
+        ValueError, TypeError
+            Bad arguments (ids out of range, a wrong ``out``, ``sparse``
+            without a finite max_distance, ``symmetric`` on a non-square
+            result, ...).
+        KeyboardInterrupt
+            Ctrl-C, after the library stopped at the next block of rows.
         """
-        if sources is None:
-            src = None
-            n_rows = self._nv
-        else:
-            src = _index_array(sources, "source")
-            n_rows = src.shape[0]
-            if n_rows == 0:
-                raise ValueError("at least one source is needed")
-        dt = np.dtype(dtype)
-        if dt == np.float32:
-            cdt = _lib.MFMM_FLOAT32
-        elif dt == np.float64:
-            cdt = _lib.MFMM_FLOAT64
-        else:
-            raise ValueError(f"dtype must be float32 or float64, got {dt}")
-        if not isinstance(backend, str) or backend.lower() not in _lib.BACKENDS:
-            raise ValueError(f"backend must be one of {sorted(_lib.BACKENDS)}, got {backend!r}")
-        unfolding = _flag(unfolding, "unfolding")
-        sparse = _flag(sparse, "sparse")
-        symmetric = _flag(symmetric, "symmetric")
-        tgt = None
-        if targets is not None:
-            tgt = _index_array(targets, "target")
-            if tgt.shape[0] == 0:
-                raise ValueError("targets must hold at least one vertex id (None: every vertex)")
-            if int(tgt.min()) < 0 or int(tgt.max()) >= self._nv:
-                raise ValueError(f"target ids must lie in [0, {self._nv})")
-        width = self._nv if tgt is None else tgt.shape[0]
-        if symmetric:
-            if sparse:
-                raise ValueError("symmetric=True is for dense results")
-            square = (src is None and (tgt is None or np.array_equal(tgt, np.arange(self._nv)))) or (
-                src is not None
-                and np.array_equal(src, tgt if tgt is not None else np.arange(self._nv))
-            )
-            if not square:
-                raise ValueError(
-                    "symmetric=True needs a square result: sources None or equal to targets"
-                )
-        if sparse:
-            if out is not None:
-                raise ValueError("out is for dense results; sparse=True returns a csr_matrix")
-            if max_distance is None or not np.isfinite(float(max_distance)):
-                raise ValueError("sparse=True needs a finite max_distance (else every entry is stored)")
-            out = np.empty((0, 0), dtype=dt)  # no dense buffer
-        shape = (n_rows, width)
-        if sparse:
-            pass
-        elif out is None:
-            out = np.empty(shape, dtype=dt)
-        else:
-            if not isinstance(out, np.ndarray):
-                raise TypeError(f"out must be a numpy array or memmap, got {type(out).__name__}")
-            if out.shape != shape:
-                raise ValueError(f"out must have shape {shape}, got {out.shape}")
-            if out.dtype != dt:
-                raise ValueError(f"out must have dtype {dt}, got {out.dtype}")
-            if not out.flags.c_contiguous:
-                raise ValueError("out must be C-contiguous")
-            if not out.flags.writeable:
-                raise ValueError("out must be writable")
-        opts = _lib.mfmm_matrix_options()
-        _lib.mfmm_matrix_options_init(byref(opts))
-        opts.backend = _lib.BACKENDS[backend.lower()]
-        opts.dtype = cdt
-        c, loc = _cost_array(cost, cost_location, self._nv, self._nf)
-        # The library writes rows into `out` while it still reads the sources
-        # and the cost: an input that shares memory with `out` (a view of
-        # it) would be overwritten mid-job (wrong rows, or vertex ids that
-        # are garbage). Such inputs are copied first.
-        if src is not None and np.may_share_memory(src, out):
-            src = src.copy()
-        if c is not None and np.may_share_memory(c, out):
-            c = c.copy()
-        if c is not None:
-            opts.cost = _addr(c)
-            opts.cost_location = loc
-        if max_distance is not None:
-            opts.max_distance = _max_distance(max_distance)
-        opts.unfolding = 1 if unfolding else 0
-        radius = _exact_start(exact_start)
-        if radius is not None:
-            opts.exact_start_radius = radius
-        opts.n_threads = _as_index(n_threads, "n_threads")
-        opts.memory_limit = _size(memory_limit, "memory_limit")
-        opts.out = _addr(out) if out.size else None
-        if tgt is not None:
-            opts.targets = _addr(tgt)
-            opts.n_targets = tgt.shape[0]
-        if opts.backend == _lib.BACKENDS["auto"] and sparse:
-            pass  # the library runs threads (OpenCL does dense rows only)
-        elif opts.backend in (_lib.BACKENDS["auto"], _lib.BACKENDS["opencl"]):
-            opts.opencl = _shared_opencl_context()
-
-        caught: List[BaseException] = []
-        interrupted: List[int] = []
-
-        def on_rows(user: Any, first: int, n: int, rows: Any) -> int:
-            # Returns the cancel code instead of raising: an exception escaping
-            # a ctypes callback is printed ("Exception ignored on calling
-            # ctypes callback function") and the job goes on.
-            try:
-                if interrupted:
-                    return 1
-                if progress is not None:
-                    progress(first + n, n_rows)
-                return 0
-            except BaseException as exc:  # KeyboardInterrupt too: stop the library
-                caught.append(exc)
-                return 1
-
-        pieces: List[Any] = []
-
-        def on_sparse(user: Any, first: int, n: int, indptr: Any, indices: Any, values: Any) -> int:
-            try:
-                if interrupted:
-                    return 1
-                ip = np.ctypeslib.as_array(ctypes.cast(indptr, ctypes.POINTER(ctypes.c_int64)), (n + 1,))
-                nnz = int(ip[n])
-                if nnz:
-                    ix = np.ctypeslib.as_array(
-                        ctypes.cast(indices, ctypes.POINTER(ctypes.c_int32)), (nnz,)
-                    ).copy()
-                    ctype = ctypes.c_double if dt == np.float64 else ctypes.c_float
-                    vals = np.ctypeslib.as_array(ctypes.cast(values, ctypes.POINTER(ctype)), (nnz,)).copy()
-                else:
-                    ix = np.empty(0, np.int32)
-                    vals = np.empty(0, dt)
-                pieces.append((ip.copy(), ix, vals))
-                if progress is not None:
-                    progress(first + n, n_rows)
-                return 0
-            except BaseException as exc:
-                caught.append(exc)
-                return 1
-
-        if sparse:
-            callback = _lib.mfmm_sparse_callback(on_sparse)
-            opts.on_sparse = callback
-        else:
-            callback = _lib.mfmm_rows_callback(on_rows)
-            opts.on_rows = callback
-        err = _lib.mfmm_error()
-        mesh_ptr = self._enter()
-        try:
-            with _sigint_as_flag(interrupted):
-                status = _lib.mfmm_distance_matrix(
-                    mesh_ptr, None if src is None else _addr(src), n_rows, byref(opts), byref(err)
-                )
-        finally:
-            self._leave()
-        if caught:
-            raise caught[0]
-        if interrupted:
-            raise KeyboardInterrupt
-        _lib.check(status, err)
-        name = _lib.mfmm_backend_name(opts.backend_used)
-        self.backend_used = name.decode("ascii") if name else None
-        self.fallback_reason = opts.fallback_reason.decode("utf-8", "replace")
-        self.vertices_settled = int(opts.vertices_settled)
-        if sparse:
-            return _csr_from_pieces(pieces, (n_rows, width), dt)
-        if symmetric:
-            _symmetrize_in_place(out)
-        return out
+        req = _rows.Request(self, sources, backend, dtype, targets)
+        unfolding = _args.flag(unfolding, "unfolding")
+        sparse = _args.flag(sparse, "sparse")
+        symmetric = _args.flag(symmetric, "symmetric")
+        return_info = _args.flag(return_info, "return_info")
+        req.check_targets(self._nv)
+        path = _sparse.sparse_matrix if sparse else _dense.dense_matrix
+        result, info = path(self, req, out, symmetric=symmetric, progress=progress,
+                            cost=cost, cost_location=cost_location, max_distance=max_distance,
+                            unfolding=unfolding, exact_start=exact_start, n_threads=n_threads,
+                            memory_limit=memory_limit)
+        return (result, info) if return_info else result
 
     def iter_distance_rows(
         self, sources: Any = None, block_rows: int = 256, **kwargs: Any
-    ) -> Iterator[Tuple[int, np.ndarray]]:
-        """Yields ``(first_row, block)``: dense blocks of at most ``block_rows``
-        rows of :meth:`distance_matrix` (same keyword options: backend, dtype,
-        targets, max_distance, cost, ...), in order, without the whole matrix
-        in memory, for writing into h5py, Zarr or a database. ``progress`` is
-        called as ``progress(rows_done, n_rows)`` over the whole job. Each
-        block is one library call; closing the generator early (``break``)
-        computes no further block."""
+    ) -> Iterator[Tuple[Any, ...]]:
+        """Dense blocks of rows of :meth:`distance_matrix`, in order, without
+        the whole matrix in memory (for writing into h5py, Zarr or a
+        database).
+
+        Each block is one library call; closing the generator early
+        (``break``) computes no further block.
+
+        Parameters
+        ----------
+        sources : array_like of int, shape (S,), optional
+            Vertex ids; None for every vertex in order.
+        block_rows : int
+            Most rows per block, >= 1.
+        **kwargs
+            :meth:`distance_matrix`'s keyword options (backend, dtype,
+            targets, max_distance, cost, ...) except ``sparse``,
+            ``symmetric`` and ``out``. ``progress`` is called as
+            ``progress(rows_done, S)`` over the whole job;
+            ``return_info=True`` adds each block's :class:`MatrixInfo`.
+
+        Yields
+        ------
+        first_row : int
+            Index of the block's first row.
+        block : numpy.ndarray of dtype, shape (at most block_rows, N or T)
+            The block's rows.
+        info : MatrixInfo
+            Only with ``return_info=True``: the block's call.
+
+        Raises
+        ------
+        ValueError, TypeError
+            As :meth:`distance_matrix`, and for ``sparse``, ``symmetric``,
+            ``out`` or ``block_rows < 1``.
+        """
         if kwargs.get("sparse") or kwargs.get("symmetric") or kwargs.get("out") is not None:
             raise ValueError("iter_distance_rows yields dense blocks: no sparse, symmetric or out")
         if block_rows < 1:
             raise ValueError("block_rows must be >= 1")
-        src = np.arange(self._nv, dtype=np.int32) if sources is None else _index_array(sources, "source")
+        src = (np.arange(self._nv, dtype=np.int32) if sources is None
+               else _args.index_array(sources, "source"))
         n_rows = src.shape[0]
         if n_rows == 0:
             raise ValueError("at least one source is needed")
         progress = kwargs.pop("progress", None)
+        with_info = _args.flag(kwargs.pop("return_info", False), "return_info")
         for first in range(0, n_rows, block_rows):
             part = src[first : first + block_rows]
 
@@ -1104,75 +741,8 @@ class Mesh:
                     return progress(first + done, n_rows)
                 return None
 
-            block = self.distance_matrix(part, progress=prog, **kwargs)
-            yield first, block
-
-
-def _csr_from_pieces(pieces: List[Any], shape: Tuple[int, int], dt: Any) -> Any:
-    """Joins the library's CSR blocks into one scipy.sparse.csr_matrix."""
-    import scipy.sparse
-
-    nnz = sum(int(p[0][-1]) for p in pieces)
-    idx_dt = np.int32 if nnz < 2**31 else np.int64
-    indptr = np.zeros(shape[0] + 1, dtype=idx_dt)
-    indices = np.empty(nnz, dtype=np.int32)
-    data = np.empty(nnz, dtype=dt)
-    row = 0
-    k = 0
-    for ip, ix, vals in pieces:
-        n = ip.shape[0] - 1
-        m = int(ip[-1])
-        indptr[row + 1 : row + n + 1] = ip[1:] + k
-        indices[k : k + m] = ix
-        data[k : k + m] = vals
-        row += n
-        k += m
-    return scipy.sparse.csr_matrix((data, indices, indptr), shape=shape)
-
-
-def _symmetrize_in_place(d: np.ndarray, tile: int = 256) -> None:
-    """d <- (d + d^T) / 2 for a square array, tile by tile (O(tile^2) extra
-    memory). Each pair (i, j), (j, i) gets the same value, (a + b) / 2 in
-    the array's dtype."""
-    n = d.shape[0]
-    for i0 in range(0, n, tile):
-        i1 = min(i0 + tile, n)
-        for j0 in range(i0, n, tile):
-            j1 = min(j0 + tile, n)
-            a = d[i0:i1, j0:j1]
-            m = (a + d[j0:j1, i0:i1].T) / 2
-            d[i0:i1, j0:j1] = m
-            d[j0:j1, i0:i1] = m.T
-
-
-@contextlib.contextmanager
-def _sigint_as_flag(flag: List[int]) -> Iterator[None]:
-    """While a long C call runs on the main thread, Ctrl-C appends to `flag`
-    instead of raising KeyboardInterrupt inside a ctypes callback (where
-    Python can only print it and go on); the row callback then returns the
-    cancel code and the caller raises one KeyboardInterrupt after the call.
-    Leaves a handler other than Python's default one alone, and does nothing
-    off the main thread (signals are only handled there)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    try:
-        previous = signal.getsignal(signal.SIGINT)
-    except (ValueError, OSError):  # pragma: no cover
-        yield
-        return
-    if previous is not signal.default_int_handler:
-        yield
-        return
-
-    def handler(signum: int, frame: Any) -> None:
-        flag.append(signum)
-
-    signal.signal(signal.SIGINT, handler)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
+            block, info = self.distance_matrix(part, progress=prog, return_info=True, **kwargs)
+            yield (first, block, info) if with_info else (first, block)
 
 
 def _free(ptr: Optional[int], solvers: List[int], exact: List[int]) -> None:
@@ -1188,41 +758,6 @@ def _free(ptr: Optional[int], solvers: List[int], exact: List[int]) -> None:
 def _rebuild_mesh(cls: type, V: np.ndarray, F: np.ndarray, options: dict) -> Mesh:
     """Unpickling and copying: a new, independent C mesh from V, F, options."""
     return cls(V, F, **options)
-
-
-_opencl_lock = threading.Lock()
-_opencl_context: Optional[ctypes.c_void_p] = None
-
-
-def _shared_opencl_context() -> Optional[ctypes.c_void_p]:
-    """The process's OpenCL context (device and built program), made on first
-    use and reused by every distance_matrix call, so the kernel is built once
-    per process (the C library itself keeps no global state). None when no
-    device works: the library then reports why, or falls back under "auto"."""
-    global _opencl_context
-    with _opencl_lock:
-        if _opencl_context is None:
-            ptr = ctypes.c_void_p()
-            err = _lib.mfmm_error()
-            if _lib.mfmm_opencl_context_create(None, byref(ptr), byref(err)) != 0 or not ptr:
-                return None
-            _opencl_context = ptr
-            atexit.register(_lib.mfmm_opencl_context_destroy, ptr)
-        return _opencl_context
-
-
-def _index_array(x: Any, what: str) -> np.ndarray:
-    a = np.asarray(x)
-    if a.ndim == 0:
-        a = a.reshape(1)
-    if a.size and a.dtype.kind not in "iu":
-        raise TypeError(f"{what}s must be integer vertex ids, got dtype {a.dtype}")
-    if a.ndim != 1:
-        raise ValueError(f"{what}s must be 1-D, got shape {a.shape}")
-    if a.size and (a.min() < _I32_MIN or a.max() > _I32_MAX):
-        bad = a[(a < _I32_MIN) | (a > _I32_MAX)][0]
-        raise ValueError(f"{what} {bad} is out of range (not a 32-bit index)")
-    return np.ascontiguousarray(a, dtype=np.int32)
 
 
 def load_mesh(path: Union[str, "os.PathLike[str]"]) -> Tuple[np.ndarray, np.ndarray]:
@@ -1247,9 +782,9 @@ def load_mesh(path: Union[str, "os.PathLike[str]"]) -> Tuple[np.ndarray, np.ndar
         V = np.empty((nv.value, 3), dtype=np.float64)
         F = np.empty((nf.value, 3), dtype=np.int32)
         if V.size:
-            ctypes.memmove(_addr(V), vp.value, V.nbytes)
+            ctypes.memmove(_args.addr(V), vp.value, V.nbytes)
         if F.size:
-            ctypes.memmove(_addr(F), fp.value, F.nbytes)
+            ctypes.memmove(_args.addr(F), fp.value, F.nbytes)
     finally:
         _lib.mfmm_free(vp)
         _lib.mfmm_free(fp)

@@ -54,7 +54,8 @@ import numpy as np
 
 from . import __version__
 from . import _lib
-from ._mesh import Mesh, _as_index, _cost_array, _exact_start, _is_int, _max_distance
+from . import _args
+from ._mesh import Mesh, load_mesh
 
 __all__ = ["distance_matrix", "job_description", "complete_blocks", "symmetrize", "DASK_CONFIG",
            "StoreError", "StoreOwnerError"]
@@ -120,17 +121,6 @@ def _sha256(*arrays: Optional[np.ndarray]) -> Optional[str]:
         h.update(str(a.dtype).encode() + str(a.shape).encode())
         h.update(a.tobytes())
     return h.hexdigest()
-
-
-def _ids(x: Any, what: str, n: int) -> np.ndarray:
-    a = np.asarray(x)
-    if a.ndim != 1 or a.size == 0:
-        raise ValueError(f"{what} must be a non-empty 1-D sequence of vertex ids")
-    if not np.issubdtype(a.dtype, np.integer):
-        raise TypeError(f"{what} must be integers, not {a.dtype}")
-    if a.min() < 0 or a.max() >= n:
-        raise ValueError(f"{what} must be vertex ids in [0, {n}); got {a.min()}..{a.max()}")
-    return a.astype(np.int32)
 
 
 def job_description(mesh: Mesh, sources: Optional[np.ndarray], targets: Optional[np.ndarray],
@@ -239,7 +229,7 @@ def _owner_record(token: str) -> Dict[str, Any]:
 
 
 def _pid_alive(pid: Any, started: Any) -> bool:
-    if not _is_int(pid) or pid <= 0:
+    if not _args.is_int(pid) or pid <= 0:
         return False
     try:
         import psutil
@@ -690,25 +680,25 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
     if not isinstance(mesh, Mesh):
         raise TypeError(f"mesh must be a meshfmm.Mesh, not {type(mesh).__name__}")
     nv = mesh.n_vertices
-    src = None if sources is None else _ids(sources, "sources", nv)
-    tgt = None if targets is None else _ids(targets, "targets", nv)
+    src = None if sources is None else _args.vertex_ids(sources, "sources", nv)
+    tgt = None if targets is None else _args.vertex_ids(targets, "targets", nv)
     dt = np.dtype(dtype)
     if dt not in (np.float32, np.float64):
         raise ValueError(f"dtype must be float32 or float64, not {dtype}")
     if max_distance is not None:
-        _max_distance(max_distance)  # TypeError or ValueError, as Mesh.distance
+        _args.max_distance(max_distance)  # TypeError or ValueError, as Mesh.distance
     cost_arr = None
     if cost is not None:
-        cost_arr, _ = _cost_array(cost, cost_location, nv, mesh.n_faces)
-    radius = _start_radius(_exact_start(exact_start))
+        cost_arr, _ = _args.cost_array(cost, cost_location, nv, mesh.n_faces)
+    radius = _start_radius(_args.exact_start_radius(exact_start))
     if compression not in _CODECS:
         raise ValueError(f"compression must be one of {', '.join(map(repr, _CODECS))}, "
                          f"not {compression!r}")
     if backend not in ("auto", "threads", "serial", "opencl"):
         raise ValueError(f"backend must be auto, threads, serial or opencl, not {backend!r}")
-    if not _is_int(retries) or retries < 0:
+    if not _args.is_int(retries) or retries < 0:
         raise ValueError(f"retries must be an integer >= 0, not {retries!r}")
-    if block_rows is not None and (not _is_int(block_rows) or block_rows < 1):
+    if block_rows is not None and (not _args.is_int(block_rows) or block_rows < 1):
         raise ValueError(f"block_rows must be an integer >= 1, not {block_rows!r}")
     # Every option a task hands the library, checked here before the store is
     # touched (resume=False overwrites it): one row marched to radius 0 with
@@ -718,7 +708,7 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
     mesh.distance_matrix(src[:1] if src is not None else [0], targets=tgt, backend="serial",
                          dtype=dt.name, max_distance=0.0, cost=cost_arr,
                          cost_location=cost_location, unfolding=unfolding,
-                         exact_start=exact_start, n_threads=_as_index(n_threads, "n_threads"))
+                         exact_start=exact_start, n_threads=_args.index(n_threads, "n_threads"))
     url, storage_options = _open_store(store, storage_options)
     n_rows = nv if src is None else src.shape[0]
     n_cols = nv if tgt is None else tgt.shape[0]
