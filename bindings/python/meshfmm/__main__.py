@@ -44,10 +44,10 @@ def _output(args: List[str]) -> Optional[str]:
 
 
 def _allpairs_zarr(args: List[str]) -> int:
-    """`meshfmm allpairs MESH -o OUT.zarr`: the Dask + Zarr job (DESIGN.md),
-    run by meshfmm.distributed."""
+    """`meshfmm allpairs MESH -o OUT.zarr`: the Dask + Zarr job of
+    meshfmm.distributed, run by its command line (meshfmm._zarr_cli)."""
     try:
-        from .distributed import cli_allpairs_zarr
+        from ._zarr_cli import cli_allpairs_zarr
         import distributed  # noqa: F401
         import zarr  # noqa: F401
     except ImportError as e:
