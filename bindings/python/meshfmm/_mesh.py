@@ -30,41 +30,52 @@ __all__ = ["Mesh", "MeshInfo", "SurfacePoint", "GeodesicPath", "MatrixInfo", "lo
 class Mesh:
     """An immutable triangle mesh, validated and preprocessed by the C core.
 
-    ``Mesh(V, F)``: ``V`` anything numpy turns into float64 ``(n, 3)``
-    (lists, float32, Fortran order, strided views), ``F`` anything numpy
-    turns into integer ``(m, 3)`` (0-based vertex ids; int64 accepted when the
-    values fit). Both are copied. ``max_unfold_steps`` bounds the unfolding
-    walk that finds the virtual edge of an obtuse corner (default 64).
-    ``spokes=False`` puts memory first: the march then never builds its
-    per-vertex update records (about 380 bytes per vertex, built on the
-    first solve and kept with the mesh) and walks the faces instead, with
-    the same results bit for bit and a march about 1.25x as long.
+    ``Mesh(V, F)`` builds it from arrays; ``Mesh(obj)`` from any object with
+    ``.vertices`` and ``.faces`` (a ``trimesh.Trimesh``, for one);
+    :meth:`from_file` reads a file. V and F are copied.
 
-    ``Mesh(obj)``: any object with ``.vertices`` and ``.faces`` (a
-    ``trimesh.Trimesh``, for one). ``Mesh.from_file(path)`` reads a file.
-
-    Raises :class:`meshfmm.MeshError` (a ValueError) with the reason for wrong
-    shapes, NaN or infinite coordinates, face indices out of range or a face
-    that repeats a vertex. Boundaries, several components, unreferenced
-    vertices, non-manifold edges and degenerate faces are accepted; copies of
-    a face (its vertices again, in any order) are counted in ``info`` and
-    stand aside, so that they make no edge non-manifold. A T-junction closed
-    by a zero-area needle face is closed inside (the faces across the needle,
-    every page of a non-manifold edge, split at its middle vertex), so
-    distances and paths cross it; face ids,
-    per-face costs and points stay the ones given (README, "Imperfect
-    meshes").
+    Boundaries, several components, unreferenced vertices, non-manifold
+    edges and degenerate faces are accepted. Copies of a face (its vertices
+    again, in any order) are counted in :attr:`info` and stand aside, so
+    that they make no edge non-manifold. A T-junction closed by a zero-area
+    needle face is closed inside (the faces across the needle split at its
+    middle vertex), so distances and paths cross it; face ids, per-face
+    costs and points stay the ones given (docs/imperfect-meshes.md).
 
     A Mesh may be used from several threads at once: each concurrent call
-    gets its own solver workspace, and the C calls release the GIL. Free it
+    gets its own solver workspace, the C calls release the GIL, and every
+    result (a :class:`MatrixInfo` included) belongs to its call. Free it
     early with :meth:`close` or a ``with`` block; otherwise it is freed when
-    garbage-collected. :meth:`close` may be called while other threads
-    compute: it refuses new calls at once (ValueError), waits for the calls
-    in flight to end, then frees the C memory.
-
-    Copies are independent: ``copy.copy``, ``copy.deepcopy`` and pickling
+    garbage-collected. Copies (``copy.copy``, ``copy.deepcopy``, pickling)
     rebuild the C mesh from ``vertices``, ``faces`` and the options, so
-    closing one copy leaves the others working.
+    closing one leaves the others working.
+
+    Parameters
+    ----------
+    V : array_like, shape (n, 3)
+        Vertex coordinates; anything numpy turns into float64 (lists,
+        float32, Fortran order, strided views). Or an object with
+        ``.vertices`` and ``.faces`` when F is None.
+    F : array_like of int, shape (m, 3), optional
+        Faces as 0-based vertex ids; any integer dtype whose values fit
+        int32.
+    max_unfold_steps : int, optional
+        Bound of the unfolding walk that finds the virtual edge of an obtuse
+        corner (default 64).
+    spokes : bool
+        True (default): the march builds per-vertex update records (about
+        380 bytes per vertex, on the first solve, kept with the mesh).
+        False puts memory first: the march walks the faces instead, with the
+        same results bit for bit and a march about 1.25x as long.
+
+    Raises
+    ------
+    MeshError
+        (a ValueError) with the reason, for wrong shapes, NaN or infinite
+        coordinates, face indices out of range or a face that repeats a
+        vertex.
+    TypeError
+        ``Mesh(obj)`` with an object lacking ``.vertices`` or ``.faces``.
     """
 
     def __init__(self, V: Any, F: Any = None, *, max_unfold_steps: Optional[int] = None,
@@ -142,8 +153,28 @@ class Mesh:
 
     @classmethod
     def from_file(cls, path: Union[str, "os.PathLike[str]"], **kwargs: Any) -> "Mesh":
-        """Reads a mesh file with :func:`load_mesh` (OBJ, OFF, PLY, STL) and
-        builds a Mesh; keyword arguments go to the constructor."""
+        """Reads a mesh file and builds a Mesh.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            An OBJ, OFF, PLY (ascii or binary) or STL file, read by
+            :func:`load_mesh`.
+        **kwargs
+            The constructor's keyword options (``max_unfold_steps``,
+            ``spokes``).
+
+        Returns
+        -------
+        Mesh
+
+        Raises
+        ------
+        FileNotFoundError, OSError
+            The file cannot be read.
+        MeshError
+            The file is malformed or the mesh is refused.
+        """
         V, F = load_mesh(path)
         return cls(V, F, **kwargs)
 
@@ -172,26 +203,33 @@ class Mesh:
         """Frees the C mesh and its solver workspaces. Idempotent.
 
         The mesh is closed to new calls at once: from then on every method
-        that reaches the C library (:meth:`distance`, :meth:`distance_matrix`,
-        :meth:`geodesic_path`, :meth:`memory`, ...) raises
-        ``ValueError("the mesh is closed")``, from any thread. Calls that other
-        threads already have in flight run to the end with their normal
-        results; close() waits for them, then frees the memory and returns.
-        (The Python-side properties -- ``vertices``, ``faces``, ``info``,
-        ``n_vertices`` -- stay readable.)
-
-        timeout: None (default) waits as long as the calls in flight take;
-            a number of seconds >= 0 waits at most that long (0: not at all).
-            When calls are still in flight then, TimeoutError is raised and
-            the mesh stays closed to new calls; the last call in flight frees
-            the memory as it returns (a later close() waits for that, and
-            garbage collection frees whatever is left).
-
-        Raises RuntimeError, and changes nothing, when the calling thread
-        itself has a call on this mesh in flight (close() from a ``progress``
-        callback, for one): it would wait for itself. The call in flight then
-        goes on, and the mesh stays open. Safe to call from any thread, and
+        that reaches the C library (:meth:`distance`,
+        :meth:`distance_matrix`, :meth:`geodesic_path`, :meth:`memory`, ...)
+        raises ``ValueError("the mesh is closed")``, from any thread. Calls
+        other threads already have in flight run to the end with their
+        normal results; close() waits for them, then frees the memory. The
+        Python-side properties (``vertices``, ``faces``, ``info``,
+        ``n_vertices``) stay readable. Safe to call from any thread, and
         from several at once.
+
+        Parameters
+        ----------
+        timeout : float, optional
+            None (default) waits as long as the calls in flight take; a
+            number of seconds >= 0 waits at most that long (0: not at all).
+
+        Raises
+        ------
+        TimeoutError
+            Calls are still in flight after `timeout`. The mesh stays closed
+            to new calls and the last call in flight frees the memory as it
+            returns (a later close() waits for that).
+        RuntimeError
+            The calling thread itself has a call on this mesh in flight
+            (close() from a ``progress`` callback): it would wait for
+            itself. Nothing changes; the mesh stays open.
+        TypeError, ValueError
+            `timeout` is not a number, or is NaN or negative.
         """
         if timeout is not None:
             if isinstance(timeout, (bool, np.bool_)) or not isinstance(timeout, numbers.Real):
@@ -348,11 +386,23 @@ class Mesh:
         return self._info
 
     def memory(self) -> Dict[str, int]:
-        """The bytes the mesh holds, array by array (mfmm_mesh_memory), as an
-        ordered dict of name -> bytes; ``sum(mesh.memory().values())`` is the
-        total. "spokes (once built)" and "exact tables (once built)" are 0
-        until the first solve that builds them (then kept with the mesh);
-        solver workspaces are not counted. Raises ValueError on a closed mesh."""
+        """The bytes the mesh holds, array by array (``mfmm_mesh_memory``).
+
+        "spokes (once built)" and "exact tables (once built)" are 0 until
+        the first solve that builds them (then kept with the mesh); solver
+        workspaces are not counted.
+
+        Returns
+        -------
+        dict of str to int
+            Array name -> bytes, in the library's order;
+            ``sum(mesh.memory().values())`` is the total.
+
+        Raises
+        ------
+        ValueError
+            The mesh is closed.
+        """
         ptr = self._enter()
         try:
             n = _lib.mfmm_mesh_memory(ptr, None, None, 0)
@@ -385,33 +435,58 @@ class Mesh:
         method: str = "fmm",
         exact_start: Any = True,
     ) -> np.ndarray:
-        """Distance from the nearest source to every vertex, float64 (n_vertices,).
+        """Distance from the nearest source to every vertex.
 
-        sources: a vertex id, a :class:`SurfacePoint` (a point inside a face),
-            or a sequence mixing those (an integer array is read as vertex ids).
-        cost: the slowness F (``|grad T| = F``), per vertex (n_vertices,) or per
-            face (n_faces,), finite and > 0; None for plain geodesic distance.
-            Per face, F is constant on each face; per vertex, F is linear
-            along each edge and local path (trapezoid means). When the mesh has as many vertices as faces, ``cost_location``
-            ('vertex' or 'face') must say which.
-        max_distance: stop marching past it; vertices beyond are +inf.
-        targets: vertex ids; the march stops once all of them are settled
-            (then only settled vertices are final, the rest may be +inf).
-        unfolding: False uses plain stencils at obtuse corners (for comparison).
-        exact_start: True (default): the march starts from the exact
+        Parameters
+        ----------
+        sources : int, SurfacePoint, or sequence of those
+            A vertex id, a :class:`SurfacePoint` (a point inside a face), or
+            a sequence mixing those; an integer array is read as vertex ids.
+        cost : array_like of float, shape (n_vertices,) or (n_faces,), optional
+            The slowness F (``|grad T| = F``), finite and > 0; None for plain
+            geodesic distance. Per face, F is constant on each face; per
+            vertex, F is linear along each edge and local path (trapezoid
+            means).
+        max_distance : float, optional
+            Stop marching past it; vertices beyond are +inf.
+        targets : array_like of int, optional
+            Vertex ids; the march stops once all of them are settled (then
+            only settled vertices are final, the rest may be +inf).
+        unfolding : bool
+            False uses plain stencils at obtuse corners (for comparison).
+        cost_location : {"vertex", "face"}, optional
+            Where ``cost`` lives; needed only when the mesh has as many
+            vertices as faces.
+        method : {"fmm", "exact"}
+            "fmm" (default): the Fast Marching Method. "exact": exact
+            polyhedral geodesic distances by window propagation
+            (``mfmm_solve_exact``), without cost, targets, unfolding or
+            exact_start options.
+        exact_start : bool, "auto" or float
+            True or "auto" (default): the march starts from the exact
             distances of the vertices within 7 mean edge lengths of each
             source, times sqrt(n_vertices / 40000) on larger meshes when
-            max_distance is None (MFMM_EXACT_START_AUTO; about half the mean
-            error of the paper's start); a
-            number: that radius in mean edge lengths; False (or 0): the
-            paper's plain start. With a cost, it applies where the cost is
-            uniform around the source (else the plain start).
-        method: "fmm" (the Fast Marching Method, the default) or "exact":
-            exact polyhedral geodesic distances by window propagation
-            (mfmm_solve_exact; no cost, targets or unfolding options).
+            max_distance is None (``MFMM_EXACT_START_AUTO``; about half the
+            mean error of the paper's start). A number: that radius in mean
+            edge lengths. False (or 0): the paper's plain start. With a
+            cost, it applies where the cost is uniform around the source.
 
-        Unreached vertices (other components, beyond max_distance) are +inf.
-        Raises ValueError (bad source, barycentric coordinates, cost, ...).
+        Returns
+        -------
+        numpy.ndarray, float64, shape (n_vertices,)
+            The distances; unreached vertices (other components, beyond
+            max_distance) are +inf.
+
+        Raises
+        ------
+        ValueError
+            A bad source, barycentric coordinates, cost, radius or option
+            combination; the mesh is closed.
+        TypeError
+            An argument of the wrong type (a max_distance that is not a
+            number, a flag that is not a bool, ...).
+        KeyboardInterrupt
+            Ctrl-C during ``method="exact"``.
         """
         unfolding = _args.flag(unfolding, "unfolding")
         if method == "exact":
@@ -512,27 +587,45 @@ class Mesh:
         straighten: bool = True,
     ) -> GeodesicPath:
         """Backtracks from ``target`` along -grad T to the source (paper
-        section 5) and returns a :class:`GeodesicPath`.
+        section 5).
 
-        distances: (n_vertices,) from :meth:`distance`.
-        target: a vertex id or a :class:`SurfacePoint`.
-        sources: the sources ``distances`` came from; the path then ends
-            exactly at the nearest one. Without them it ends at a vertex
-            where T is 0 (a vertex source); where T stops decreasing above 0
-            (a face source, a source value > 0) it raises RuntimeError.
-        cost, cost_location: the cost ``distances`` was solved with.
-        max_points: most points the path may have (default: the library's).
-        straighten: True (default): the traced path is replaced by the
-            shortest polyline inside the strip of faces it crossed (unfolded,
-            funnel algorithm; rerouted around a vertex where that is shorter),
+        Parameters
+        ----------
+        distances : array_like of float, shape (n_vertices,)
+            Distances from :meth:`distance`.
+        target : int or SurfacePoint
+            Where the path starts: a vertex id or a point inside a face.
+        sources : int, SurfacePoint, or sequence of those, optional
+            The sources ``distances`` came from; the path then ends exactly
+            at the nearest one. Without them it ends at a vertex where T is
+            0 (a vertex source).
+        cost, cost_location : optional
+            The cost ``distances`` was solved with, as in :meth:`distance`.
+        max_points : int, optional
+            Most points the path may have (default: the library's).
+        straighten : bool
+            True (default): the traced path is replaced by the shortest
+            polyline inside the strip of faces it crossed (unfolded, funnel
+            algorithm; rerouted around a vertex where that is shorter),
             which removes the drift of the first-order T's gradient. With a
-            per-face cost only runs of equal cost are straightened (border
-            crossings stay); with a per-vertex cost nothing is. Never longer
-            than the traced path. False: the raw section-5 path.
+            per-face cost only runs of equal cost are straightened; with a
+            per-vertex cost nothing is. Never longer than the traced path.
+            False: the raw section-5 path.
 
-        Raises ValueError for an unreached (+inf) target, RuntimeError when
-        tracing stalls or cannot reach a source; it never returns a path
-        that ends elsewhere.
+        Returns
+        -------
+        GeodesicPath
+            From the target (point 0) to the source.
+
+        Raises
+        ------
+        ValueError
+            An unreached (+inf) target, distances of the wrong shape, a bad
+            target or source.
+        RuntimeError
+            Tracing stalls or cannot reach a source (without ``sources``,
+            where T stops decreasing above 0: a face source, a source value
+            > 0). It never returns a path that ends elsewhere.
         """
         d = np.ascontiguousarray(distances, dtype=np.float64)
         if d.shape != (self._nv,):
@@ -761,11 +854,28 @@ def _rebuild_mesh(cls: type, V: np.ndarray, F: np.ndarray, options: dict) -> Mes
 
 
 def load_mesh(path: Union[str, "os.PathLike[str]"]) -> Tuple[np.ndarray, np.ndarray]:
-    """Reads a triangle mesh file (OBJ, OFF, PLY ascii or binary) with the
-    library's readers and returns ``(V, F)``: float64 (nv, 3) and int32 (nf, 3).
+    """Reads a triangle mesh file with the library's readers.
 
-    Raises FileNotFoundError / OSError when the file cannot be read and
-    :class:`meshfmm.MeshError` when it is malformed."""
+    Parameters
+    ----------
+    path : str or os.PathLike
+        An OBJ, OFF, PLY (ascii or binary) or STL file (binary or ascii;
+        coincident vertices welded).
+
+    Returns
+    -------
+    V : numpy.ndarray, float64, shape (nv, 3)
+        Vertex coordinates.
+    F : numpy.ndarray, int32, shape (nf, 3)
+        Faces as 0-based vertex ids.
+
+    Raises
+    ------
+    FileNotFoundError, OSError
+        The file cannot be read.
+    MeshError
+        The file is malformed.
+    """
     fspath = os.fspath(path)
     if not os.path.exists(fspath):
         raise FileNotFoundError(errno.ENOENT, "no such mesh file", fspath)

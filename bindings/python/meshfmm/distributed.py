@@ -31,6 +31,9 @@ tree ``c/`` and ``meshfmm_blocks/``), never other files; a location that
 holds something else than a meshfmm store is refused unless
 ``overwrite=True``.
 
+From the command line: ``meshfmm allpairs MESH -o OUT.zarr [--workers N |
+--scheduler ADDRESS] [--resume] ...`` (``meshfmm allpairs --help``).
+
 Needs ``dask[distributed]`` and ``zarr>=3``.
 """
 
@@ -63,21 +66,13 @@ _BLOCK_BYTES = 8 << 20
 
 
 # Blosc (cname, clevel) per `compression`, always with bit shuffle: on real
-# meshes' rows (bench/bench_compression.py) lz4 + bit shuffle stores within
+# meshes' rows (bench/scale/bench_compression.py) lz4 + bit shuffle stores within
 # 0.5 % of zstd 3 + byte shuffle and encodes ~3x faster (the encoding is on
 # each task's critical path); zstd 3 + bit shuffle is ~2 % smaller again.
 _CODECS: Dict[str, Optional[Tuple[str, int]]] = {"lz4": ("lz4", 5), "zstd": ("zstd", 3),
                                                  "none": None}
 
 
-# Dask settings for long compute-bound tasks. Dask's defaults poll every
-# 10-500 ms (event-loop tick, memory and system monitors, GIL monitor,
-# statistical profiler) in the scheduler, every nanny and every worker: on a
-# 2-core LocalCluster that cost 5-9 % of the tasks' CPU, these ~2 %
-# (bench/bench_cluster.py). distance_matrix's own LocalCluster runs with them;
-# for a cluster of your own, start it inside dask.config.set(DASK_CONFIG), or
-# give `dask scheduler` / `dask worker` the same as DASK_* variables
-# (DASK_DISTRIBUTED__ADMIN__TICK__INTERVAL=1s, ...).
 DASK_CONFIG: Dict[str, Any] = {
     "distributed.admin.tick.interval": "1s",
     "distributed.admin.system-monitor.interval": "2s",
@@ -85,6 +80,17 @@ DASK_CONFIG: Dict[str, Any] = {
     "distributed.worker.memory.monitor-interval": "1s",
     "distributed.worker.profile.enabled": False,
 }
+"""Dask settings for long compute-bound tasks.
+
+Dask's defaults poll every 10-500 ms (event-loop tick, memory and system
+monitors, GIL monitor, statistical profiler) in the scheduler, every nanny
+and every worker: on a 2-core LocalCluster that cost 5-9 % of the tasks'
+CPU, these settings about 2 % (bench/scale/bench_cluster.py).
+:func:`distance_matrix`'s own LocalCluster runs with them; for a cluster of
+your own, start it inside ``dask.config.set(DASK_CONFIG)``, or give
+``dask scheduler`` / ``dask worker`` the same as ``DASK_*`` variables
+(``DASK_DISTRIBUTED__ADMIN__TICK__INTERVAL=1s``, ...).
+"""
 
 
 def _default_block_rows(n_rows: int, row_bytes: int, dask_threads: int) -> int:
@@ -114,12 +120,41 @@ def job_description(mesh: Mesh, sources: Optional[np.ndarray], targets: Optional
                     dtype: str, max_distance: Optional[float], cost: Optional[np.ndarray],
                     cost_location: Optional[str], unfolding: bool,
                     exact_start_radius: Union[None, float, str] = None) -> Dict[str, Any]:
-    """What identifies a job (stored in the array's attributes): hashes of the
-    mesh, sources, targets and cost, and the options that change the numbers.
-    The backend and block size do not change them and are not part of it.
-    exact_start_radius: the radius of the exact start in mean edge lengths
-    (0: the plain start; None or "auto": the library's default, recorded as
-    "auto", its rule MFMM_EXACT_START_AUTO)."""
+    """What identifies a job, as stored in the array's attributes.
+
+    Hashes of the mesh, sources, targets and cost, and the options that
+    change the numbers; the backend and block size do not change them and
+    are not part of it.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The mesh (its vertices, faces and ``max_unfold_steps``).
+    sources, targets : numpy.ndarray of int32, shape (S,) and (T,), or None
+        Row and column vertex ids; None for every vertex.
+    dtype : {"float32", "float64"}
+        The output dtype.
+    max_distance : float or None
+        The march's limit.
+    cost : numpy.ndarray of float64 or None
+        Per-vertex or per-face cost.
+    cost_location : {"vertex", "face"} or None
+        Where the cost lives.
+    unfolding : bool
+        Whether obtuse corners are unfolded.
+    exact_start_radius : float, "auto" or None
+        The exact start's radius in mean edge lengths (0: the plain start;
+        None or "auto": the library's default, recorded as "auto").
+
+    Returns
+    -------
+    dict
+        JSON-serialisable: ``meshfmm_version``, ``mesh_sha256``,
+        ``n_vertices``, ``n_faces``, ``sources_sha256``, ``n_sources``,
+        ``targets_sha256``, ``n_targets``, ``dtype``, ``max_distance``,
+        ``cost_sha256``, ``cost_location``, ``unfolding``,
+        ``exact_start_radius``, ``max_unfold_steps``.
+    """
     V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
     F = np.ascontiguousarray(mesh.faces, dtype=np.int32)
     return {
@@ -137,8 +172,8 @@ def job_description(mesh: Mesh, sources: Optional[np.ndarray], targets: Optional
         "cost_location": cost_location if cost is not None else None,
         "unfolding": bool(unfolding),
         "exact_start_radius": _start_radius(exact_start_radius),
-        # None: the default (64), so that stores written before this key
-        # still match
+        # as given (None: the default, 64), so a job that leaves it unset
+        # matches stores that do not record it
         "max_unfold_steps": mesh._options()["max_unfold_steps"],
     }
 
@@ -156,11 +191,26 @@ def _start_radius(radius: Union[None, float, str]) -> Union[float, str]:
 
 
 def complete_blocks(arr: Any, block_rows: int) -> List[int]:
-    """Indices of the row blocks of `arr` that are complete and verified: the
-    chunk decodes (its CRC-32C matches), holds no NaN (the fill value of a
-    chunk never written) and matches the digest its task wrote for the
-    store's job and this block. Reads the whole array in this process; a resumed
-    ``distance_matrix`` does the same check as tasks on its cluster."""
+    """The row blocks of a meshfmm store that are complete and verified.
+
+    A block is complete when its chunk decodes (its CRC-32C matches), holds
+    no NaN (the fill value of a chunk never written) and matches the digest
+    its task wrote for the store's job and this block. Reads the whole
+    array in this process; a resumed :func:`distance_matrix` does the same
+    check as tasks on its cluster.
+
+    Parameters
+    ----------
+    arr : zarr.Array
+        A store written by :func:`distance_matrix`.
+    block_rows : int
+        Rows per block (``arr.chunks[0]``).
+
+    Returns
+    -------
+    list of int
+        Indices of the complete blocks, ascending.
+    """
     return _store.verified_blocks(arr, range(math.ceil(arr.shape[0] / block_rows)), block_rows)
 
 
@@ -233,61 +283,96 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                     n_workers: Optional[int] = None,
                     storage_options: Optional[dict] = None, compression: str = "lz4",
                     progress: Any = True, retries: int = 3, overwrite: bool = False) -> Any:
-    """Computes a dense S x N (or S x T) distance matrix as Dask tasks writing
-    a Zarr v3 array at `store`, and returns the ``zarr.Array``.
+    """A dense S x N (or S x T) distance matrix computed as Dask tasks
+    writing a Zarr v3 array.
 
-    mesh: a :class:`meshfmm.Mesh`; shipped to the workers as V and F, with
-        its options (``Mesh(..., spokes=False)``: each worker's mesh skips
-        the march's ~380 bytes per vertex of spokes, same rows).
-    store: a directory path or an fsspec URL (with `storage_options`).
-    sources: vertex ids (S,), None for every vertex; targets: vertex ids
-        (T,) for the columns, in the given order; None for every vertex.
-    client: a ``distributed.Client``; None starts a ``LocalCluster`` of
-        `n_workers` processes (default: the machine's cores) with one thread
-        each and the settings of ``DASK_CONFIG``, and prints its dashboard
-        address.
-    dtype: "float32" or "float64"; the values equal ``mesh.distance`` per row
-        (float64 bit for bit, float32 the same rounding).
-    resume: True skips blocks already complete and verified when the store
-        holds the same job, and refuses a store holding another job; False
-        starts over a meshfmm store, deleting only its own entries
-        (``zarr.json``, ``c/``, ``meshfmm_blocks/``), never other files.
-        Either way a store that another live run owns is refused
-        (:class:`StoreOwnerError`), and a run killed before it finished does
-        not block the next one (see the module's notes).
-    block_rows: rows per task and chunk (default: about 8 MiB a chunk, at
-        least 4 tasks per Dask thread of the cluster).
-    backend, n_threads: the in-process backend each task runs ("threads",
-        "serial", "opencl", "auto") and its threads (0: the worker's share of
-        its machine, cores / Dask threads on that host, so a LocalCluster of
-        one 1-thread process per core runs 1 library thread per task).
-    max_distance, cost, cost_location, unfolding, exact_start: as in
-        ``Mesh.distance``; the job records the exact start's radius, so a
-        store computed with another one is a different job.
-    compression: "lz4" (Blosc lz4 with bit shuffle, the default), "zstd"
-        (Blosc zstd level 3 with bit shuffle: ~2 % smaller, ~3x slower to
-        encode) or "none"; chunks always carry a CRC-32C. Measured on real
-        meshes' rows by bench/bench_compression.py (bench/RESULTS.md).
-    progress: True for a progress bar on a terminal (plain lines when piped),
-        False for none, or a callable ``progress(rows_done, n_rows)``; an
-        exception it raises stops the job (blocks in flight still finish).
-    retries: times a failed task is retried (a killed worker's tasks are
+    Each task computes one block of rows with ``Mesh.distance_matrix`` and
+    writes them into its own chunk, with a digest beside it. A run owns the
+    store while it writes (a token in the attribute ``meshfmm_owner``,
+    checked by every task before it writes): if another run takes the store
+    over meanwhile, this one writes nothing more and raises
+    :class:`StoreOwnerError`.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        Shipped to the workers as V and F, with its options
+        (``Mesh(..., spokes=False)``: each worker's mesh skips the march's
+        ~380 bytes per vertex of spokes, same rows).
+    store : str or os.PathLike
+        A directory path or an fsspec URL (with `storage_options`).
+    sources : array_like of int, shape (S,), optional
+        Row vertex ids; None for every vertex.
+    targets : array_like of int, shape (T,), optional
+        Column vertex ids, in the given order; None for every vertex.
+    client : distributed.Client, optional
+        None starts a ``LocalCluster`` of `n_workers` processes (default:
+        the machine's cores) with one thread each and the settings of
+        :data:`DASK_CONFIG`, and prints its dashboard address.
+    dtype : {"float32", "float64"}
+        The values equal ``Mesh.distance`` per row (float64 bit for bit,
+        float32 the same rounding).
+    resume : bool
+        True skips blocks already complete and verified when the store holds
+        the same job, and refuses a store holding another job. False starts
+        a meshfmm store over, deleting only its own entries (``zarr.json``,
+        ``c/``, ``meshfmm_blocks/``), never other files. Either way a store
+        that another live run owns is refused, and a run killed before it
+        finished does not block the next one.
+    block_rows : int, optional
+        Rows per task and chunk (default: about 8 MiB a chunk, at least 4
+        tasks per Dask thread of the cluster).
+    backend : {"threads", "serial", "opencl", "auto"}
+        The in-process backend each task runs. Under "auto" each worker
+        picks its own; the run record counts the blocks per backend.
+    n_threads : int
+        Library threads per task; 0: the worker's share of its machine
+        (cores / Dask threads on that host, so a LocalCluster of one
+        1-thread process per core runs 1 library thread per task).
+    max_distance, cost, cost_location, unfolding, exact_start
+        As in ``Mesh.distance``; the job records the exact start's radius,
+        so a store computed with another one is a different job.
+    n_workers : int, optional
+        Processes of the LocalCluster started when `client` is None.
+    storage_options : dict, optional
+        fsspec options for a URL `store`.
+    compression : {"lz4", "zstd", "none"}
+        Blosc lz4 with bit shuffle (default), Blosc zstd level 3 with bit
+        shuffle (~2 % smaller, ~3x slower to encode), or none; chunks always
+        carry a CRC-32C.
+    progress : bool or callable
+        True for a progress bar on a terminal (plain lines when piped),
+        False for none, or ``progress(rows_done, n_rows)``; an exception it
+        raises stops the job (blocks in flight still finish).
+    retries : int
+        Times a failed task is retried (a killed worker's tasks are
         rescheduled by Dask regardless).
-    overwrite: write the store into a location that exists and is not a
-        meshfmm store (a non-empty directory, another Zarr node): its Zarr
-        entries (``zarr.json``, ``c/``) are replaced and other files kept.
-        Without it such a location is refused with :class:`StoreError`, as
-        is a store holding another job when `resume` is set.
+    overwrite : bool
+        Write the store into a location that exists and is not a meshfmm
+        store (a non-empty directory, another Zarr node): its Zarr entries
+        (``zarr.json``, ``c/``) are replaced and other files kept.
 
-    A run owns the store while it writes (a token in the attribute
-    ``meshfmm_owner``, checked by every task before it writes): if another
-    run takes the store over meanwhile, this one writes nothing more and
-    raises :class:`StoreOwnerError`.
+    Returns
+    -------
+    zarr.Array
+        The matrix, shape (S, N) or (S, T), of `dtype`. Its attribute
+        ``meshfmm_last_run`` records this call's blocks computed and
+        skipped, the task seconds computing and writing (encoding included)
+        and the CPU seconds of the tasks' threads, and, summed over the
+        blocks computed, their :class:`~meshfmm.MatrixInfo`: ``backends``
+        (backend name -> blocks), ``vertices_settled`` and
+        ``start_fallbacks``.
 
-    The attribute ``meshfmm_last_run`` of the returned array records how many
-    blocks this call computed and skipped, the task seconds spent computing
-    and writing (encoding included) and the CPU seconds of the tasks' threads,
-    summed over the tasks.
+    Raises
+    ------
+    StoreError
+        The location holds another job (with `resume`), or is not a meshfmm
+        store (without `overwrite`), or is an input.
+    StoreOwnerError
+        Another live run owns the store, or takes it over during the run.
+    ValueError, TypeError
+        Bad arguments, checked before the store is touched (one row is
+        computed with the job's options first).
     """
     import zarr
     from zarr.codecs import BloscCodec, BloscShuffle, Crc32cCodec
@@ -500,14 +585,37 @@ def _run_blocks(client: Any, arr: Any, url: str, storage_options: Optional[dict]
 
 def symmetrize(store: Any, out: Any, storage_options: Optional[dict] = None,
                overwrite: bool = False) -> Any:
-    """(D + D^T) / 2 of a square matrix in a Zarr store, written to `out`, with
-    Dask arrays (chunk by chunk, never the whole matrix in memory):
-    ``da.from_zarr(store)`` then ``((D + D.T) / 2).astype(D.dtype).to_zarr(out)``.
-    Returns the new ``zarr.Array``.
+    """(D + D^T) / 2 of a square matrix in a Zarr store, written to `out`.
 
-    Raises StoreError when `out` is `store`, holds it or lies inside it, and
-    when `out` exists and is not empty unless `overwrite` is set; then only
-    its Zarr entries are replaced, and other files in it are kept."""
+    Runs with Dask arrays, chunk by chunk, never the whole matrix in memory:
+    ``da.from_zarr(store)`` then
+    ``((D + D.T) / 2).astype(D.dtype).to_zarr(out)``.
+
+    Parameters
+    ----------
+    store : str or os.PathLike
+        The square matrix (a path or fsspec URL).
+    out : str or os.PathLike
+        Where the result goes.
+    storage_options : dict, optional
+        fsspec options for both.
+    overwrite : bool
+        Replace `out`'s Zarr entries when it exists and is not empty (other
+        files in it are kept).
+
+    Returns
+    -------
+    zarr.Array
+        The symmetric matrix, read-only.
+
+    Raises
+    ------
+    StoreError
+        `out` is `store`, holds it or lies inside it, or exists and is not
+        empty without `overwrite`.
+    ValueError
+        The matrix is not square.
+    """
     import dask.array as da
     import zarr
 
