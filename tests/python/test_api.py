@@ -153,10 +153,10 @@ def test_unreferenced_vertex_is_inf():
 
 def test_duplicate_faces_are_copies_not_walls():
     """Copies of faces (an export artifact: same vertices, any order, twice or
-    three times) used to make every edge of the face non-manifold, hence a
+    three times) must not make every edge of the face non-manifold, hence a
     wall for the exact solver and the exact start: on the unit square
-    f(0,1,2) f(1,3,2) f(1,3,2), vertex 3 got 2 from vertex 0 instead of
-    sqrt(2). Now every result equals the mesh without the copies (the
+    f(0,1,2) f(1,3,2) f(1,3,2), vertex 3 would get 2 from vertex 0 instead
+    of sqrt(2). Every result equals the mesh without the copies (the
     reference) to rounding, and info counts them."""
     V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.0]])
     sq = meshfmm.Mesh(V, [[0, 1, 2], [1, 3, 2], [1, 3, 2]])

@@ -323,7 +323,7 @@ def test_progress_formats_time_left():
 
 def test_each_task_gets_its_hosts_share_of_cores(monkeypatch):
     # a LocalCluster of one 1-thread process per core: 1 library thread each
-    # (0 used to give every task all cores: 2 x oversubscribed on 2 cores)
+    # (all cores per task would oversubscribe 2 cores 2 x)
     class W:
         address = "tcp://10.0.0.7:4242"
 
@@ -451,7 +451,7 @@ def test_back_to_back_jobs_on_one_mesh_and_client(hand, serial64, client, tmp_pa
 
 
 def test_exact_start_is_passed_through_and_part_of_the_job(hand, client, tmp_path):
-    """Issue 12: the option reaches the tasks (the rows equal the plain
+    """The option reaches the tasks (the rows equal the plain
     start's serial rows), and the job records the radius, so a store
     computed with one start is not resumed with another."""
     src = SOURCES[:20]

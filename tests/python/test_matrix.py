@@ -1,4 +1,4 @@
-"""Distance matrices (issue 4): Mesh.distance_matrix on every backend equals
+"""Distance matrices: Mesh.distance_matrix on every backend equals
 Mesh.distance rows (float64 bit for bit, float32 = float64 rounded), and
 equals `meshfmm allpairs` from the command line; out= takes a numpy.memmap;
 backend "opencl" without a device raises OpenCLError and "auto" falls back.

@@ -1,4 +1,4 @@
-"""Issue 11: target columns (S x T), sparse local matrices, row streaming and
+"""Target columns (S x T), sparse local matrices, row streaming and
 symmetric output, against the full dense rows (the serial core)."""
 
 from __future__ import annotations
