@@ -15,10 +15,47 @@ from typing import Any, Optional, Tuple
 import numpy as np
 
 from . import _lib
+from ._lib import MeshError
 from ._types import SurfacePoint
 
 I32_MIN = -(2**31)
 I32_MAX = 2**31 - 1
+
+
+def mesh_arrays(V: Any, F: Any) -> Tuple[np.ndarray, np.ndarray]:
+    """A mesh's vertices (n, 3) and faces (m, 3) -> private read-only copies,
+    float64 and int32, C order. Raises MeshError for non-numeric arrays,
+    wrong shapes, counts or vertex ids beyond 32 bits (the rest is the
+    library's to check)."""
+    Va = np.asarray(V)
+    if Va.dtype.kind not in "iuf":
+        raise MeshError(f"vertices must be numbers, got dtype {Va.dtype}")
+    if Va.ndim != 2 or Va.shape[1] != 3:
+        raise MeshError(f"vertices must have shape (n, 3), got {Va.shape}")
+    Fa = np.asarray(F)
+    if Fa.size == 0 and Fa.ndim <= 2 and Fa.dtype.kind == "f":
+        Fa = Fa.astype(np.int32)  # an empty list: let the shape check speak
+    if Fa.dtype.kind not in "iu":
+        raise MeshError(f"faces must be integer vertex ids, got dtype {Fa.dtype}")
+    if Fa.ndim != 2 or Fa.shape[1] != 3:
+        raise MeshError(f"faces must have shape (m, 3), got {Fa.shape}")
+    nv, nf = Va.shape[0], Fa.shape[0]
+    if nv > I32_MAX or nf > I32_MAX:
+        raise MeshError(f"too many vertices or faces for 32-bit indices ({nv}, {nf})")
+    if nf and Fa.dtype.itemsize >= 4 and Fa.dtype != np.int32:
+        lo, hi = Fa.min(), Fa.max()
+        if lo < I32_MIN or hi > I32_MAX:
+            bad = np.argwhere((Fa < I32_MIN) | (Fa > I32_MAX))[0]
+            raise MeshError(
+                f"face {bad[0]} names vertex {Fa[bad[0], bad[1]]}, out of range "
+                f"(the mesh has {nv} vertices)"
+            )
+    # One private copy each, in the C types; read-only views go out.
+    V = np.array(Va, dtype=np.float64, order="C", copy=True)
+    F = np.array(Fa, dtype=np.int32, order="C", copy=True)
+    V.setflags(write=False)
+    F.setflags(write=False)
+    return V, F
 
 
 def addr(a: np.ndarray) -> int:

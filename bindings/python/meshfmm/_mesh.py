@@ -21,7 +21,6 @@ import numpy as np
 
 from . import _args, _dense, _lib, _rows, _sparse
 from ._interrupt import sigint_as_flag
-from ._lib import MeshError
 from ._types import GeodesicPath, MatrixInfo, MeshInfo, SourceLike, SurfacePoint
 
 __all__ = ["Mesh", "MeshInfo", "SurfacePoint", "GeodesicPath", "MatrixInfo", "load_mesh"]
@@ -102,34 +101,8 @@ class Mesh:
         self._solvers: List[int] = []
         self._exact_solvers: List[int] = []
 
-        Va = np.asarray(V)
-        if Va.dtype.kind not in "iuf":
-            raise MeshError(f"vertices must be numbers, got dtype {Va.dtype}")
-        if Va.ndim != 2 or Va.shape[1] != 3:
-            raise MeshError(f"vertices must have shape (n, 3), got {Va.shape}")
-        Fa = np.asarray(F)
-        if Fa.size == 0 and Fa.ndim <= 2 and Fa.dtype.kind == "f":
-            Fa = Fa.astype(np.int32)  # an empty list: let the shape check speak
-        if Fa.dtype.kind not in "iu":
-            raise MeshError(f"faces must be integer vertex ids, got dtype {Fa.dtype}")
-        if Fa.ndim != 2 or Fa.shape[1] != 3:
-            raise MeshError(f"faces must have shape (m, 3), got {Fa.shape}")
-        nv, nf = Va.shape[0], Fa.shape[0]
-        if nv > _args.I32_MAX or nf > _args.I32_MAX:
-            raise MeshError(f"too many vertices or faces for 32-bit indices ({nv}, {nf})")
-        if nf and Fa.dtype.itemsize >= 4 and Fa.dtype != np.int32:
-            lo, hi = Fa.min(), Fa.max()
-            if lo < _args.I32_MIN or hi > _args.I32_MAX:
-                bad = np.argwhere((Fa < _args.I32_MIN) | (Fa > _args.I32_MAX))[0]
-                raise MeshError(
-                    f"face {bad[0]} names vertex {Fa[bad[0], bad[1]]}, out of range "
-                    f"(the mesh has {nv} vertices)"
-                )
-        # One private copy each, in the C types; read-only views go out.
-        self._V = np.array(Va, dtype=np.float64, order="C", copy=True)
-        self._F = np.array(Fa, dtype=np.int32, order="C", copy=True)
-        self._V.setflags(write=False)
-        self._F.setflags(write=False)
+        self._V, self._F = _args.mesh_arrays(V, F)
+        nv, nf = self._V.shape[0], self._F.shape[0]
 
         opts = _lib.mfmm_mesh_options()
         _lib.mfmm_mesh_options_init(byref(opts))
