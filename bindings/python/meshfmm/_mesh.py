@@ -155,6 +155,13 @@ class Mesh:
     def _options(self) -> dict:
         return {"max_unfold_steps": self._max_unfold_steps, "spokes": self._spokes}
 
+    @property
+    def options(self) -> Dict[str, Any]:
+        """The constructor's keyword options, ``max_unfold_steps`` (None: the
+        default) and ``spokes``: ``Mesh(V, F, **mesh.options)`` builds an
+        equal mesh (a new dict each time)."""
+        return self._options()
+
     def __reduce__(self) -> Tuple[Any, ...]:
         if self.closed:
             raise ValueError("cannot pickle or copy a closed mesh")

@@ -174,7 +174,7 @@ def job_description(mesh: Mesh, sources: Optional[np.ndarray], targets: Optional
         "exact_start_radius": _start_radius(exact_start_radius),
         # as given (None: the default, 64), so a job that leaves it unset
         # matches stores that do not record it
-        "max_unfold_steps": mesh._options()["max_unfold_steps"],
+        "max_unfold_steps": mesh.options["max_unfold_steps"],
     }
 
 
@@ -487,7 +487,7 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                                "exact_start": radius, "cost": cost_arr,
                                "cost_location": cost_location, "n_threads": n_threads,
                                "host_threads": host_threads,
-                               "mesh_options": mesh._options()}, retries)
+                               "mesh_options": mesh.options}, retries)
         except BaseException:
             # release the store (only where this run's token is still there)
             owner.stop()
