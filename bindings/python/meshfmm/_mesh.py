@@ -476,7 +476,7 @@ class Mesh:
             return self._distance_exact(sources, max_distance)
         if method != "fmm":
             raise ValueError(f"method must be 'fmm' or 'exact', not {method!r}")
-        if _args.is_int(sources):  # the common case, kept cheap (see bench_python.py)
+        if _args.is_int(sources):  # the common case, kept cheap (bench/suite/bench_python.py)
             one = _lib.mfmm_source(_args.index(sources, "source"), -1)
             src_addr, n_src = ctypes.addressof(one), 1
         else:
