@@ -1,7 +1,7 @@
 """meshfmm against exact geodesics (igl.exact_geodesic, MMP) and against
 geometry-central's fast marching (potpourri3d) on the shared meshes.
 
-Metrics (DESIGN.md): mean relative error in percent over vertices with a
+Metrics (docs/methods.md#metrics): mean relative error in percent over vertices with a
 positive exact distance, and max error in percent of the mesh diameter (the
 bounding-box diagonal of the referenced vertices). Bound: no worse than
 geometry-central's FMM from the same sources on the same mesh, within 2% of its

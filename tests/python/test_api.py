@@ -153,10 +153,10 @@ def test_unreferenced_vertex_is_inf():
 
 def test_duplicate_faces_are_copies_not_walls():
     """Copies of faces (an export artifact: same vertices, any order, twice or
-    three times) used to make every edge of the face non-manifold, hence a
+    three times) must not make every edge of the face non-manifold, hence a
     wall for the exact solver and the exact start: on the unit square
-    f(0,1,2) f(1,3,2) f(1,3,2), vertex 3 got 2 from vertex 0 instead of
-    sqrt(2). Now every result equals the mesh without the copies (the
+    f(0,1,2) f(1,3,2) f(1,3,2), vertex 3 would get 2 from vertex 0 instead
+    of sqrt(2). Every result equals the mesh without the copies (the
     reference) to rounding, and info counts them."""
     V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.0]])
     sq = meshfmm.Mesh(V, [[0, 1, 2], [1, 3, 2], [1, 3, 2]])
@@ -463,19 +463,22 @@ def test_distance_matrix_smoke(tmp_path):
     V, F = grid(10)
     m = meshfmm.Mesh(V, F)
     try:
-        D = m.distance_matrix([0, 60], backend="serial", dtype="float64")
+        D, info = m.distance_matrix([0, 60], backend="serial", dtype="float64",
+                                    return_info=True)
     except NotImplementedError as exc:
         pytest.skip(str(exc))
     assert D.shape == (2, 121) and D.dtype == np.float64
     np.testing.assert_array_equal(D[0], m.distance(0))
     np.testing.assert_array_equal(D[1], m.distance(60))
-    assert m.backend_used == "serial"
+    assert info == meshfmm.MatrixInfo("serial", "", info.vertices_settled, 0)
+    assert info.vertices_settled > 0
+    assert not hasattr(m, "backend_used")
     mm = np.lib.format.open_memmap(tmp_path / "all.npy", mode="w+", dtype=np.float32,
                                    shape=(121, 121))
     seen = []
-    out = m.distance_matrix(out=mm, backend="threads", n_threads=2,
-                            progress=lambda done, n: seen.append((done, n)))
-    assert out is mm and m.backend_used == "threads"
+    out, info = m.distance_matrix(out=mm, backend="threads", n_threads=2, return_info=True,
+                                  progress=lambda done, n: seen.append((done, n)))
+    assert out is mm and info.backend == "threads"
     mm.flush()
     back = np.load(tmp_path / "all.npy", mmap_mode="r")
     np.testing.assert_array_equal(back[60], m.distance(60).astype(np.float32))
@@ -506,10 +509,10 @@ def test_opencl_errors_map_to_openclerror(tmp_path):
         except meshfmm.OpenCLError as exc:
             assert isinstance(exc, RuntimeError) and str(exc), exc
             print("OpenCLError", exc)
-        D = m.distance_matrix([0, 1], backend="auto", dtype="float64")
-        assert m.backend_used in ("threads", "serial"), m.backend_used
+        D, info = m.distance_matrix([0, 1], backend="auto", dtype="float64", return_info=True)
+        assert info.backend in ("threads", "serial"), info
         assert (D[1] == m.distance(1)).all()
-        print("fallback", m.backend_used)
+        print("fallback", info.backend)
         """
     ) % str(Path(__file__).parent)
     env = dict(os.environ, OCL_ICD_VENDORS=str(tmp_path), OPENCL_VENDOR_PATH=str(tmp_path))
@@ -595,3 +598,14 @@ def test_max_unfold_steps_reaches_the_core(meshes_dir):
     assert default.n_obtuse_corners == short.n_obtuse_corners > 0
     assert default.n_virtual_edges + default.n_unfold_failures == default.n_obtuse_corners
     assert short.n_unfold_failures > default.n_unfold_failures
+
+
+def test_options_rebuild_an_equal_mesh():
+    V, F = grid(4)
+    m = meshfmm.Mesh(V, F, max_unfold_steps=8, spokes=False)
+    assert m.options == {"max_unfold_steps": 8, "spokes": False}
+    m.options["spokes"] = True  # a copy: the mesh's options stay
+    assert m.options["spokes"] is False
+    again = meshfmm.Mesh(m.vertices, m.faces, **m.options)
+    assert np.array_equal(again.distance(0), m.distance(0))
+    assert meshfmm.Mesh(V, F).options == {"max_unfold_steps": None, "spokes": True}

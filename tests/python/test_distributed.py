@@ -20,6 +20,9 @@ zarr = pytest.importorskip("zarr")
 
 import meshfmm  # noqa: E402
 import meshfmm.distributed as md  # noqa: E402
+import meshfmm._zarr_store as zs  # noqa: E402
+import meshfmm._zarr_tasks as zt  # noqa: E402
+from meshfmm._zarr_cli import cli_allpairs_zarr  # noqa: E402
 from conftest import MESHES  # noqa: E402
 
 SOURCES = np.arange(0, 810, 7, dtype=np.int32)  # 116 rows of hand_lowres
@@ -59,6 +62,10 @@ def test_rows_equal_serial_float64_and_float32(hand, serial64, client, tmp_path)
     assert np.array_equal(Z32[:], serial64.astype(np.float32))
     run = Z32.attrs[md.RUN_ATTR]
     assert run["blocks"] == 8 and run["blocks_computed"] == 8
+    # each block's MatrixInfo, summed: the default backend on every block
+    assert run["backends"] == {"threads": 8}
+    assert run["vertices_settled"] == len(SOURCES) * hand.n_vertices
+    assert run["start_fallbacks"] == 0
 
 
 def test_targets_give_the_columns_of_full_rows(hand, serial64, client, tmp_path):
@@ -260,7 +267,7 @@ def test_command_line(tmp_path):
     out = str(tmp_path / "cli.zarr")
     src = tmp_path / "s.txt"
     src.write_text("0\n5\n9\n")
-    code = ("import sys; from meshfmm.distributed import cli_allpairs_zarr;"
+    code = ("import sys; from meshfmm._zarr_cli import cli_allpairs_zarr;"
             "sys.exit(cli_allpairs_zarr(sys.argv[1:]))")
     r = subprocess.run([sys.executable, "-c", code, str(MESHES / "hand_lowres.obj"), "-o", out,
                         "--workers", "1", "--sources", str(src), "--dtype", "float64"],
@@ -276,7 +283,7 @@ def test_command_line(tmp_path):
 def test_command_line_refuses_a_value_option_twice(tmp_path, twice):
     # argparse let the last one win silently; the C command line refuses it
     with pytest.raises(SystemExit) as e:
-        md.cli_allpairs_zarr([str(MESHES / "hand_lowres.obj"), "-o", str(tmp_path / "a.zarr"),
+        cli_allpairs_zarr([str(MESHES / "hand_lowres.obj"), "-o", str(tmp_path / "a.zarr"),
                               "--workers", "1", "--dtype", "float64", *twice])
     assert e.value.code == 2
     assert not (tmp_path / "a.zarr").exists() and not (tmp_path / "b.zarr").exists()
@@ -316,7 +323,7 @@ def test_progress_formats_time_left():
 
 def test_each_task_gets_its_hosts_share_of_cores(monkeypatch):
     # a LocalCluster of one 1-thread process per core: 1 library thread each
-    # (0 used to give every task all cores: 2 x oversubscribed on 2 cores)
+    # (all cores per task would oversubscribe 2 cores 2 x)
     class W:
         address = "tcp://10.0.0.7:4242"
 
@@ -326,15 +333,15 @@ def test_each_task_gets_its_hosts_share_of_cores(monkeypatch):
     import distributed
 
     monkeypatch.setattr(distributed, "get_worker", lambda: W)
-    monkeypatch.setattr(md, "_cores", lambda: 16)
-    assert md._task_threads(0, {"10.0.0.7": 16}) == 1
-    assert md._task_threads(0, {"10.0.0.7": 4}) == 4
-    assert md._task_threads(0, {"10.0.0.7": 1}) == 16
-    assert md._task_threads(0, {}) == 16  # a host the job did not see: the worker's own threads
-    assert md._task_threads(3, {"10.0.0.7": 16}) == 3  # asked for: as given
+    monkeypatch.setattr(zt, "_cores", lambda: 16)
+    assert zt._task_threads(0, {"10.0.0.7": 16}) == 1
+    assert zt._task_threads(0, {"10.0.0.7": 4}) == 4
+    assert zt._task_threads(0, {"10.0.0.7": 1}) == 16
+    assert zt._task_threads(0, {}) == 16  # a host the job did not see: the worker's own threads
+    assert zt._task_threads(3, {"10.0.0.7": 16}) == 3  # asked for: as given
     # outside a worker the library's own default (0: all cores)
     monkeypatch.setattr(distributed, "get_worker", lambda: (_ for _ in ()).throw(ValueError()))
-    assert md._task_threads(0, {}) == 0
+    assert zt._task_threads(0, {}) == 0
 
 
 def test_default_blocks_are_equal_multiples_of_the_threads():
@@ -444,7 +451,7 @@ def test_back_to_back_jobs_on_one_mesh_and_client(hand, serial64, client, tmp_pa
 
 
 def test_exact_start_is_passed_through_and_part_of_the_job(hand, client, tmp_path):
-    """Issue 12: the option reaches the tasks (the rows equal the plain
+    """The option reaches the tasks (the rows equal the plain
     start's serial rows), and the job records the radius, so a store
     computed with one start is not resumed with another."""
     src = SOURCES[:20]
@@ -545,7 +552,7 @@ def test_a_run_whose_store_is_taken_over_writes_nothing_more(hand, serial64, cli
     os.remove(os.path.join(store, "c", "2", "0"))
     V, F = hand.vertices, hand.faces
     with pytest.raises(RuntimeError, match="taken over") as e:
-        md._compute_block("k", V, F, store, None, 16, 24, SOURCES, None,
+        zt.compute_block("k", V, F, store, None, 16, 24, SOURCES, None,
                           {"backend": "serial", "dtype": "float64", "n_threads": 1,
                            "max_distance": None, "unfolding": True, "cost": None,
                            "cost_location": None}, 2, "not-the-owner", "job")
@@ -568,7 +575,7 @@ def test_a_run_whose_store_is_taken_over_writes_nothing_more(hand, serial64, cli
         md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
                            progress=False)
     # its heartbeat stopped over a minute ago: a killed run, taken over
-    _set_owner(store, heartbeat=time.time() - 2 * md._LEASE_S)
+    _set_owner(store, heartbeat=time.time() - 2 * zs._LEASE_S)
     Z = md.distance_matrix(hand, store, sources=SOURCES, client=client, dtype="float64",
                            progress=False)
     assert np.array_equal(Z[:], serial64)
@@ -578,7 +585,7 @@ def test_a_run_whose_store_is_taken_over_writes_nothing_more(hand, serial64, cli
 def test_the_owner_heartbeat_advances_while_a_job_runs(hand, client, tmp_path, monkeypatch):
     # a run on another host is taken for dead after _LEASE_S without a
     # heartbeat: a live one beats every _HEARTBEAT_S (shortened here)
-    monkeypatch.setattr(md, "_HEARTBEAT_S", 0.05)
+    monkeypatch.setattr(zs, "_HEARTBEAT_S", 0.05)
     store = str(tmp_path / "hb.zarr")
     beats = []
 
@@ -615,7 +622,7 @@ def test_a_killed_jobs_token_does_not_block_its_resume(hand, serial64, client, t
                                progress=False)
         assert isinstance(e.value, md.StoreOwnerError)
         capsys.readouterr()
-        rc = md.cli_allpairs_zarr([str(MESHES / "hand_lowres.obj"), "-o", store, "--sources",
+        rc = cli_allpairs_zarr([str(MESHES / "hand_lowres.obj"), "-o", store, "--sources",
                                    str(src), "--dtype", "float64", "--workers", "1",
                                    "--resume", "--no-progress"])
         err = capsys.readouterr().err
@@ -710,7 +717,7 @@ def test_an_output_that_holds_an_input_is_refused_and_left_intact(tmp_path, caps
                            (MESHES / "hand_lowres.obj", proj / "src.txt", proj / "src.txt"),
                            (tmp_path / "link" / "mesh.obj", None, proj)):
         capsys.readouterr()
-        rc = md.cli_allpairs_zarr([str(mesh), "-o", str(out), "--workers", "1", "--no-progress",
+        rc = cli_allpairs_zarr([str(mesh), "-o", str(out), "--workers", "1", "--no-progress",
                                    *(["--sources", str(src)] if src else [])])
         err = capsys.readouterr().err
         assert rc == 2 and "is an input or contains one" in err
@@ -730,7 +737,7 @@ def test_a_location_that_is_not_a_meshfmm_store_needs_overwrite(hand, serial64, 
             md.distance_matrix(hand, str(out), sources=SOURCES, client=client, resume=resume,
                                progress=False)
         assert isinstance(e.value, md.StoreError)
-    rc = md.cli_allpairs_zarr([str(MESHES / "hand_lowres.obj"), "-o", str(out), "--workers",
+    rc = cli_allpairs_zarr([str(MESHES / "hand_lowres.obj"), "-o", str(out), "--workers",
                                "1", "--no-progress"])
     err = capsys.readouterr().err
     assert rc == 2 and "--overwrite" in err and len(err.strip().splitlines()) == 1
@@ -758,7 +765,7 @@ def test_a_location_that_is_not_a_meshfmm_store_needs_overwrite(hand, serial64, 
     (other / "keep.txt").write_text("kept\n")
     src = tmp_path / "s.txt"
     src.write_text("0\n5\n9\n")
-    rc = md.cli_allpairs_zarr([str(MESHES / "hand_lowres.obj"), "-o", str(other), "--sources",
+    rc = cli_allpairs_zarr([str(MESHES / "hand_lowres.obj"), "-o", str(other), "--sources",
                                str(src), "--dtype", "float64", "--workers", "1",
                                "--no-progress", "--overwrite"])
     assert rc == 0, capsys.readouterr().err

@@ -1,4 +1,4 @@
-"""The exact start of the march (issue 12.2): against the stored
+"""The exact start of the march: against the stored
 igl.exact_geodesic references, never worse than the paper's plain start and
 at most 0.6x its mean relative error, below potpourri3d's robust heat method
 in mean and max error; rows equal on every backend (OpenCL bit for bit); the
@@ -24,7 +24,7 @@ from conftest import (
     reference,
 )
 
-TARGET = 0.6  # issue 12: mean relative error at most 0.6x the plain start's
+TARGET = 0.6  # mean relative error at most 0.6x the plain start's (docs/methods.md#metrics)
 
 
 @pytest.mark.parametrize("name", MANIFOLD_MESHES)
@@ -158,11 +158,12 @@ def surface_points(name, n_faces=3, n_edges=1):
 
 @pytest.mark.parametrize("name", MANIFOLD_MESHES + ["beetle.obj"])
 def test_point_sources_never_worse(name):
-    """Issue 12: points inside faces and on edges start no worse than the
+    """Points inside faces and on edges start no worse than the
     plain start (mean relative error against the library's exact solver,
     which equals the stored igl references, test_exact.py). The straight
     start's walk reaches the mesh's longest edge (6.6 mean edges on
-    fertility, 12 on beetle), beyond a radius-6 patch: fertility was 1.12x."""
+    fertility, 12 on beetle), beyond a radius-6 patch, which alone gives
+    fertility 1.12x."""
     need_data()
     m = mesh(name)
     for p in surface_points(name):
@@ -178,7 +179,7 @@ def test_point_sources_never_worse(name):
 @pytest.mark.parametrize("backend", ["serial", "threads", "opencl"])
 def test_local_rows_within_the_radius_are_exact(backend):
     """A row with max_distance inside the exact start's radius is the exact
-    patch (issue 11: the patch ends at max_distance, so a local row costs its
+    patch (the patch ends at max_distance, so a local row costs its
     reach): equal to the exact solver to 1e-12 where finite, +inf exactly
     where the exact distance passes max_distance; the same on every backend
     (sparse on the CPU ones, dense rows on OpenCL)."""

@@ -1,6 +1,6 @@
 """meshfmm.load_mesh goes through the C loader: STL (binary and ascii, welded),
 unsupported formats named, files that are not regular refused, and number
-parsing that does not depend on the locale (issue 9 item 4, issue 10)."""
+parsing that does not depend on the locale."""
 import os
 import struct
 import subprocess
@@ -79,7 +79,7 @@ def test_not_regular_files_refused(tmp_path):
     fifo = tmp_path / "pipe.obj"
     os.mkfifo(fifo)
     with pytest.raises(OSError, match="FIFO"):
-        meshfmm.load_mesh(fifo)  # hung forever before
+        meshfmm.load_mesh(fifo)  # opening a FIFO for reading would block
 
 
 def _comma_locale_env(tmp_path):

@@ -1,4 +1,4 @@
-"""Distance matrices (issue 4): Mesh.distance_matrix on every backend equals
+"""Distance matrices: Mesh.distance_matrix on every backend equals
 Mesh.distance rows (float64 bit for bit, float32 = float64 rounded), and
 equals `meshfmm allpairs` from the command line; out= takes a numpy.memmap;
 backend "opencl" without a device raises OpenCLError and "auto" falls back.
@@ -41,11 +41,13 @@ def test_rows_equal_distance(name, backend):
     m = mesh(name)
     src = SOURCES if name == "hand_lowres.obj" else [5, 80, 2593, 1000]
     ref = rows_of(m, src)
-    D = matrix_or_skip(m, src, backend=backend, dtype="float64", n_threads=2)
+    D, info = matrix_or_skip(m, src, backend=backend, dtype="float64", n_threads=2,
+                             return_info=True)
     assert D.shape == (len(src), m.n_vertices) and D.dtype == np.float64
     assert np.array_equal(D.view(np.uint64), ref.view(np.uint64))
+    assert isinstance(info, meshfmm.MatrixInfo)
     if backend != "auto":
-        assert m.backend_used == backend
+        assert info.backend == backend and info.reason == ""
     D32 = matrix_or_skip(m, src, backend=backend, n_threads=2)
     assert D32.dtype == np.float32
     assert np.array_equal(D32.view(np.uint32), ref.astype(np.float32).view(np.uint32))
@@ -110,8 +112,9 @@ def test_no_opencl_device(tmp_path):
         import numpy as np, meshfmm
         V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.]])
         m = meshfmm.Mesh(V, [[0, 1, 2], [1, 3, 2]])
-        D = m.distance_matrix(backend="auto", dtype="float64")
-        assert m.backend_used == "threads", m.backend_used
+        D, info = m.distance_matrix(backend="auto", dtype="float64", return_info=True)
+        assert info.backend == "threads", info
+        assert info.reason, info
         assert np.array_equal(D[2], m.distance(2))
         try:
             m.distance_matrix(backend="opencl")
@@ -132,7 +135,7 @@ def test_opencl_context_made_once_per_process():
     """Every OpenCL call reuses one context (the program is built once per
     process); rows from repeated calls stay equal to the serial core's."""
     need_data()
-    from meshfmm import _mesh
+    from meshfmm import _rows
 
     m = mesh("hand_lowres.obj")
     ref = rows_of(m, SOURCES)
@@ -140,7 +143,7 @@ def test_opencl_context_made_once_per_process():
     for _ in range(3):
         D = matrix_or_skip(m, SOURCES, backend="opencl", dtype="float64")
         assert np.array_equal(D.view(np.uint64), ref.view(np.uint64))
-        ctx = _mesh._shared_opencl_context()
+        ctx = _rows.shared_opencl_context()
         assert ctx is not None
         first = first or ctx.value
         assert ctx.value == first

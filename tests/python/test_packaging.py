@@ -1,4 +1,4 @@
-"""What `pip install .` gives besides the library (issue 10 point 4): the
+"""What `pip install .` gives besides the library: the
 `meshfmm` command (console script and `python -m meshfmm`, the C command
 line's commands), Mesh from any object with .vertices and .faces (trimesh),
 Mesh.from_file.
@@ -208,7 +208,7 @@ def test_meshio_one_liner_in_usage():
 
 def test_meshfmm_library_wins(monkeypatch, tmp_path):
     """$MESHFMM_LIBRARY names the library to load even when the package
-    carries one (it used to be ignored then, silently), and a path that is
+    carries one (not silently ignored), and a path that is
     no file is an ImportError that names it."""
     from meshfmm import _lib as lib
 

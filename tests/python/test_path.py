@@ -75,7 +75,7 @@ def test_unreached_and_bad_target():
         m.geodesic_path(d, m.n_vertices + 5, sources=[0])
 
 
-# ---- issue 9.2 and 9.3: paths end at their source or raise; point sources on edges
+# ---- paths end at their source or raise; point sources on edges
 
 
 def _ends_at(p, x, h):

@@ -166,8 +166,8 @@ def test_matrix_rows_equal_single_solves(mesh_case, data):
 # Found by the path property (a jittered 4 x 4 grid): T(7) comes from source 3
 # through a virtual edge (section 4.2), across faces that do not touch vertex
 # 7's neighbours, so T has a local minimum at vertex 7 among its mesh
-# neighbours and backtracking along -grad T stalled there until paths learned
-# to follow virtual edges through their strips (issue 9 points 2/3).
+# neighbours, and backtracking along -grad T stalls there unless paths follow
+# virtual edges through their strips.
 
 
 @pytest.mark.parametrize("straighten", [True, False])

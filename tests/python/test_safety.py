@@ -1,7 +1,6 @@
-"""Defects of issue 9 (Python side), each reproduced first: max_distance
-checks (point 5), inputs aliasing distance_matrix's out (6), copies and
-pickles of a Mesh (7), a full disk under a memmapped matrix (13), Ctrl-C in
-distance_matrix (14)."""
+"""Python-side safety, each case reproduced: max_distance checks, inputs
+aliasing distance_matrix's out, copies and pickles of a Mesh, a full disk
+under a memmapped matrix, Ctrl-C in distance_matrix."""
 
 from __future__ import annotations
 
@@ -34,7 +33,7 @@ def run_isolated(code: str, timeout: float = 120) -> subprocess.CompletedProcess
                           text=True, timeout=timeout, cwd=str(HERE))
 
 
-# ------------------------------------------------- 5: max_distance checks
+# ---------------------------------------------------- max_distance checks
 @pytest.mark.parametrize("bad,exc,words", [
     (-1.0, ValueError, [">= 0", "-1"]),
     (-np.inf, ValueError, [">= 0"]),
@@ -75,7 +74,7 @@ def test_max_distance_accepted(ok):
     np.testing.assert_array_equal(D[0], d)
 
 
-# -------------------------------------------- 6: inputs aliasing out
+# ----------------------------------------------- inputs aliasing out
 ALIAS_CASES = ["sources", "cost"]
 
 
@@ -83,8 +82,8 @@ ALIAS_CASES = ["sources", "cost"]
 @pytest.mark.parametrize("what", ALIAS_CASES)
 def test_inputs_sharing_memory_with_out(backend, what):
     """sources (or cost) that are a view of `out`: the library overwrites
-    them with rows while it still reads them. Before the fix: garbage vertex
-    ids (a crash) or rows computed with a clobbered cost. Run in a
+    them with rows while it still reads them, unless they are copied first:
+    else garbage vertex ids (a crash) or rows computed with a clobbered cost. Run in a
     subprocess so that a segfault fails the test."""
     code = f"""
     import numpy as np, meshfmm
@@ -130,10 +129,10 @@ def test_inputs_not_aliasing_are_not_copied_needlessly():
         np.testing.assert_array_equal(D[i], m.distance(int(s)).astype(np.float32))
 
 
-# ------------------------------------------------ 7: copies and pickles
+# --------------------------------------------------- copies and pickles
 def test_copy_then_close_one_other_works():
-    """Before the fix copy.copy shared the C pointer: closing one copy freed
-    the mesh under the other (use-after-free, then a double free). In a
+    """A copy sharing the C pointer would free the mesh under the other copy
+    when one is closed (use-after-free, then a double free). In a
     subprocess, so that the crash shows as a failure."""
     code = """
     import copy, gc, pickle, numpy as np, meshfmm
@@ -214,7 +213,7 @@ def test_pickled_mesh_in_a_container_and_deepcopy_memo():
     assert m.distance(0)[0] == 0.0
 
 
-# ---------------------------------------- 13: reserving the memmap's space
+# -------------------------------------------- reserving the memmap's space
 def test_open_memmap_writes_a_valid_npy(tmp_path):
     m = meshfmm.Mesh(*grid(5))
     n = m.n_vertices
@@ -299,7 +298,7 @@ def test_numpy_open_memmap_dies_of_sigbus_on_a_full_disk(small_tmpfs):
         (proc.returncode, proc.stderr[-2000:])
 
 
-# ------------------------------------------------------------- 14: Ctrl-C
+# ----------------------------------------------------------------- Ctrl-C
 CTRL_C = """
 import sys, time, numpy as np, meshfmm
 from test_api import grid
@@ -323,8 +322,8 @@ print("finished", flush=True)
 def test_sigint_gives_one_keyboard_interrupt(backend, with_progress):
     """SIGINT from outside while distance_matrix runs: the process stops with
     one KeyboardInterrupt traceback and no "Exception ignored on calling
-    ctypes callback function" (before the fix: one such message per Ctrl-C,
-    and the job went on)."""
+    ctypes callback function" (which an exception escaping the callback
+    prints once per Ctrl-C while the job goes on)."""
     code = textwrap.dedent(CTRL_C.format(backend=backend, with_progress=with_progress))
     proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, cwd=str(HERE))

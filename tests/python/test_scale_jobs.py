@@ -1,4 +1,4 @@
-"""Issue 11: target columns (S x T), sparse local matrices, row streaming and
+"""Target columns (S x T), sparse local matrices, row streaming and
 symmetric output, against the full dense rows (the serial core)."""
 
 from __future__ import annotations
@@ -24,16 +24,17 @@ def test_targets_equal_full_columns(backend):
     m = mesh("hand_lowres.obj")
     # (auto may run full rows on OpenCL, which counts no work: threads here)
     full_backend = "threads" if backend in ("auto", "opencl") else backend
-    full = m.distance_matrix(SOURCES, backend=full_backend, dtype="float64", n_threads=2)
-    full_work = m.vertices_settled
+    full, full_info = m.distance_matrix(SOURCES, backend=full_backend, dtype="float64",
+                                        n_threads=2, return_info=True)
     tg = [5, 400, 5, 800, 2]
-    D = m.distance_matrix(SOURCES, backend=backend, dtype="float64", n_threads=2, targets=tg)
+    D, info = m.distance_matrix(SOURCES, backend=backend, dtype="float64", n_threads=2,
+                                targets=tg, return_info=True)
     assert D.shape == (len(SOURCES), len(tg))
     assert np.array_equal(D.view(np.uint64), full[:, tg].view(np.uint64))
-    if m.backend_used != "opencl":  # (OpenCL counts no work)
-        assert m.vertices_settled < full_work
+    if info.backend != "opencl":  # (OpenCL counts no work)
+        assert info.vertices_settled < full_info.vertices_settled
     if backend != "auto":
-        assert m.backend_used == backend
+        assert info.backend == backend
     D32 = m.distance_matrix(SOURCES, backend=backend, n_threads=2, targets=tg)
     assert np.array_equal(D32, full[:, tg].astype(np.float32))
 

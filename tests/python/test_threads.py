@@ -50,6 +50,52 @@ def test_four_threads_equal_serial():
     assert 1 <= len(m._solvers) <= 4
 
 
+
+@pytest.mark.parametrize("slow_backend, fast_backend", [("threads", "serial"),
+                                                        ("serial", "threads")])
+def test_matrix_info_is_per_call(slow_backend, fast_backend):
+    """Two threads share one Mesh with different backends: each call returns
+    its own MatrixInfo, also when the other call ends while it is in flight."""
+    m = meshfmm.Mesh(*grid(10))
+    fast_done = threading.Event()
+    results = {}
+    errors = []
+
+    def slow():
+        def wait_for_fast(done, n):
+            # hold this call in flight until the other one has returned
+            if not fast_done.wait(30):
+                raise TimeoutError("the other call did not return")
+        try:
+            results["slow"] = m.distance_matrix([0, 5, 60], backend=slow_backend,
+                                                n_threads=2, progress=wait_for_fast,
+                                                return_info=True)
+        except BaseException as exc:
+            errors.append(exc)
+
+    def fast():
+        try:
+            results["fast"] = m.distance_matrix([1, 2], backend=fast_backend, n_threads=2,
+                                                return_info=True)
+        except BaseException as exc:
+            errors.append(exc)
+        finally:
+            fast_done.set()
+
+    t_slow = threading.Thread(target=slow)
+    t_slow.start()
+    _hold_until(lambda: m._active > 0)
+    t_fast = threading.Thread(target=fast)
+    t_fast.start()
+    t_fast.join()
+    t_slow.join()
+    assert not errors, errors
+    (d_slow, i_slow), (d_fast, i_fast) = results["slow"], results["fast"]
+    assert i_slow.backend == slow_backend and i_fast.backend == fast_backend
+    assert i_slow.vertices_settled == 3 * 121 and i_fast.vertices_settled == 2 * 121
+    assert np.array_equal(d_slow[2], m.distance(60).astype(np.float32))
+    assert not hasattr(m, "backend_used")
+
 def _hold_until(cond, seconds=5.0):
     """Polls cond() every millisecond for at most `seconds`."""
     deadline = time.monotonic() + seconds

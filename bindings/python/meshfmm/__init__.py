@@ -8,6 +8,8 @@ C99 library libmeshfmm.
 >>> d = mesh.distance(0)                            # float64 (nv,)  # doctest: +SKIP
 >>> path = mesh.geodesic_path(d, 1234)              # doctest: +SKIP
 >>> D = mesh.distance_matrix([0, 10, 20])           # float32 (3, nv)  # doctest: +SKIP
+>>> D, info = mesh.distance_matrix([0, 10], return_info=True)  # doctest: +SKIP
+>>> info.backend                                    # "threads"  # doctest: +SKIP
 """
 
 from __future__ import annotations
@@ -15,7 +17,8 @@ from __future__ import annotations
 from . import _lib
 from ._lib import MeshError, OpenCLError
 from ._memmap import open_memmap
-from ._mesh import GeodesicPath, Mesh, MeshInfo, SurfacePoint, load_mesh
+from ._mesh import Mesh, load_mesh
+from ._types import GeodesicPath, MatrixInfo, MeshInfo, SurfacePoint
 
 #: Version of the loaded libmeshfmm ("MAJOR.MINOR.PATCH").
 __version__: str = _lib.version()
@@ -28,6 +31,7 @@ __all__ = [
     "MeshInfo",
     "SurfacePoint",
     "GeodesicPath",
+    "MatrixInfo",
     "MeshError",
     "OpenCLError",
     "load_mesh",

@@ -21,8 +21,15 @@ _NAME = "meshfmm.exe" if sys.platform == "win32" else "meshfmm"
 
 
 def cli_path() -> Optional[str]:
-    """The C command line: the one inside the package (a wheel or
-    ``pip install .``), else $MESHFMM_CLI (a development build), else None."""
+    """Where the C command line is.
+
+    Returns
+    -------
+    str or None
+        The binary inside the package (a wheel or ``pip install .``), else
+        ``$MESHFMM_CLI`` (a development build) when it names an executable
+        file, else None.
+    """
     inside = Path(__file__).resolve().parent / "_bin" / _NAME
     if inside.is_file() and os.access(inside, os.X_OK):
         return str(inside)
@@ -44,10 +51,10 @@ def _output(args: List[str]) -> Optional[str]:
 
 
 def _allpairs_zarr(args: List[str]) -> int:
-    """`meshfmm allpairs MESH -o OUT.zarr`: the Dask + Zarr job (DESIGN.md),
-    run by meshfmm.distributed."""
+    """`meshfmm allpairs MESH -o OUT.zarr`: the Dask + Zarr job of
+    meshfmm.distributed, run by its command line (meshfmm._zarr_cli)."""
     try:
-        from .distributed import cli_allpairs_zarr
+        from ._zarr_cli import cli_allpairs_zarr
         import distributed  # noqa: F401
         import zarr  # noqa: F401
     except ImportError as e:
@@ -58,6 +65,23 @@ def _allpairs_zarr(args: List[str]) -> int:
 
 
 def main(argv: Optional[List[str]] = None) -> int:
+    """Runs the ``meshfmm`` command.
+
+    ``allpairs ... -o OUT.zarr`` runs the Dask + Zarr job in Python; every
+    other command replaces this process with the C command line
+    (``os.execv``), so it does not return.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after the command name; None reads ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The exit status: 2 when the C command line is not installed or the
+        Zarr job lacks Dask or Zarr, else the Zarr job's status.
+    """
     args = list(sys.argv[1:] if argv is None else argv)
     if args and args[0] == "allpairs":
         out = _output(args[1:])

@@ -42,21 +42,42 @@ def _reserve(fd: int, offset: int, length: int) -> None:
 
 def open_memmap(path: Union[str, "os.PathLike[str]"], shape: Tuple[int, ...],
                 dtype: Any = "float32") -> np.memmap:
-    """Creates (or truncates) the .npy file ``path`` for a C-order array of
-    ``shape`` and ``dtype``, reserves its full size on disk, and returns it
-    memory-mapped for writing (``numpy.memmap``, mode "r+"), ready for
-    ``Mesh.distance_matrix(out=...)``.
+    """A .npy file on disk, its full size reserved, memory-mapped for writing.
 
-    Raises OSError (errno ENOSPC, "No space left on device") at once when
-    the disk cannot hold the file, and removes the file; without this the
-    writes would fail half-way through with SIGBUS. The file's contents read
-    as zeros until written: to tell a finished matrix from an interrupted one,
-    write to a temporary name and rename it when the job has returned::
+    Creates (or truncates) the file for a C-order array, reserves its blocks
+    on disk, and returns it ready for ``Mesh.distance_matrix(out=...)``.
+    Without the reservation a full disk would show up half-way through as
+    SIGBUS. The contents read as zeros until written: to tell a finished
+    matrix from an interrupted one, write to a temporary name and rename it
+    when the job has returned::
 
         D = meshfmm.open_memmap("all.npy.partial", (n, n), "float32")
         mesh.distance_matrix(out=D)
         D.flush(); del D
         os.replace("all.npy.partial", "all.npy")
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The .npy file to create.
+    shape : int or tuple of int
+        The array's shape, each >= 0.
+    dtype : numpy dtype
+        The array's dtype (default float32).
+
+    Returns
+    -------
+    numpy.memmap
+        Mode "r+", of `shape` and `dtype`.
+
+    Raises
+    ------
+    OSError
+        errno ENOSPC ("No space left on device") at once when the disk
+        cannot hold the file (the file is removed), or another error
+        creating it.
+    ValueError
+        A negative dimension.
     """
     fspath = os.fspath(path)
     dt = np.dtype(dtype)
