@@ -40,12 +40,12 @@ def sparse_rows(mesh, radii_edges, n_rows, threads, rng):
     out = []
     for k in radii_edges:
         for start in ("exact", "plain"):  # the default exact start, and the paper's
-            S, dt = timed(lambda: mesh.distance_matrix(
+            (S, info), dt = timed(lambda: mesh.distance_matrix(
                 src, max_distance=k * h, sparse=True, backend="threads", n_threads=threads,
-                exact_start=start == "exact"))
+                exact_start=start == "exact", return_info=True))
             out.append({"r_edges": k, "start": start, "rows": n_rows, "seconds": dt,
                         "rows_per_s": n_rows / dt, "nnz_per_row": S.nnz / n_rows,
-                        "vertices_settled_per_row": mesh.vertices_settled / n_rows})
+                        "vertices_settled_per_row": info.vertices_settled / n_rows})
     return out
 
 
@@ -75,13 +75,13 @@ def main() -> None:
     mesh = meshfmm.Mesh(*benchlib.generate("sine", n, work))
     n_land = 200 if a.quick else 1000
     land = rng.choice(mesh.n_vertices, size=n_land, replace=False).astype(np.int32)
-    L, t_land = timed(lambda: mesh.distance_matrix(land, targets=land, backend="threads",
-                                                   n_threads=a.threads))
-    settled_land = mesh.vertices_settled
+    (L, info), t_land = timed(lambda: mesh.distance_matrix(
+        land, targets=land, backend="threads", n_threads=a.threads, return_info=True))
+    settled_land = info.vertices_settled
     n_full = 50 if a.quick else 100
-    _, t_full = timed(lambda: mesh.distance_matrix(land[:n_full], backend="threads",
-                                                   n_threads=a.threads))
-    settled_full = mesh.vertices_settled
+    (_, info), t_full = timed(lambda: mesh.distance_matrix(
+        land[:n_full], backend="threads", n_threads=a.threads, return_info=True))
+    settled_full = info.vertices_settled
     per_land, per_full = t_land / n_land, t_full / n_full
     res["landmarks"] = {"mesh": f"sine {n}", "n_vertices": mesh.n_vertices, "landmarks": n_land,
                         "landmark_seconds_per_row": per_land, "full_seconds_per_row": per_full,
@@ -91,9 +91,9 @@ def main() -> None:
     # landmarks in one region (the n_land vertices nearest to one point): rows stop early
     V = mesh.vertices
     near = np.argsort(np.linalg.norm(V - V[land[0]], axis=1))[:n_land].astype(np.int32)
-    _, t_near = timed(lambda: mesh.distance_matrix(near, targets=near, backend="threads",
-                                                   n_threads=a.threads))
-    settled_near = mesh.vertices_settled
+    (_, info), t_near = timed(lambda: mesh.distance_matrix(
+        near, targets=near, backend="threads", n_threads=a.threads, return_info=True))
+    settled_near = info.vertices_settled
     res["landmarks"].update({"clustered_seconds_per_row": t_near / n_land,
                              "clustered_speedup_per_row": per_full / (t_near / n_land),
                              "settled_per_row_clustered": settled_near / n_land})
