@@ -14,7 +14,7 @@
  * FP_CONTRACT OFF, so rows equal the C core's bit for bit in float64.
  * The host embeds this file with the #include lines replaced by the headers.
  */
-#include "march.h"
+#include "march/march.h"
 
 /* The march for source sources[first + gid], with T in T_row. */
 inline void mfmm_row_march(int nv, __global const int *wedge_offset,

@@ -91,10 +91,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/error.h"
 #include "exact/exact.h"
-#include "core/mesh.h"
-#include "core/check.h"
-#include "core/order.h"
+#include "mesh/mesh.h"
+#include "mesh/check.h"
+#include "mesh/order.h"
 
 #define EX_PI 3.14159265358979323846264338328
 #define EX_TWO_PI 6.283185307179586476925286766559

@@ -8,9 +8,10 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "base/error.h"
 #include "rows.h"
-#include "core/order.h"
-#include "solve/seed.h"
+#include "mesh/order.h"
+#include "start/seed.h"
 #include "solve/solve.h"
 
 const char *mfmm_backend_name(mfmm_backend backend)

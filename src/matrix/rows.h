@@ -4,7 +4,7 @@
 #ifndef MFMM_MATRIX_ROWS_H
 #define MFMM_MATRIX_ROWS_H
 
-#include "core/mesh.h"
+#include "mesh/mesh.h"
 
 /* A validated matrix job. */
 typedef struct mfmm_rows_job {

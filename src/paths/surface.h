@@ -5,8 +5,8 @@
 
 #include <math.h>
 
-#include "core/mesh.h"
-#include "core/start.h" /* mfmm_dist3 */
+#include "mesh/mesh.h"
+#include "start/straight.h" /* mfmm_dist3 */
 
 #define ON_EDGE 1e-12 /* barycentric coordinate treated as 0 (on the edge) */
 

@@ -13,9 +13,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/check.h"
-#include "core/order.h"
-#include "core/start.h"
+#include "base/error.h"
+#include "mesh/check.h"
+#include "mesh/order.h"
+#include "mesh/unfold.h"
+#include "start/straight.h"
 #include "surface.h"
 #include "straighten.h"
 

@@ -5,11 +5,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/check.h"
-#include "core/mesh.h"
-#include "core/order.h"
-#include "core/start.h"
-#include "seed.h"
+#include "base/error.h"
+#include "mesh/check.h"
+#include "mesh/mesh.h"
+#include "mesh/order.h"
+#include "mesh/spokes.h"
+#include "start/straight.h"
+#include "start/seed.h"
 #include "solve.h"
 
 struct mfmm_solver {

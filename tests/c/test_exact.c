@@ -16,7 +16,7 @@
 
 #include "testutil.h"
 #include "exact/exact.h"
-#include "core/mesh.h"
+#include "mesh/mesh.h"
 
 /* ---------------------------------------------------------------- helpers */
 

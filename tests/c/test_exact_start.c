@@ -13,8 +13,8 @@
 #include <string.h>
 #include <cmocka.h>
 
-#include "core/mesh.h"
-#include "core/order.h"
+#include "mesh/mesh.h"
+#include "mesh/order.h"
 #include "exact/exact.h"
 #include "testutil.h"
 

@@ -14,7 +14,8 @@
 #include <cmocka.h>
 
 #include "testutil.h"
-#include "core/mesh.h"
+#include "mesh/mesh.h"
+#include "mesh/unfold.h"
 #include "io/generate.h"
 
 static double bytes_per_vertex(const mfmm_mesh *mesh)

@@ -17,7 +17,7 @@
 #include <cmocka.h>
 
 #include "testutil.h"
-#include "core/mesh.h"
+#include "mesh/mesh.h"
 #include "io/generate.h"
 
 /* g's vertices, plus one unreferenced vertex, and its faces in a shuffled

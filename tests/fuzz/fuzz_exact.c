@@ -47,7 +47,7 @@
 
 #include "meshfmm.h"
 #include "byte_reader.h"
-#include "core/order.h"
+#include "mesh/order.h"
 #include "exact/exact.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);

@@ -2,6 +2,7 @@
 #include <float.h>
 #include <math.h>
 
+#include "base/error.h"
 #include "check.h"
 #include "order.h"
 
@@ -77,3 +78,26 @@ mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int
                          (long)src->face);
     return MFMM_OK;
 }
+
+void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_location,
+                       double *uniform)
+{
+    for (int32_t v = 0; v < mesh->nv; v++)
+        uniform[v] = 0.0;
+    for (int32_t f = 0; f < mesh->nf; f++) {
+        const int32_t *fv = mesh->face_records[f].v;
+        double x;
+        if (cost_location == 2) {
+            x = cost[f];
+        } else { /* the face's corners all alike, or -1 */
+            x = cost[fv[0]];
+            if (cost[fv[1]] != x || cost[fv[2]] != x)
+                x = -1.0;
+        }
+        for (int k = 0; k < 3; k++) {
+            double *u = uniform + fv[k];
+            *u = *u == 0.0 || *u == x ? x : -1.0;
+        }
+    }
+}
+

@@ -5,7 +5,7 @@
 #ifndef MFMM_MATRIX_OPENCL_LOADER_H
 #define MFMM_MATRIX_OPENCL_LOADER_H
 
-#include "core/mesh.h"
+#include "meshfmm.h"
 
 #ifdef MESHFMM_HAVE_OPENCL
 #include <CL/cl.h>

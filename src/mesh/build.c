@@ -1,28 +1,20 @@
-/* Mesh validation and the precomputation every solve reuses: adjacency,
- * edge lengths, corner angles (section 4.1) and virtual edges (section 4.2,
- * in unfold.c). */
+/* The precomputation every solve reuses, from checked arrays: vertex and
+ * face order (order.c), adjacency, edge lengths, corner angles (section
+ * 4.1), virtual edges (section 4.2, in unfold.c) and the face records the
+ * march reads; and the mesh's destruction. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "mesh.h"
+#include "base/error.h"
+#include "build.h"
 #include "order.h"
+#include "unfold.h"
 
-/* Largest coordinate magnitude accepted, and smallest extent: lengths are
- * squared once (1e200 and 1e-200 are far from overflow and underflow). */
-#define MFMM_MAX_COORDINATE 1e100
+/* Smallest extent: lengths are squared once (1e-200 is far from
+ * underflow). */
 #define MFMM_MIN_DIAGONAL 1e-100
-
-void mfmm_mesh_options_init(mfmm_mesh_options *options)
-{
-    if (!options)
-        return;
-    memset(options, 0, sizeof *options);
-    options->struct_size = sizeof *options;
-    options->max_unfold_steps = 64;
-    options->spokes = 1;
-}
 
 void mfmm_mesh_destroy(mfmm_mesh *mesh)
 {
@@ -444,78 +436,6 @@ static mfmm_status build_records(mfmm_mesh *m)
     return MFMM_OK;
 }
 
-static mfmm_status validate(const double *vertices, int32_t nv, const int32_t *faces,
-                            int32_t nf, mfmm_error *err)
-{
-    for (int64_t i = 0; i < (int64_t)nv * 3; i++) {
-        if (!isfinite(vertices[i]))
-            return mfmm_fail(err, MFMM_ERR_NONFINITE_VERTEX, i / 3,
-                             "vertex %lld has a coordinate that is NaN or infinite",
-                             (long long)(i / 3));
-        /* squared lengths must not overflow */
-        if (fabs(vertices[i]) > MFMM_MAX_COORDINATE)
-            return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, i / 3,
-                             "vertex %lld has a coordinate of magnitude %g; coordinates must be "
-                             "within +-%g (rescale the mesh)",
-                             (long long)(i / 3), fabs(vertices[i]), MFMM_MAX_COORDINATE);
-    }
-    for (int64_t f = 0; f < nf; f++) {
-        const int32_t *t = faces + 3 * f;
-        for (int k = 0; k < 3; k++)
-            if (t[k] < 0 || t[k] >= nv)
-                return mfmm_fail(err, MFMM_ERR_INDEX_OUT_OF_RANGE, f,
-                                 "face %lld names vertex %ld, outside [0, %ld) (ids count from 0)",
-                                 (long long)f, (long)t[k], (long)nv);
-        if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
-            return mfmm_fail(err, MFMM_ERR_REPEATED_VERTEX, f,
-                             "face %lld names a vertex twice (%ld, %ld, %ld; ids count from 0)",
-                             (long long)f, (long)t[0], (long)t[1], (long)t[2]);
-    }
-    return MFMM_OK;
-}
-
-mfmm_status mfmm_mesh_create(const double *vertices, int32_t nv, const int32_t *faces,
-                             int32_t nf, const mfmm_mesh_options *options, mfmm_mesh **out,
-                             mfmm_error *err)
-{
-    mfmm_ok(err);
-    if (!out)
-        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "out (the mesh pointer) is NULL");
-    *out = NULL;
-    if (!vertices || !faces)
-        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "%s is NULL",
-                         !vertices ? "vertices" : "faces");
-    if (nv < 1 || nf < 1 || nf > MFMM_MAX_FACES || nv > INT32_MAX / 3)
-        return mfmm_fail(err, MFMM_ERR_BAD_COUNT, -1,
-                         "a mesh needs 1 to %d vertices and 1 to %d faces (got %ld vertices, "
-                         "%ld faces)",
-                         INT32_MAX / 3, MFMM_MAX_FACES, (long)nv, (long)nf);
-    mfmm_mesh_options opt;
-    mfmm_mesh_options_init(&opt);
-    if (options) {
-        if (mfmm_check_struct_size(options, sizeof opt, "mfmm_mesh_options", err) != MFMM_OK)
-            return MFMM_ERR_BAD_ARGUMENT;
-        opt = *options;
-    }
-    if (opt.max_unfold_steps < 1)
-        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "max_unfold_steps must be >= 1 (got %ld)",
-                         (long)opt.max_unfold_steps);
-    if (opt.spokes != 0 && opt.spokes != 1)
-        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "spokes must be 0 or 1 (got %ld)",
-                         (long)opt.spokes);
-    mfmm_status st = validate(vertices, nv, faces, nf, err);
-    if (st != MFMM_OK)
-        return st;
-    mfmm_mesh *m = NULL;
-    st = mfmm_mesh_build(vertices, nv, faces, nf, &opt, &m, err);
-    if (st == MFMM_OK && m->info.n_degenerate_faces > 0)
-        st = mfmm_mesh_close_t_junctions(&m, vertices, nv, faces, nf, &opt, err);
-    if (st != MFMM_OK)
-        return st;
-    *out = m;
-    return MFMM_OK;
-}
-
 mfmm_status mfmm_mesh_build(const double *vertices, int32_t nv, const int32_t *faces,
                             int32_t nf, const mfmm_mesh_options *options, mfmm_mesh **out,
                             mfmm_error *err)
@@ -607,81 +527,4 @@ mfmm_status mfmm_mesh_build(const double *vertices, int32_t nv, const int32_t *f
     }
     *out = m;
     return MFMM_OK;
-}
-
-mfmm_status mfmm_mesh_get_info(const mfmm_mesh *mesh, mfmm_mesh_info *info)
-{
-    if (!mesh || !info)
-        return MFMM_ERR_NULL_POINTER;
-    *info = mesh->info;
-    return MFMM_OK;
-}
-
-int32_t mfmm_mesh_vertex_count(const mfmm_mesh *mesh)
-{
-    return mesh ? mesh->nv : 0;
-}
-
-int32_t mfmm_mesh_face_count(const mfmm_mesh *mesh)
-{
-    return mesh ? mesh->nf_in : 0;
-}
-
-void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_location,
-                       double *uniform)
-{
-    for (int32_t v = 0; v < mesh->nv; v++)
-        uniform[v] = 0.0;
-    for (int32_t f = 0; f < mesh->nf; f++) {
-        const int32_t *fv = mesh->face_records[f].v;
-        double x;
-        if (cost_location == 2) {
-            x = cost[f];
-        } else { /* the face's corners all alike, or -1 */
-            x = cost[fv[0]];
-            if (cost[fv[1]] != x || cost[fv[2]] != x)
-                x = -1.0;
-        }
-        for (int k = 0; k < 3; k++) {
-            double *u = uniform + fv[k];
-            *u = *u == 0.0 || *u == x ? x : -1.0;
-        }
-    }
-}
-
-int mfmm_mesh_memory(const mfmm_mesh *mesh, const char **names, size_t *bytes, int max)
-{
-    if (!mesh || max < 0 || (max > 0 && (!names || !bytes)))
-        return -1;
-    size_t nv = (size_t)mesh->nv, nf = (size_t)mesh->nf, nc = 3 * nf;
-    size_t n_virts = (size_t)mesh->n_virts, n_steps = (size_t)mesh->virt_strip[n_virts];
-    /* the exact tables may be built by another thread meanwhile (mesh.h) */
-    pthread_mutex_t *lock = (pthread_mutex_t *)(uintptr_t)&mesh->cache_lock;
-    pthread_mutex_lock(lock);
-    size_t exact_bytes = mesh->exact_tables_bytes, spoke_bytes = mesh->spokes_bytes;
-    pthread_mutex_unlock(lock);
-    const struct {
-        const char *name;
-        size_t bytes;
-    } a[] = {
-        {"xyz", nv * 3 * sizeof(double)},
-        {"face_neighbor", nc * sizeof(int32_t)},
-        {"vertex_face (CSR)", (nv + 1 + nc) * sizeof(int32_t)},
-        {"to_internal/to_external", 2 * nv * sizeof(int32_t)},
-        {"face_to_internal/external", ((size_t)mesh->nf_in + nf) * sizeof(int32_t) +
-                                          (mesh->piece_next ? nf * (sizeof(int32_t) + 9 * sizeof(double)) : 0)},
-        {"face records", nf * sizeof(mfmm_face)},
-        {"virtual edges", (size_t)mesh->n_virts * sizeof(mfmm_virt) + (nv + 1) * sizeof(int32_t)},
-        {"strip", n_steps * sizeof(int32_t)},
-        {"virt_strip", (n_virts + 1) * sizeof(int32_t)},
-        {"mesh struct", sizeof *mesh},
-        {"exact tables (once built)", exact_bytes},
-        {"spokes (once built)", spoke_bytes},
-    };
-    int n = (int)(sizeof a / sizeof a[0]);
-    for (int i = 0; i < n && i < max; i++) {
-        names[i] = a[i].name;
-        bytes[i] = a[i].bytes;
-    }
-    return n;
 }

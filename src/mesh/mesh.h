@@ -1,4 +1,5 @@
-/* The mesh's internal layout (private to the library). */
+/* The mesh's internal layout (private to the library): the type every
+ * part of the library takes, and small inline accessors. Built by build.c. */
 #ifndef MFMM_MESH_H
 #define MFMM_MESH_H
 
@@ -6,7 +7,7 @@
 #include <pthread.h>
 
 #include "meshfmm.h"
-#include "march.h"
+#include "march/march.h"
 
 /* One face of the strip that a virtual edge C -> V crosses (section 4.2).
  * Not stored: mfmm_strip_next re-walks a strip (unfold.c). */
@@ -111,42 +112,6 @@ static inline mfmm_march_mesh mfmm_mesh_march_view(const mfmm_mesh *mesh)
     return m;
 }
 
-/* The mesh's spokes for the march (march.h: F = 1, unfolding on), built
- * on first use under the mesh's lock and kept until mfmm_mesh_destroy:
- * *offset (nv+1) and *spokes. MFMM_ERR_OUT_OF_MEMORY (both NULL: the
- * face walk gives the same rows) or MFMM_OK (both NULL when the mesh was
- * made with mfmm_mesh_options.spokes = 0). */
-mfmm_status mfmm_mesh_spokes_of(const mfmm_mesh *mesh, const int32_t **offset,
-                                const mfmm_spoke **spokes);
-
-/* Builds a mesh from checked arrays (mfmm_mesh_create's work, without its
- * argument checks and without closing T-junctions): *out, or an error. */
-mfmm_status mfmm_mesh_build(const double *vertices, int32_t nv, const int32_t *faces,
-                            int32_t nf, const mfmm_mesh_options *opt, mfmm_mesh **out,
-                            mfmm_error *err);
-
-/* Closes the T-junctions of *mesh, built from (vertices, nv, faces, nf), in
- * place (tjunction.c): where a zero-area face is a needle A-M-B with M
- * inside edge AB and one face A-B-C across AB, the needle stands for M
- * lying on AB, and the march (no triangle update through zero area) and the
- * paths would go round through A or B. The needle is dropped and A-B-C
- * split at M into two pieces that keep its corner order, rebuilding the
- * mesh until no such needle is left; input face ids, per-face costs,
- * points and paths map through face_to_internal/external and the pieces
- * (order.h). A mesh with none is left as it is. MFMM_OK or an error (the
- * mesh then destroyed and *mesh NULL). */
-mfmm_status mfmm_mesh_close_t_junctions(mfmm_mesh **mesh, const double *vertices, int32_t nv,
-                                        const int32_t *faces, int32_t nf,
-                                        const mfmm_mesh_options *opt, mfmm_error *err);
-
-/* Finds the virtual edge of every obtuse corner by unfolding (section 4.2);
- * fills full[].virt, virt_len, virt_cos_a, virt_cos_b, strip_at, strip_n, the
- * strips' steps (build_steps, corner order) and the counts.
- * Needs the face records' vertices, lengths and cosines, xyz, face_neighbor
- * and the corners (full, corner 3f+k), as mesh creation has them then.
- * MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
-mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *mesh, int32_t max_steps);
-
 /* 1 when face f has zero area (its record's cosines are NaN), else 0. */
 static inline int mfmm_mesh_degenerate(const mfmm_mesh *mesh, int32_t f)
 {
@@ -193,48 +158,5 @@ static inline int32_t mfmm_mesh_virt_index(const mfmm_mesh *mesh, int32_t corner
     mfmm_march_mesh m = mfmm_mesh_march_view(mesh);
     return (int32_t)(mfmm_march_virt_of(&m, fr->virt >> 2, corner) - mesh->virts);
 }
-
-/* A walk along a virtual edge's strip, rebuilding its steps as the build
- * found them (bit for bit): mfmm_strip_begin, then mfmm_strip_next per step.
- * The fields are the walk's. */
-typedef struct mfmm_vec2 {
-    double x, y;
-} mfmm_vec2;
-typedef struct mfmm_strip_walk {
-    const mfmm_mesh *m;
-    int32_t corner, a, b, n, i;
-    int32_t e1, e2, face, opposite, k1, k2;
-    mfmm_vec2 pa, pb, p1, p2, away, pv;
-} mfmm_strip_walk;
-
-/* Starts the walk of virtual edge j's strip (j: index in virts). */
-void mfmm_strip_begin(mfmm_strip_walk *w, const mfmm_mesh *mesh, int32_t j);
-
-/* The walk's next step into *step: 1, or 0 past the last (whose far is V). */
-int mfmm_strip_next(mfmm_strip_walk *w, mfmm_virt_step *step);
-
-/* For the march's virtual stencils under a cost (march.h): uniform[v] = the
- * cost every face around v has (per face), or that v and every neighbour
- * has (per vertex); -1 where they differ; 0 for vertices in no face.
- * cost_location 1 per vertex, 2 per face. */
-void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_location,
-                       double *uniform);
-
-/* Fills err (if any) and returns status. */
-mfmm_status mfmm_fail(mfmm_error *err, mfmm_status status, int64_t index, const char *fmt, ...)
-#ifdef __GNUC__
-    __attribute__((format(printf, 4, 5)))
-#endif
-    ;
-
-/* Marks err as success. */
-void mfmm_ok(mfmm_error *err);
-
-/* Checks a public option struct's struct_size (its first field) against the
- * layout this library knows, `known` = sizeof; MFMM_ERR_BAD_ARGUMENT naming
- * `type` when they differ (a struct not filled by its _init function, or
- * compiled against another header version). */
-mfmm_status mfmm_check_struct_size(const void *options, size_t known, const char *type,
-                                   mfmm_error *err);
 
 #endif /* MFMM_MESH_H */

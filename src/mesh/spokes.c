@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mesh.h"
+#include "spokes.h"
 
 /* One triangle's update of c, as x's face walk computes it. */
 typedef struct spoke_slot {

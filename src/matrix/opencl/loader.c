@@ -1,5 +1,6 @@
 /* The OpenCL ICD loader, opened at run time (see opencl_loader.h). */
-#include "opencl_loader.h"
+#include "base/error.h"
+#include "loader.h"
 
 #ifdef MESHFMM_HAVE_OPENCL
 

@@ -1,6 +1,7 @@
 /* The exact start of a march (seed.h). */
 #include <math.h>
 
+#include "base/error.h"
 #include "seed.h"
 
 mfmm_status mfmm_check_exact_start(double radius, mfmm_error *err)

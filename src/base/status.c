@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mesh.h"
+#include "error.h"
 
 static const char *const status_strings[MFMM_STATUS_COUNT] = {
     [MFMM_OK] = "success",

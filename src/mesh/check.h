@@ -19,4 +19,11 @@ double mfmm_distance_bound(const mfmm_mesh *mesh, const double *cost, mfmm_cost_
 mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int32_t i,
                               mfmm_error *err);
 
+/* For the march's virtual stencils under a cost (march.h): uniform[v] = the
+ * cost every face around v has (per face), or that v and every neighbour
+ * has (per vertex); -1 where they differ; 0 for vertices in no face.
+ * cost_location 1 per vertex, 2 per face. */
+void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_location,
+                       double *uniform);
+
 #endif

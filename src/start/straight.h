@@ -8,7 +8,7 @@
 
 #include <math.h>
 
-#include "mesh.h"
+#include "mesh/mesh.h"
 
 /* The walk reaches faces whose entry edge is nearer the point than this many
  * mean edge lengths (or the longest edge, if longer), at most

@@ -13,7 +13,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mesh.h"
+#include "tjunction.h"
+#include "build.h"
+#include "base/error.h"
 
 /* At most this many rounds (a round splits each face once, so a chain of
  * k vertices on one edge takes k rounds; each round drops a needle of the

@@ -5,7 +5,8 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "mesh.h"
+#include "unfold.h"
+#include "base/error.h"
 
 typedef mfmm_vec2 vec2;
 

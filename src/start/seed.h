@@ -7,8 +7,8 @@
 #ifndef MFMM_SOLVE_SEED_H
 #define MFMM_SOLVE_SEED_H
 
-#include "core/mesh.h"
-#include "core/start.h"
+#include "mesh/mesh.h"
+#include "straight.h"
 #include "exact/exact.h"
 
 /* Validates an exact_start_radius option (MFMM_EXACT_START_AUTO, or finite

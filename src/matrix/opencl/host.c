@@ -8,9 +8,12 @@
  * many threads. */
 #include <string.h>
 
-#include "rows.h"
-#include "opencl_loader.h"
-#include "solve/seed.h"
+#include "base/error.h"
+#include "matrix/rows.h"
+#include "loader.h"
+#include "mesh/check.h"
+#include "mesh/spokes.h"
+#include "start/seed.h"
 
 void mfmm_opencl_options_init(mfmm_opencl_options *options)
 {

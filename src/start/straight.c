@@ -14,7 +14,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "start.h"
+#include "straight.h"
 
 typedef struct v2 {
     double x, y;
