@@ -50,11 +50,4 @@ int mfmm_rows_deliver_sparse(const mfmm_rows_job *job, int32_t first, int32_t n,
 /* Frees the arrays of n sparse rows (after a failure). */
 void mfmm_sparse_rows_free(mfmm_sparse_row *rows, int32_t n);
 
-/* Runs rows [start, n_sources) on an OpenCL device: opt->opencl, else a
- * context made from opt->opencl_options for the call. *rows_done receives the
- * rows delivered (from start) even on failure, so a fallback can go on from
- * there. MFMM_ERR_NO_OPENCL when built without OpenCL or no device works. */
-mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *rows_done,
-                             mfmm_error *err);
-
 #endif

@@ -8,7 +8,6 @@
 
 #include "base/error.h"
 #include "build.h"
-#include "mesh.h"
 #include "tjunction.h"
 
 /* Largest coordinate magnitude accepted: lengths are squared once (1e200
