@@ -10,6 +10,7 @@
 #include "mesh/mesh.h"
 #include "straight.h"
 #include "exact/exact.h"
+#include "patch.h"
 
 /* Validates an exact_start_radius option (MFMM_EXACT_START_AUTO, or finite
  * and >= 0). */

@@ -16,6 +16,7 @@
 
 #include "testutil.h"
 #include "exact/exact.h"
+#include "start/patch.h"
 #include "mesh/mesh.h"
 
 /* ---------------------------------------------------------------- helpers */

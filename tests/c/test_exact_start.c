@@ -16,6 +16,7 @@
 #include "mesh/mesh.h"
 #include "mesh/order.h"
 #include "exact/exact.h"
+#include "start/patch.h"
 #include "testutil.h"
 
 static double *exact_row(const mfmm_mesh *mesh, const mfmm_source *src)
@@ -93,7 +94,7 @@ static void test_patch_is_exact(void **state)
                 isrc.face = mfmm_order_point_in(mesh, isrc.face, isrc.bary, isrc.bary);
             assert_int_equal(mfmm_exact_patch(ws, &isrc, 1, R, 0, &n, &pv, &pd, NULL), MFMM_OK);
             assert_true(n >= 10);
-            /* every vertex within R, and a ring beyond it (exact.c) */
+            /* every vertex within R, and a ring beyond it (start/patch.c) */
             int32_t inside = 0, beyond = 0;
             for (int32_t v = 0; v < nv; v++)
                 inside += e[v] <= R;
@@ -434,7 +435,7 @@ static void test_saddle_corner_continuous(void **state)
             p.bary[c % 3] = 1.0 - 2e-9;
             solve_r(solver, &p, MFMM_EXACT_START_RADIUS, d1);
             /* the exact solver itself: within the move (1-Lipschitz); it left
-             * vertices at +inf before its near-source fix (exact.c, EX_NEAR) */
+             * vertices at +inf before its near-source fix (exact/state.h, EX_NEAR) */
             double *e1 = exact_row(mesh, &p);
             double move = 0.0;
             for (int j = 0; j < 3; j++) {

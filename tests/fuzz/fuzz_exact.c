@@ -49,6 +49,7 @@
 #include "byte_reader.h"
 #include "mesh/order.h"
 #include "exact/exact.h"
+#include "start/patch.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -284,7 +285,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             int32_t inside = 0, in_r = 0;
             for (int32_t v = 0; v < nv; v++)
                 inside += e[v] <= R;
-            /* every value exact, those beyond R too (the ring of exact.c);
+            /* every value exact, those beyond R too (the ring of start/patch.c);
              * where the full solve fell back to walls at non-manifold edges
              * (its budget passed beyond R), the patch's values are at most
              * its upper bounds */
