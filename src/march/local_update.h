@@ -72,7 +72,7 @@ typedef struct mfmm_virt {
 } mfmm_virt;
 
 /* A spoke: what vertex x's settling offers one neighbour c at F = 1 with
- * unfolding (march.h, the spoke walk; built by src/core/spokes.c): |xc| and
+ * unfolding (march.h, the spoke walk; built by src/mesh/spokes.c): |xc| and
  * the (up to) two triangles through x that update c, each with its third
  * vertex y, |yc| and the cosine at c, oriented for mfmm_triangle_interior
  * (bit s of x_is_a: x is the triangle's A, so a = |yc| and b = |xc|).
@@ -95,9 +95,8 @@ typedef struct mfmm_spoke {
 /* An entry of a vertex's face list (mfmm_march_mesh.wedge): face f where
  * the vertex is corner k, packed as 16 f + 4 ((k + 2) mod 3) + (k + 1) mod 3,
  * so that the march reads the face and the corners after k by shifts and
- * masks (from a corner id 3 f + k, a division and two table lookups per
- * face: 3.5-5 % of the march, bench/ab_solve.py). Hence at most
- * MFMM_MAX_FACES faces. */
+ * masks rather than a division and two table lookups
+ * (docs/march-measurements.md). Hence at most MFMM_MAX_FACES faces. */
 #define MFMM_MAX_FACES (0x7fffffff / 16)
 #define MFMM_WEDGE(f, k) (16 * (f) + 4 * (((k) + 2) % 3) + ((k) + 1) % 3)
 #define MFMM_WEDGE_FACE(w) ((mfmm_i32)((mfmm_u32)(w) >> 4))
@@ -149,11 +148,10 @@ MFMM_INLINE double mfmm_min(double x, double y)
  *   F (b cos theta - a) < u < F (b - a cos theta).
  * Outside these bounds, widened by 1e-8 (a + b), the update is +inf without
  * its division and two square roots, and its branch is taken before them;
- * inside them the test above decides as before. So the local update (with
- * its edges) is the same bit for bit (test_local_update; all rows of seven
- * meshes): the bounds reject 1.2-1.5 of the 2.2-2.5 triangles evaluated per
- * settled vertex, every one the test rejects, and the march runs 0.91x
- * (bench/bench_spokes.c). (Alone, the test after the root accepts some
+ * inside them the test above decides. So the local update (with its edges)
+ * is the same bit for bit (test_local_update), and most triangles are
+ * rejected before the root (docs/march-measurements.md). (Alone, the test
+ * after the root accepts some
  * u > F c on slivers, where no root exists, at values above the edge
  * update; where rounding would put a needle on the other side of a bound,
  * the update is within 1e-8 of the edge update it borders.) */
@@ -184,8 +182,7 @@ MFMM_INLINE double mfmm_triangle_interior(double ta, double tb, double a, double
     double t = alpha * u + beta * sqrt(d);
     if (!(t > u)) /* also rejects NaN */
         return MFMM_INF;
-    /* the test with x = CD = b (t - u) / t of section 4.1, multiplied by t > 0
-     * (measured: these as one select instead of two branches, no faster) */
+    /* the test with x = CD = b (t - u) / t of section 4.1, multiplied by t > 0 */
     double xt = lb * (t - u);
     if (la * cos_c * t < xt && xt * cos_c < la * t)
         return t0 + t;

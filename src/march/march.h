@@ -1,7 +1,7 @@
 /*
  * The heap Fast Marching loop of section 2, over the arrays a mesh
- * precomputes. Shared by the C core (src/solve.c) and the OpenCL kernel
- * (kernels/), like local_update.h: one march, one result.
+ * precomputes. Shared by the C core (src/solve/solve.c) and the OpenCL
+ * kernel (kernels/fmm_rows.cl), like local_update.h: one march, one result.
  *
  * Workspace per march (all of nv entries): T (double), label (u8), heap keys
  * (double), heap vertices (i32), heap positions (i32).
@@ -70,19 +70,9 @@ typedef struct mfmm_march_state {
  * the sequence of pushes, which every backend runs alike. ---- */
 
 #ifndef MFMM_HEAP_ARITY
-/* measured: 2, 4, 8, 16 -> 8 fastest (bench_solve); 4 later 1-3 % faster on
- * small meshes, but it settles equal keys in another order (icosphere rows
- * change), so rows would not stay bit-identical.
- * Measured (bench_solve, 10 alternating rounds, camelhead, bunny, nefertiti,
- * igea, plain and exact start; median march time against this heap): arity
- * 4 -2 to +2 % (igea slower); ties by (key, vertex id) +2 to +10 % (a tie
- * flag in the child scan, or an SSE2 min tree); a radix heap on T's bits
- * (bucket lists linked through the vertices) +14 to +24 %; a window of
- * buckets of T +16 to +36 % (camelhead); a lazy heap without decrease-key
- * +25 to +69 %; a bottom-up pop, 64-byte aligned children: +-1 %. The
- * bucket window ran 24 % fewer instructions (the radix heap 5 % more), but
- * both mispredict their list walks (camelhead 11.4 -> 14-15 per settled
- * vertex) and wait on the links. */
+/* 8 was the fastest arity, and bucket, radix and lazy heaps were slower
+ * (docs/march-measurements.md); the arity also fixes the order in which
+ * equal keys settle, so it cannot change without changing rows. */
 #define MFMM_HEAP_ARITY 8
 #endif
 
@@ -129,8 +119,8 @@ MFMM_INLINE mfmm_i32 mfmm_heap_pop(mfmm_march_state *s)
                 break;
             mfmm_i32 child = first;
             double ck = s->heap_key[first];
-            /* (a loop with a branch: unrolled, or without branches (cmov,
-             * a tournament), it ran fewer instructions but 4-18 % slower) */
+            /* (a loop with a branch: faster than unrolled or branch-free
+             * scans, docs/march-measurements.md) */
             mfmm_i32 last = first + MFMM_HEAP_ARITY < n ? first + MFMM_HEAP_ARITY : n;
             for (mfmm_i32 c = first + 1; c < last; c++)
                 if (s->heap_key[c] < ck) {
@@ -266,10 +256,9 @@ MFMM_INLINE void mfmm_march_offer_to(mfmm_march_state *s, const mfmm_march_mesh 
     if (t < s->T[c]) {
         mfmm_u8 st = lc & MFMM_STATE_MASK;
         /* c joins the front: its own spokes or faces are read when it
-         * settles. Its spokes (~7 lines) are fetched now, long before
-         * (measured, bench_spokes: one line -> six, march nefertiti -9 %,
-         * sine 500 -14 %, camelhead within noise; from a cold cache -12 to
-         * -20 %; eight no better, a loop to the exact end slower) */
+         * settles. Its spokes (~7 lines) are fetched now, long before, so
+         * that they are in cache when it settles
+         * (docs/march-measurements.md) */
         if (st == MFMM_FAR) {
             if (spokes) {
                 MFMM_GLOBAL const char *b = (MFMM_GLOBAL const char *)(m->spokes + m->spoke_offset[c]);
@@ -387,7 +376,7 @@ MFMM_COLD void mfmm_march_virtual(mfmm_march_state *s, const mfmm_march_mesh *m,
     mfmm_march_offer(s, m, c, lc, best);
 }
 
-/* Seeds v at an exact value (the exact start, src/solve/seed.h): as
+/* Seeds v at an exact value (the exact start, src/start/seed.h): as
  * mfmm_march_seed, and the march never lowers it, since an update from
  * first-order neighbours can only add error to an exact value. */
 MFMM_INLINE void mfmm_march_seed_fixed(mfmm_march_state *s, mfmm_i32 v, double value)
@@ -397,7 +386,7 @@ MFMM_INLINE void mfmm_march_seed_fixed(mfmm_march_state *s, mfmm_i32 v, double v
         s->label[v] = (mfmm_u8)(s->label[v] | MFMM_FIXED);
 }
 
-/* Seeds one source's exact patch (the exact start, src/solve/seed.h): the
+/* Seeds one source's exact patch (the exact start, src/start/seed.h): the
  * n vertices pv at values value + f * pd, final (mfmm_march_seed_fixed), in
  * this order. A patch vertex whose neighbours are all in the patch, as are
  * the corners of the virtual edges that end at it, settles here, off the
@@ -474,9 +463,8 @@ MFMM_INLINE mfmm_i32 mfmm_march_loop(mfmm_march_state *s, const mfmm_march_mesh 
         double tx = w.T[x];
         /* the virtual edges that end at x (section 4.2), before x's faces:
          * their records and C's face are loads of their own, which then
-         * overlap with the face walk instead of waiting after it (measured:
-         * nefertiti unfolding 1 7.48 -> 7.14 ms; after the walk, behind a
-         * flag in x's faces, they cost 2.5x main's virtual entries) */
+         * overlap with the face walk instead of waiting after it
+         * (docs/march-measurements.md) */
         if (w.unfolding)
             for (mfmm_i32 j = mm.virt_first[x]; j < mm.virt_first[x + 1]; j++) {
                 MFMM_GLOBAL const mfmm_virt *vr = mm.virts + j;
@@ -512,17 +500,12 @@ MFMM_INLINE mfmm_i32 mfmm_march_loop(mfmm_march_state *s, const mfmm_march_mesh 
                 mfmm_march_offer(&w, &mm, c, lc, t);
             }
         /* section 2's update of x's neighbours, face by face. x's faces are
-         * in fan order (mesh.c): face (x, p, q) is mostly followed by
+         * in fan order (mesh/build.c): face (x, p, q) is mostly followed by
          * (x, q, r), so q's value waits one face (pend) and is offered once
-         * with what that face gives it: the min of the same values in 40 %
-         * fewer offers (camelhead, cachegrind). Measured, march: fan order
-         * -10 to -16 % (settled neighbours come in runs: the branches on
-         * them mispredict 2.1 instead of 3.9 times per settled vertex), this
-         * another -1.5 to -2.5 %. Around a closed fan the first face's p
-         * is the last face's q: its value waits for the fan's end (first)
-         * and goes with the last pend, one offer instead of two (the spokes
-         * then hold one record fewer per vertex: 7.95 -> 6.96 on sine 316,
-         * march -1.5 to -3 %, bench_spokes) */
+         * with what that face gives it: the min of the same values in fewer
+         * offers. Around a closed fan the first face's p is the last face's
+         * q: its value waits for the fan's end (first) and goes with the
+         * last pend, one offer instead of two (docs/march-measurements.md) */
         mfmm_i32 pend = -1, first = -1, j0 = mm.wedge_offset[x];
         double pend_t = 0.0, first_t = 0.0;
         for (mfmm_i32 j = j0; j < end; j++) {
@@ -549,14 +532,8 @@ MFMM_INLINE mfmm_i32 mfmm_march_loop(mfmm_march_state *s, const mfmm_march_mesh 
              * and V once V is Alive, with the virtual edge from V (V's
              * settling offered it too: equal, so min leaves it). The same
              * operands as mfmm_march_corner, so that both round alike.
-             * (Unfolding costs 3.1-3.3 mispredictions and 90-97 instructions
-             * per settled vertex, +27-35 % of the march: camelhead,
-             * nefertiti. Reading V's record for every face and selecting
-             * instead of branching on jv == jp, jq saved 1.1 of them but ran
-             * +6 % / +16 % slower with unfolding on / off, camelhead: GCC
-             * threads a ?: select into one branch through every use, and the
-             * arithmetic selects cost more. A record index in the face in
-             * place of V, +7 B/vertex: within 1 %.) */
+             * (Branching on jv == jp, jq is faster than selecting:
+             * docs/march-measurements.md.) */
             mfmm_i32 jv = (fr->virt | no_virt) & 3; /* 3: none */
             if (!alive_p && !(lp & MFMM_FIXED)) {
                 double t;
@@ -659,8 +636,8 @@ MFMM_INLINE double mfmm_march_spoke_triangle(const mfmm_march_state *w,
  * face walk (mfmm_march_loop with general = 0), the same operands in the
  * same order of offers, so the same rows bit for bit, from records that
  * hold them ready: no case for virtual stencils, one offer per spoke, x's
- * spokes read in one sequence (measured: 0.73-0.79x
- * the face walk's march, 56 instead of 72-byte records 0.77-0.87x).
+ * spokes read in one sequence, faster than the face walk
+ * (docs/march-measurements.md).
  * A virtual edge's own term (T(V) + |CV|) and the edges from A and B are
  * not in its spokes: V's, A's and B's settling offered them. */
 MFMM_INLINE mfmm_i32 mfmm_march_spoke_loop(mfmm_march_state *s, const mfmm_march_mesh *m)
@@ -723,7 +700,8 @@ MFMM_INLINE mfmm_i32 mfmm_march_run(mfmm_march_state *s, const mfmm_march_mesh *
     if (settled == m->nv && !targets)
         return settled;
     /* a list is worth it for a local march; past nv/8 touched vertices a
-     * sequential pass is cheaper than scattered ones (measured, bench_scale) */
+     * sequential pass is cheaper than scattered ones
+     * (docs/march-measurements.md) */
     if (s->touched && s->n_touched < m->nv / 8) {
         for (mfmm_i32 i = 0; i < s->n_touched; i++) {
             mfmm_i32 v = s->touched[i];
