@@ -111,8 +111,8 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
  * needle (m on the segment ab, faces on ab one side and on am, mb the
  * other) joins the faces on both sides along the line. The window goes on,
  * in the same plane, from each overlap into the face across it (ex_emit):
- * the same straight paths. Before, D was a wall, and a shortest path
- * across the junction went round through a vertex. */
+ * the same straight paths. As a wall, D would make a shortest path
+ * across the junction go round through a vertex. */
 static void ex_pass(mfmm_exact_ws *ws, int32_t hd, int flip, double L, double s0, double s1,
                     double ix, double iy, double sigma)
 {

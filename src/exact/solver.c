@@ -259,7 +259,7 @@ mfmm_status mfmm_solve_exact(mfmm_exact_solver *solver, const mfmm_source *sourc
     mfmm_status st = ex_check_sources(solver, sources, n_sources, err);
     if (st != MFMM_OK)
         return st;
-    /* vertex sources in the mesh's internal order (core/order.h) */
+    /* vertex sources in the mesh's internal order (mesh/order.h) */
     mfmm_mapped_args mapped = {0};
     if (mfmm_order_map_args(solver->mesh, sources, n_sources, NULL, 0, NULL, 0, NULL, &mapped) !=
         MFMM_OK)

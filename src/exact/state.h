@@ -91,7 +91,7 @@ typedef struct ex_rec {
 
 /* The read-only tables of a mesh (exact.h): built once, shared by the
  * workspaces of any number of threads. Faces are laid out in the order of
- * their least (internal, Morton-ordered: core/order.c) vertex, so that a
+ * their least (internal, Morton-ordered: mesh/order.c) vertex, so that a
  * patch's faces lie together in memory: in the files' order the faces
  * around a vertex were 12,000 records apart on the bunny. */
 struct mfmm_exact_tables {

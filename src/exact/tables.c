@@ -47,8 +47,8 @@ static int ex_i32_pair_cmp(const void *pa, const void *pb)
 /* Non-manifold edges (three or more faces, copies aside) join every face on
  * them: a shortest path may cross from any of them into any other. Their
  * half-edges (across -1) get flip 2 and a place in a cycle per edge
- * (nm_he, nm_next), which ex_fan_out walks. Before, they were walls, and a
- * path through one bent at a vertex (beetle: up to 0.03, 5 %, too long). 0, or
+ * (nm_he, nm_next), which ex_fan_out walks. As walls, they would make a
+ * path through one bend at a vertex (beetle: up to 0.03, 5 %, too long). 0, or
  * -1 when out of memory. */
 static int ex_link_nonmanifold(mfmm_exact_tables *t)
 {

@@ -88,7 +88,7 @@ static int64_t solve_row(const mfmm_rows_job *job, mfmm_solver *solver,
     if (settled < 0)
         return -1;
     if (!job->targets && !job->sparse) {
-        /* the row's one pass: gathered into input order (core/order.h) */
+        /* the row's one pass: gathered into input order (mesh/order.h) */
         const int32_t *in = job->mesh->to_internal;
         if (job->elem_size == sizeof(double)) {
             double *d = (double *)dst;

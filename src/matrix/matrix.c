@@ -1,5 +1,5 @@
 /* mfmm_distance_matrix: many sources, rows handed out in blocks, on the
- * serial core (one thread or many) or on OpenCL (src/opencl_host.c). */
+ * serial core (one thread or many) or on OpenCL (opencl/). */
 #include <float.h>
 #include <math.h>
 #include <pthread.h>
@@ -133,7 +133,7 @@ mfmm_status mfmm_distance_matrix(const mfmm_mesh *mesh, const int32_t *sources,
                             (double)FLT_MAX, mesh->info.mean_edge_length * mesh->info.n_edges,
                             cost ? ", times the largest cost" : "");
     }
-    /* ids and costs in the mesh's internal order (core/order.h), after the
+    /* ids and costs in the mesh's internal order (mesh/order.h), after the
      * checks (whose messages name the caller's ids) */
     double *mapped_cost = NULL;
     if (cst == MFMM_OK && own_cost) {

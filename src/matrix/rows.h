@@ -1,6 +1,6 @@
 /* Internal: a validated many-source job and the delivery of its rows
  * (rows.c), shared by the CPU engines (matrix.c) and the OpenCL backend
- * (opencl_host.c). */
+ * (opencl/rows.c). */
 #ifndef MFMM_MATRIX_ROWS_H
 #define MFMM_MATRIX_ROWS_H
 

@@ -18,7 +18,7 @@ typedef struct mfmm_virt_step {
     double t;       /* CV crosses it at e1 + t (e2 - e1) */
 } mfmm_virt_step;
 
-/* A corner while the mesh is built (mesh.c, unfold.c), by corner id 3f+k;
+/* A corner while the mesh is built (build.c, unfold.c), by corner id 3f+k;
  * the march gets records per face (mfmm_face, mfmm_virt) from these. virt:
  * V's id >= 0 (the obtuse corner is split by the virtual edge to V), or one
  * of the MFMM_VIRT_ codes. */
@@ -57,7 +57,7 @@ struct mfmm_mesh {
                                   -1 at a boundary or non-manifold edge */
     int32_t *vertex_face_offset; /* (nv+1,) CSR: each vertex's faces, as
                                     MFMM_WEDGE(f, k) (local_update.h), in fan
-                                    order (mesh.c fan_order) */
+                                    order (build.c fan_order) */
     int32_t *vertex_wedge;
     mfmm_corner_full *full;    /* (3 nf,) while building only, then NULL */
     mfmm_face *face_records;   /* (nf,) for the march (local_update.h), 64-byte aligned;

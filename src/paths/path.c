@@ -111,7 +111,7 @@ mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
     }
 
     /* the caller's T, target, sources and per-vertex cost in the mesh's
-     * internal vertex order (core/order.h); points hold faces only */
+     * internal vertex order (mesh/order.h); points hold faces only */
     mfmm_mapped_args mapped = {0};
     mfmm_source target_in = *target;
     if (target_in.face == -1)

@@ -412,7 +412,7 @@ static int follow_virt(tracer *t, pos *p, int32_t c)
     return mfmm_path_emit(t, f, p->b) ? 1 : -1;
 }
 
-/* The best straight way from a point source to one vertex (start.c). */
+/* The best straight way from a point source to one vertex (start/straight.c). */
 typedef struct walk_find {
     int32_t target;
     double value, best;

@@ -1,6 +1,6 @@
 /* The public solver: a reusable workspace, the checks, and one march
- * (core/march.h) from the exact start (seed.h) or the straight one
- * (core/start.h). */
+ * (march/march.h) from the exact start (start/seed.h) or the straight
+ * one (start/straight.h). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

@@ -191,7 +191,7 @@ mfmm_status mfmm_exact_start_seed(const mfmm_mesh *mesh, mfmm_exact_ws **ws,
     }
     if (src->face >= 0) {
         /* the straight start's vertices beyond the patch: its walk reaches
-         * the mesh's longest edge (start.c), up to 12 mean edges on the
+         * the mesh's longest edge (straight.c), up to 12 mean edges on the
          * test meshes, exact where the surface is flat; without them a
          * face source started worse than the plain start (fertility 1.12x) */
         beyond_ctx c = {st, *ws, src->value, R};

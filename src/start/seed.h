@@ -2,7 +2,7 @@
  * exact distances of the vertices near a point source seed the march in
  * place of the paper's start, which creates most of a first-order march's
  * error at the source's point singularity. Shared by the solver (solve.c)
- * and the OpenCL host (matrix/opencl_host.c), which computes each row's
+ * and the OpenCL host (matrix/opencl/rows.c), which computes each row's
  * seeds and uploads them, so that every backend seeds alike. */
 #ifndef MFMM_SOLVE_SEED_H
 #define MFMM_SOLVE_SEED_H
@@ -32,7 +32,7 @@ double mfmm_exact_start_edges(const mfmm_mesh *mesh, double radius, double max_d
  * order. Applies only where the cost is one F over the patch: uniform (see
  * mfmm_uniform_cost, NULL when cost is NULL) equal at every patch vertex;
  * elsewhere, and for radius 0, *n is 0 and the caller takes the straight
- * start (core/start.h). The patch ends at max_distance (T beyond it is
+ * start (start/straight.h). The patch ends at max_distance (T beyond it is
  * +inf in the row), so that a local row costs its reach and is exact where
  * it is finite within the radius. *ws is the exact workspace, made here on first use
  * (the caller frees it with mfmm_exact_ws_destroy).
@@ -50,7 +50,7 @@ mfmm_status mfmm_exact_start(const mfmm_mesh *mesh, mfmm_exact_ws **ws, const mf
 /* Seeds one checked source into a reset march state (cost fields set): its
  * exact start (mfmm_exact_start, uniform as there) where that applies, at
  * value + F * d, final where `fixed` (one source: the march never lowers
- * them); for a point, also the straight start's vertices (core/start.h)
+ * them); for a point, also the straight start's vertices (start/straight.h)
  * beyond the patch, which the march may lower. Elsewhere the straight
  * start alone. n_fallback as for mfmm_exact_start. MFMM_ERR_OUT_OF_MEMORY as
  * mfmm_exact_start. */

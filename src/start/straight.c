@@ -1,4 +1,4 @@
-/* The straight start around a point source (start.h). Seeding only
+/* The straight start around a point source (straight.h). Seeding only
  * the source face's corners and the far vertices across its edges made T
  * depend on which face names a point on an edge and jump when the point
  * moves off the edge. Here the faces holding the point are all start faces,

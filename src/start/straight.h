@@ -19,7 +19,7 @@
 /* Where a checked point source (face >= 0) lies, from its barycentric
  * coordinates (weights <= 0 count as 0): at a vertex (two zero weights), on
  * an edge (one), or inside its face. Shared by the straight start and the
- * exact start (solve/seed.c), which must agree on it. */
+ * exact start (start/seed.c), which must agree on it. */
 typedef enum mfmm_source_kind { MFMM_AT_VERTEX, MFMM_ON_EDGE, MFMM_IN_FACE } mfmm_source_kind;
 typedef struct mfmm_source_loc {
     mfmm_source_kind kind;

@@ -1,4 +1,4 @@
-/* A built mesh's memory (issue 13.3): at most 300 bytes per vertex on every
+/* A built mesh's memory: at most 300 bytes per vertex on every
  * shared mesh and on generated sine and sphere meshes, counted array by
  * array (mfmm_mesh_memory); and the virtual edges' strips, which the mesh
  * keeps only as their vertices (mesh.h), re-walked (mfmm_strip_next) to the

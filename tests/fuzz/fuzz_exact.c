@@ -66,7 +66,7 @@ static double dist3(const double *a, const double *b)
 }
 
 /* A face of nonzero area with a factor 4 over the library's zero-area test
- * (src/core/mesh.c: the sine between two unit edge vectors above
+ * (src/mesh/build.c: the sine between two unit edge vectors above
  * 64 eps (lmax / l0) (lmax / l1)). */
 static int solid_face(const double *V, const int32_t *f)
 {
@@ -276,7 +276,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         const int32_t *pv = NULL;
         const double *pd = NULL;
         double R = radius * 0.5;
-        mfmm_source isrc = src[0]; /* the patch API takes internal ids (core/order.h) */
+        mfmm_source isrc = src[0]; /* the patch API takes internal ids (src/mesh/order.h) */
         if (isrc.face < 0)
             isrc.vertex = mfmm_vertex_in(mesh, isrc.vertex);
         else /* faces are numbered internally too, and split at T-junctions */

@@ -1,4 +1,4 @@
-/* The OpenCL ICD loader, opened at run time (see opencl_loader.h). */
+/* The OpenCL ICD loader, opened at run time (see loader.h). */
 #include "base/error.h"
 #include "loader.h"
 

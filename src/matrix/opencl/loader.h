@@ -59,7 +59,7 @@ typedef struct mfmm_cl_api {
  * the missing symbol, when it cannot; *api is then empty. */
 mfmm_status mfmm_cl_api_load(mfmm_cl_api *api, const char *library, mfmm_error *err);
 
-/* Forgets the table (the library stays loaded; see opencl_loader.c). */
+/* Forgets the table (the library stays loaded; see loader.c). */
 void mfmm_cl_api_unload(mfmm_cl_api *api);
 
 #endif /* MESHFMM_HAVE_OPENCL */
