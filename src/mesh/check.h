@@ -1,4 +1,4 @@
-/* The checks of a solve's arguments, shared by the solvers above core
+/* The checks of a solve's arguments, shared by the rooms above the mesh
  * (src/solve, src/exact) and the matrix jobs (private to the library). */
 #ifndef MFMM_CHECK_H
 #define MFMM_CHECK_H

@@ -1,4 +1,4 @@
-/* T-junctions closed by needle faces (mesh.h, mfmm_mesh_close_t_junctions).
+/* T-junctions closed by needle faces (tjunction.h, mfmm_mesh_close_t_junctions).
  *
  * Exporters and repair tools close a T-junction, a vertex M lying inside
  * the edge AB of face A-B-C, with a zero-area face A-M-B. That face takes no

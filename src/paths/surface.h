@@ -1,4 +1,4 @@
-/* Small surface-point helpers shared by path tracing (trace.c) and
+/* Small surface-point helpers shared by path tracing (field.c, trace.c, path.c) and
  * straightening (straighten.c). */
 #ifndef MFMM_PATHS_SURFACE_H
 #define MFMM_PATHS_SURFACE_H
