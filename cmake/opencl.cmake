@@ -1,16 +1,16 @@
-# The OpenCL backend (issue 4). Included by the top-level CMakeLists.txt; also
-# run as a script (cmake -P) at build time to embed kernels/fmm_rows.cl with
-# its #include "local_update.h" / "march.h" lines replaced by those files, so
-# the embedded program is self-contained.
+# The OpenCL backend. Included by the top-level CMakeLists.txt; also run as a
+# script (cmake -P) at build time to embed kernels/fmm_rows.cl with its
+# #include "march/march.h" line replaced by src/march/march.h (and that
+# file's #include "local_update.h" by src/march/local_update.h), so the
+# embedded program is self-contained.
 
 if(CMAKE_SCRIPT_MODE_FILE)
-  # -DKERNEL=... -DSRC_DIR=... -DOUT=...
-  file(READ "${SRC_DIR}/local_update.h" lu)
-  file(READ "${SRC_DIR}/march.h" march)
+  # -DKERNEL=... -DSRC_DIR=<src/> -DOUT=...
+  file(READ "${SRC_DIR}/march/local_update.h" lu)
+  file(READ "${SRC_DIR}/march/march.h" march)
   file(READ "${KERNEL}" text)
   string(REPLACE "#include \"local_update.h\"" "${lu}" march "${march}")
-  string(REPLACE "#include \"march.h\"" "${march}" text "${text}")
-  string(REPLACE "#include \"local_update.h\"" "${lu}" text "${text}")
+  string(REPLACE "#include \"march/march.h\"" "${march}" text "${text}")
   if(text MATCHES "#include \"")
     message(FATAL_ERROR "${KERNEL}: an #include was left unexpanded")
   endif()
@@ -35,7 +35,7 @@ if(NOT MESHFMM_WITH_OPENCL)
 endif()
 
 # Only the headers: libmeshfmm opens the ICD loader (libOpenCL.so.1) at run
-# time (src/matrix/opencl_loader.c), so it links no OpenCL library and loads on
+# time (src/matrix/opencl/loader.c), so it links no OpenCL library and loads on
 # machines without one.
 find_path(MESHFMM_OPENCL_INCLUDE_DIR CL/cl.h
   HINTS ${OpenCL_INCLUDE_DIR} ENV OpenCL_ROOT
@@ -49,11 +49,11 @@ message(STATUS "meshfmm: OpenCL backend on (headers in ${MESHFMM_OPENCL_INCLUDE_
 set(MESHFMM_KERNEL_C ${CMAKE_CURRENT_BINARY_DIR}/generated/fmm_rows_cl.c)
 add_custom_command(OUTPUT ${MESHFMM_KERNEL_C}
   COMMAND ${CMAKE_COMMAND} -DKERNEL=${CMAKE_CURRENT_SOURCE_DIR}/kernels/fmm_rows.cl
-          -DSRC_DIR=${CMAKE_CURRENT_SOURCE_DIR}/src/core -DOUT=${MESHFMM_KERNEL_C}
+          -DSRC_DIR=${CMAKE_CURRENT_SOURCE_DIR}/src -DOUT=${MESHFMM_KERNEL_C}
           -P ${CMAKE_CURRENT_SOURCE_DIR}/cmake/opencl.cmake
   DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/kernels/fmm_rows.cl
-          ${CMAKE_CURRENT_SOURCE_DIR}/src/core/local_update.h
-          ${CMAKE_CURRENT_SOURCE_DIR}/src/core/march.h
+          ${CMAKE_CURRENT_SOURCE_DIR}/src/march/local_update.h
+          ${CMAKE_CURRENT_SOURCE_DIR}/src/march/march.h
           ${CMAKE_CURRENT_SOURCE_DIR}/cmake/opencl.cmake
   COMMENT "Embedding kernels/fmm_rows.cl"
   VERBATIM)

@@ -1,12 +1,12 @@
 /*
  * Many sources at once: one work-item runs one source's full heap march
- * (src/march.h, the serial core's own code) and writes that source's row.
+ * (src/march/march.h, the serial core's own code) and writes that source's row.
  * Per-item workspaces are item-contiguous slices of nv entries. With
  * targets (n_targets > 0) a row marches until its targets settle (the
  * serial solver's early stop, the same flags) and writes only their columns.
  *
  * A row starts from its source's vertex, or (exact start, n_seeds > 0) from
- * the seeds the host computed for it (src/solve/seed.h): for the batch's row
+ * the seeds the host computed for it (src/start/seed.h): for the batch's row
  * i, vertices seeds[j] at values seed_value[j] for j in [seeds[i],
  * seeds[i + 1]), seeded in that order, as the serial solver does.
  *
@@ -14,7 +14,7 @@
  * FP_CONTRACT OFF, so rows equal the C core's bit for bit in float64.
  * The host embeds this file with the #include lines replaced by the headers.
  */
-#include "march.h"
+#include "march/march.h"
 
 /* The march for source sources[first + gid], with T in T_row. */
 inline void mfmm_row_march(int nv, __global const int *wedge_offset,
@@ -79,7 +79,7 @@ inline void mfmm_row_march(int nv, __global const int *wedge_offset,
 
 /* float64 rows: T in a workspace slice, the row gathered from it in the
  * caller's vertex order (order: internal id of each input vertex, as
- * src/core/order.h), or the target columns copied out. */
+ * src/mesh/order.h), or the target columns copied out. */
 __kernel void fmm_rows_f64(int nv, __global const int *wedge_offset,
                            __global const int *wedge,
                            __global const mfmm_face *faces, __global const double *cost,

@@ -36,7 +36,7 @@
 
 #include "bench_util.h"
 #include "meshfmm.h"
-#include "exact/exact.h"
+#include "start/patch.h"
 
 static int bench(const char *path, double edges, int n_sources)
 {

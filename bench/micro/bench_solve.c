@@ -25,7 +25,8 @@
 
 #include "bench_util.h"
 #include "meshfmm.h"
-#include "core/mesh.h"
+#include "mesh/mesh.h"
+#include "mesh/spokes.h"
 #include "io/generate.h"
 
 /* The march's edge graph as CSR with lengths, in the mesh's internal order. */

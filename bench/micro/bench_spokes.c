@@ -78,7 +78,8 @@
 
 #include "bench_util.h"
 #include "meshfmm.h"
-#include "core/mesh.h"
+#include "mesh/mesh.h"
+#include "mesh/spokes.h"
 
 static double median(double *x, int n)
 {

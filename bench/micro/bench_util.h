@@ -8,7 +8,7 @@
 #include <time.h>
 
 #include "meshfmm.h"
-#include "core/march.h"
+#include "march/march.h"
 
 /* Wall-clock seconds (monotonic). */
 static inline double now(void)

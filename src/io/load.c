@@ -11,7 +11,7 @@
 #include <unistd.h>
 
 #include "io.h"
-#include "core/mesh.h"
+#include "base/error.h"
 
 #define FORMATS_READ "meshfmm reads OBJ, OFF, PLY (ascii and binary) and STL (ascii and binary)"
 

@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "io.h"
-#include "core/mesh.h"
+#include "base/error.h"
 
 static int is_blank(char c)
 {

@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "io.h"
-#include "core/mesh.h"
+#include "base/error.h"
 
 typedef struct off_cursor {
     const char *p, *end;

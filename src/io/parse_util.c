@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "io.h"
-#include "core/mesh.h"
+#include "base/error.h"
 
 void mfmm_io_vec_init(mfmm_io_vec *v, size_t elem)
 {

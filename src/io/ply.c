@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "io.h"
-#include "core/mesh.h"
+#include "base/error.h"
 
 #define PLY_MAX_ELEMENTS 32
 #define PLY_MAX_PROPS 64

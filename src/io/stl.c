@@ -12,7 +12,7 @@
 #include <string.h>
 
 #include "io.h"
-#include "core/mesh.h"
+#include "base/error.h"
 
 /* ---- welding: open addressing on the coordinates' bits ---- */
 

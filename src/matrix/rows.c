@@ -1,5 +1,5 @@
 /* Handing finished rows to the caller, shared by every row engine
- * (matrix.c's serial and thread engines, opencl_host.c). */
+ * (cpu.c's serial and thread engines, opencl/rows.c). */
 #include <stdlib.h>
 #include <string.h>
 

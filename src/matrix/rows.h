@@ -1,10 +1,10 @@
 /* Internal: a validated many-source job and the delivery of its rows
  * (rows.c), shared by the CPU engines (matrix.c) and the OpenCL backend
- * (opencl_host.c). */
+ * (opencl/rows.c). */
 #ifndef MFMM_MATRIX_ROWS_H
 #define MFMM_MATRIX_ROWS_H
 
-#include "core/mesh.h"
+#include "mesh/mesh.h"
 
 /* A validated matrix job. */
 typedef struct mfmm_rows_job {
@@ -51,12 +51,5 @@ int mfmm_rows_deliver_sparse(const mfmm_rows_job *job, int32_t first, int32_t n,
 
 /* Frees the arrays of n sparse rows (after a failure). */
 void mfmm_sparse_rows_free(mfmm_sparse_row *rows, int32_t n);
-
-/* Runs rows [start, n_sources) on an OpenCL device: opt->opencl, else a
- * context made from opt->opencl_options for the call. *rows_done receives the
- * rows delivered (from start) even on failure, so a fallback can go on from
- * there. MFMM_ERR_NO_OPENCL when built without OpenCL or no device works. */
-mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *rows_done,
-                             mfmm_error *err);
 
 #endif

@@ -1,4 +1,4 @@
-/* Path straightening: see the block comment below. Used by trace.c after a
+/* Path straightening: see the block comment below. Used by path.c after a
  * path was traced (section 5); it reads the mesh only. */
 #include <stdint.h>
 #include <stdlib.h>

@@ -2,7 +2,7 @@
 #ifndef MFMM_PATHS_STRAIGHTEN_H
 #define MFMM_PATHS_STRAIGHTEN_H
 
-#include "core/mesh.h"
+#include "mesh/mesh.h"
 
 /* Straightens the traced path raw[0..n-1] (n > 1). face_cost: NULL, or a
  * per-face cost (pieces then break where it changes). Returns 1 with *out a

@@ -1,12 +1,12 @@
-/* Small surface-point helpers shared by path tracing (trace.c) and
+/* Small surface-point helpers shared by path tracing (field.c, trace.c, path.c) and
  * straightening (straighten.c). */
 #ifndef MFMM_PATHS_SURFACE_H
 #define MFMM_PATHS_SURFACE_H
 
 #include <math.h>
 
-#include "core/mesh.h"
-#include "core/start.h" /* mfmm_dist3 */
+#include "mesh/mesh.h"
+#include "start/straight.h" /* mfmm_dist3 */
 
 #define ON_EDGE 1e-12 /* barycentric coordinate treated as 0 (on the edge) */
 

@@ -1,311 +1,30 @@
 /*
- * Minimal geodesic paths (Kimmel & Sethian 1998, section 5): backtrack from a
- * target along dX/ds = -grad T with Heun's second-order method, switching to
- * a first-order (Euler) step at sonic points. Inside a face, T is the
- * quadratic fitted to the face's three vertices and the far vertices of its
- * three neighbours, unfolded into the face's plane (six values, six
- * coefficients); where that fit is ill-posed the face's linear gradient is
- * used. The path moves face to face through edges and vertices and records a
- * surface point at each crossing; between two points it is straight (a
- * geodesic inside a flat face is).
+ * The walk of a minimal geodesic path (Kimmel & Sethian 1998, section 5):
+ * backtrack from a target along dX/ds = -grad T with Heun's second-order
+ * method, switching to a first-order (Euler) step at sonic points, grad T
+ * being the face's field (field.c). The path moves face to face through
+ * edges and vertices and records a surface point at each crossing; between
+ * two points it is straight (a geodesic inside a flat face is). It ends at
+ * a source: a vertex, a face source's face, or along the straight start's
+ * segment (start/straight.h).
  */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/check.h"
-#include "core/order.h"
-#include "core/start.h"
+#include "base/error.h"
+#include "field.h"
+#include "mesh/check.h"
+#include "mesh/order.h"
+#include "mesh/unfold.h"
+#include "start/straight.h"
 #include "surface.h"
-#include "straighten.h"
-
-#define SNAP_BARY 1e-9      /* a crossing this close to a corner is at the vertex */
-#define OUTWARD_COS 1e-9    /* a direction leaves through an edge it lies on */
-#define SONIC_COS 0.70710678118654752 /* predictor and corrector 45 degrees apart: sonic */
-#define STALL_STEPS 64      /* steps without T decreasing before giving up */
-#define PIVOT_RATIO 1e-7    /* 6x6 fit refused below this pivot ratio */
-
-typedef struct src_key {
-    int32_t key; /* vertex id (vertex sources) or face id (face sources) */
-    int32_t idx; /* index into options->sources */
-} src_key;
-
-/* One face unfolded into its plane, with its interpolants of T. */
-typedef struct frame {
-    int32_t f;
-    int32_t v[3];
-    int degenerate;
-    double e1[3], e2[3];  /* in-plane axes; corner 0 at the origin */
-    double P[3][2];       /* corners in the plane */
-    double gb[3][2];      /* gradients of the barycentric coordinates */
-    double T[3];
-    int lin_ok;           /* all three corners finite */
-    double glin[2];       /* linear gradient */
-    int quad_ok;          /* quadratic fit usable */
-    double c[6];          /* T = c0 + c1 x + c2 y + c3 x^2 + c4 xy + c5 y^2, normalized coords */
-    double ox, oy, scale; /* normalization: (p - o) / scale */
-    double max_edge;
-    double F;             /* face cost (per face), or mean of corner costs */
-} frame;
-
-typedef struct tracer {
-    const mfmm_mesh *m;
-    const double *T;
-    const mfmm_source *src;
-    int32_t n_src;
-    const double *cost;
-    mfmm_cost_location cost_loc;
-    src_key *vkeys, *fkeys;
-    int32_t n_vkeys, n_fkeys;
-    mfmm_surface_point *pts;
-    int32_t cap, n, max_points;
-    int grow;             /* pts is the tracer's own, grown as needed */
-    double len, wlen;
-    double last_xyz[3], last_F;
-    mfmm_error *err;
-    mfmm_status st;
-} tracer;
-
-/* Reads T[v], refusing NaN. */
-static int read_T(tracer *t, int32_t v, double *out)
-{
-    double x = t->T[v];
-    if (isnan(x)) {
-        v = mfmm_vertex_out(t->m, v); /* the caller's id */
-        t->st = mfmm_fail(t->err, MFMM_ERR_BAD_ARGUMENT, v, "distances[%d] is NaN", (int)v);
-        return 0;
-    }
-    *out = x;
-    return 1;
-}
-
-/* F at barycentric b of face f (1 without cost; the costs were checked
- * when the call began, mfmm_check_cost). */
-static double cost_at(const tracer *t, int32_t f, const double b[3])
-{
-    if (!t->cost)
-        return 1.0;
-    if (t->cost_loc == MFMM_COST_PER_FACE)
-        return t->cost[f];
-    double s = 0.0;
-    for (int k = 0; k < 3; k++)
-        s += b[k] * t->cost[t->m->face_records[f].v[k]];
-    return s;
-}
-
-/* Gaussian elimination with partial pivoting; 0 when ill-conditioned. */
-static int solve6(double A[6][6], double r[6], double x[6])
-{
-    double pmax = 0.0, pmin = INFINITY;
-    for (int col = 0; col < 6; col++) {
-        int piv = col;
-        for (int i = col + 1; i < 6; i++)
-            if (fabs(A[i][col]) > fabs(A[piv][col]))
-                piv = i;
-        if (piv != col) {
-            for (int j = 0; j < 6; j++) {
-                double s = A[col][j]; A[col][j] = A[piv][j]; A[piv][j] = s;
-            }
-            double s = r[col]; r[col] = r[piv]; r[piv] = s;
-        }
-        double p = fabs(A[col][col]);
-        if (!(p > 0.0))
-            return 0;
-        if (p > pmax) pmax = p;
-        if (p < pmin) pmin = p;
-        for (int i = col + 1; i < 6; i++) {
-            double q = A[i][col] / A[col][col];
-            for (int j = col; j < 6; j++)
-                A[i][j] -= q * A[col][j];
-            r[i] -= q * r[col];
-        }
-    }
-    if (pmin < PIVOT_RATIO * pmax)
-        return 0;
-    for (int i = 5; i >= 0; i--) {
-        double s = r[i];
-        for (int j = i + 1; j < 6; j++)
-            s -= A[i][j] * x[j];
-        x[i] = s / A[i][i];
-        if (!isfinite(x[i]))
-            return 0;
-    }
-    return 1;
-}
-
-/* Unfolds the far vertex w of the neighbour across the edge opposite corner k
- * into the face's plane: the point at its 3D distances from the edge's ends,
- * on the other side of the edge from corner k. */
-static void unfold_far(const mfmm_mesh *m, const frame *fr, int k, int32_t w, double out[2])
-{
-    int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
-    const double *X1 = m->xyz + 3 * (size_t)fr->v[k1], *X2 = m->xyz + 3 * (size_t)fr->v[k2];
-    const double *W = m->xyz + 3 * (size_t)w;
-    double d1 = mfmm_dist3(W, X1), d2 = mfmm_dist3(W, X2);
-    double ex = fr->P[k2][0] - fr->P[k1][0], ey = fr->P[k2][1] - fr->P[k1][1];
-    double L = sqrt(ex * ex + ey * ey);
-    ex /= L;
-    ey /= L;
-    double a = (d1 * d1 - d2 * d2 + L * L) / (2.0 * L);
-    double h2 = d1 * d1 - a * a;
-    double h = h2 > 0.0 ? sqrt(h2) : 0.0;
-    double nx = -ey, ny = ex; /* normal to the edge, pointed away from corner k */
-    if ((fr->P[k][0] - fr->P[k1][0]) * nx + (fr->P[k][1] - fr->P[k1][1]) * ny > 0.0) {
-        nx = -nx;
-        ny = -ny;
-    }
-    out[0] = fr->P[k1][0] + a * ex + h * nx;
-    out[1] = fr->P[k1][1] + a * ey + h * ny;
-}
-
-/* Builds face f's frame and interpolants. 0 on a bad input value. */
-static int frame_build(tracer *t, int32_t f, frame *fr)
-{
-    const mfmm_mesh *m = t->m;
-    memset(fr, 0, sizeof *fr);
-    fr->f = f;
-    for (int k = 0; k < 3; k++) {
-        fr->v[k] = m->face_records[f].v[k];
-        if (!read_T(t, fr->v[k], &fr->T[k]))
-            return 0;
-    }
-    double b1[3] = {1.0 / 3, 1.0 / 3, 1.0 / 3};
-    fr->F = cost_at(t, f, b1);
-    const double *A = m->xyz + 3 * (size_t)fr->v[0], *B = m->xyz + 3 * (size_t)fr->v[1],
-                 *C = m->xyz + 3 * (size_t)fr->v[2];
-    double u[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]};
-    double w[3] = {C[0] - A[0], C[1] - A[1], C[2] - A[2]};
-    double L = sqrt(mfmm_dot3(u, u));
-    fr->max_edge = fmax(L, fmax(sqrt(mfmm_dot3(w, w)), mfmm_dist3(B, C)));
-    double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-    double n2 = sqrt(mfmm_dot3(n, n));
-    if (mfmm_mesh_degenerate(m, f) || !(L > 0.0) || !(n2 > 1e-14 * fr->max_edge * fr->max_edge)) {
-        fr->degenerate = 1;
-        return 1;
-    }
-    for (int i = 0; i < 3; i++) {
-        fr->e1[i] = u[i] / L;
-        n[i] /= n2;
-    }
-    fr->e2[0] = n[1] * fr->e1[2] - n[2] * fr->e1[1];
-    fr->e2[1] = n[2] * fr->e1[0] - n[0] * fr->e1[2];
-    fr->e2[2] = n[0] * fr->e1[1] - n[1] * fr->e1[0];
-    fr->P[1][0] = L;
-    fr->P[2][0] = mfmm_dot3(w, fr->e1);
-    fr->P[2][1] = mfmm_dot3(w, fr->e2);
-    double twoA = fr->P[1][0] * fr->P[2][1] - fr->P[1][1] * fr->P[2][0];
-    for (int k = 0; k < 3; k++) {
-        const double *p1 = fr->P[(k + 1) % 3], *p2 = fr->P[(k + 2) % 3];
-        fr->gb[k][0] = (p1[1] - p2[1]) / twoA;
-        fr->gb[k][1] = (p2[0] - p1[0]) / twoA;
-    }
-    fr->lin_ok = isfinite(fr->T[0]) && isfinite(fr->T[1]) && isfinite(fr->T[2]);
-    if (!fr->lin_ok)
-        return 1;
-    for (int d = 0; d < 2; d++)
-        fr->glin[d] = fr->T[0] * fr->gb[0][d] + fr->T[1] * fr->gb[1][d] + fr->T[2] * fr->gb[2][d];
-
-    /* Section 5: the second-order fit over the face and its three neighbours. */
-    double pts[6][2], vals[6];
-    for (int k = 0; k < 3; k++) {
-        pts[k][0] = fr->P[k][0];
-        pts[k][1] = fr->P[k][1];
-        vals[k] = fr->T[k];
-    }
-    double Fmin = fr->F, Fmax = fr->F;
-    for (int k = 0; k < 3; k++) {
-        int32_t g = m->face_neighbor[3 * f + k];
-        if (g < 0 || mfmm_mesh_degenerate(m, g))
-            return 1; /* boundary or degenerate neighbour: linear */
-        int32_t a1 = fr->v[(k + 1) % 3], a2 = fr->v[(k + 2) % 3], far = -1;
-        for (int j = 0; j < 3; j++) {
-            int32_t x = m->face_records[g].v[j];
-            if (x != a1 && x != a2)
-                far = x;
-        }
-        if (far < 0 || far == fr->v[k])
-            return 1;
-        if (!read_T(t, far, &vals[3 + k]))
-            return 0;
-        if (!isfinite(vals[3 + k]))
-            return 1;
-        unfold_far(m, fr, k, far, pts[3 + k]);
-        if (t->cost) {
-            double Fg = t->cost[t->cost_loc == MFMM_COST_PER_FACE ? g : far];
-            Fmin = fmin(Fmin, Fg);
-            Fmax = fmax(Fmax, Fg);
-        }
-    }
-    /* T has a kink where the cost jumps (refraction): no smooth fit there. */
-    if (t->cost && (t->cost_loc == MFMM_COST_PER_FACE ? Fmax != Fmin : Fmax > 1.1 * Fmin))
-        return 1;
-    fr->ox = (fr->P[0][0] + fr->P[1][0] + fr->P[2][0]) / 3.0;
-    fr->oy = (fr->P[0][1] + fr->P[1][1] + fr->P[2][1]) / 3.0;
-    fr->scale = fr->max_edge;
-    double M[6][6], r[6];
-    for (int i = 0; i < 6; i++) {
-        double x = (pts[i][0] - fr->ox) / fr->scale, y = (pts[i][1] - fr->oy) / fr->scale;
-        M[i][0] = 1.0;
-        M[i][1] = x;
-        M[i][2] = y;
-        M[i][3] = x * x;
-        M[i][4] = x * y;
-        M[i][5] = y * y;
-        r[i] = vals[i] - fr->T[0];
-    }
-    fr->quad_ok = solve6(M, r, fr->c);
-    return 1;
-}
-
-/* grad T at plane point p: the quadratic where usable and descending like
- * the linear gradient, else the linear one. 0 when there is none. */
-static int field_grad(const frame *fr, const double p[2], double g[2])
-{
-    if (!fr->lin_ok) {
-        /* a corner is unreached: head for the lowest finite corner */
-        int best = -1;
-        for (int k = 0; k < 3; k++)
-            if (isfinite(fr->T[k]) && (best < 0 || fr->T[k] < fr->T[best]))
-                best = k;
-        if (best < 0)
-            return 0;
-        g[0] = p[0] - fr->P[best][0];
-        g[1] = p[1] - fr->P[best][1];
-        return g[0] != 0.0 || g[1] != 0.0;
-    }
-    g[0] = fr->glin[0];
-    g[1] = fr->glin[1];
-    if (fr->quad_ok) {
-        double x = (p[0] - fr->ox) / fr->scale, y = (p[1] - fr->oy) / fr->scale;
-        double qx = (fr->c[1] + 2.0 * fr->c[3] * x + fr->c[4] * y) / fr->scale;
-        double qy = (fr->c[2] + fr->c[4] * x + 2.0 * fr->c[5] * y) / fr->scale;
-        if (qx * g[0] + qy * g[1] > 0.0) {
-            g[0] = qx;
-            g[1] = qy;
-        }
-    }
-    return isfinite(g[0]) && isfinite(g[1]) && (g[0] != 0.0 || g[1] != 0.0);
-}
-
-static void bary_to_plane(const frame *fr, const double b[3], double p[2])
-{
-    p[0] = b[0] * fr->P[0][0] + b[1] * fr->P[1][0] + b[2] * fr->P[2][0];
-    p[1] = b[0] * fr->P[0][1] + b[1] * fr->P[1][1] + b[2] * fr->P[2][1];
-}
-
-static double frame_T(const frame *fr, const double b[3])
-{
-    double s = 0.0;
-    for (int k = 0; k < 3; k++)
-        if (b[k] > 0.0)
-            s += b[k] * fr->T[k];
-    return s;
-}
+#include "trace.h"
 
 /* Appends a point; the segment to it ran through face f. */
-static int emit(tracer *t, int32_t f, const double b[3])
+int mfmm_path_emit(tracer *t, int32_t f, const double b[3])
 {
-    double x[3], F = cost_at(t, f, b);
+    double x[3], F = mfmm_path_cost_at(t, f, b);
     mfmm_bary_to_xyz(t->m, f, b, x);
     if (t->n > 0) {
         double d = mfmm_dist3(x, t->last_xyz);
@@ -342,7 +61,7 @@ static int emit(tracer *t, int32_t f, const double b[3])
     return 1;
 }
 
-static int cmp_key(const void *a, const void *b)
+int mfmm_path_key_cmp(const void *a, const void *b)
 {
     const src_key *x = a, *y = b;
     if (x->key != y->key)
@@ -498,7 +217,7 @@ static int try_finish(tracer *t, const frame *fr, const double b[3], double Tx)
     }
     if (eb[0] == b[0] && eb[1] == b[1] && eb[2] == b[2])
         return 1; /* already there */
-    return emit(t, fr->f, eb) ? 1 : -1;
+    return mfmm_path_emit(t, fr->f, eb) ? 1 : -1;
 }
 
 /* Where a ray from b along plane direction d leaves face fr: the largest
@@ -585,7 +304,7 @@ static int leave_vertex(tracer *t, pos *p, frame *fr, double *d_out)
     for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
         int32_t c = MFMM_WEDGE_CORNER(m->vertex_wedge[i]), f = c / 3, k = c % 3;
         frame cf;
-        if (!frame_build(t, f, &cf))
+        if (!mfmm_path_frame_build(t, f, &cf))
             return -1;
         for (int j = 1; j <= 2; j++) {
             int32_t w = cf.v[(k + j) % 3];
@@ -601,7 +320,7 @@ static int leave_vertex(tracer *t, pos *p, frame *fr, double *d_out)
         if (cf.degenerate)
             continue;
         double g[2];
-        if (!field_grad(&cf, cf.P[k], g))
+        if (!mfmm_path_field_grad(&cf, cf.P[k], g))
             continue;
         double gn = sqrt(g[0] * g[0] + g[1] * g[1]);
         double d[2] = {-g[0] / gn, -g[1] / gn};
@@ -624,14 +343,14 @@ static int leave_vertex(tracer *t, pos *p, frame *fr, double *d_out)
     if (kind == 2) {
         pos q;
         set_vertex(&q, m, bf, bw);
-        if (!emit(t, bf, q.b))
+        if (!mfmm_path_emit(t, bf, q.b))
             return -1;
         *p = q;
         return 1;
     }
     set_vertex(p, m, bf, v);
     p->vertex = -1;
-    if (!frame_build(t, bf, fr))
+    if (!mfmm_path_frame_build(t, bf, fr))
         return -1;
     d_out[0] = bd[0];
     d_out[1] = bd[1];
@@ -662,7 +381,7 @@ static int slide(tracer *t, pos *p, const frame *fr, int k, const double d[2], d
     if (left <= hmax) {
         int32_t v = fr->v[toward];
         set_vertex(p, t->m, fr->f, v);
-        return emit(t, fr->f, p->b) ? 1 : -1;
+        return mfmm_path_emit(t, fr->f, p->b) ? 1 : -1;
     }
     double q = hmax / L;
     p->b[other] -= q;
@@ -684,16 +403,16 @@ static int follow_virt(tracer *t, pos *p, int32_t c)
     while (mfmm_strip_next(&w, &st)) {
         double b[3];
         edge_bary(m, f, st.e1, st.e2, st.t, b);
-        if (!emit(t, f, b)) /* the piece to it ran through f */
+        if (!mfmm_path_emit(t, f, b)) /* the piece to it ran through f */
             return -1;
         f = st.face;
         V = st.far;
     }
     set_vertex(p, m, f, V);
-    return emit(t, f, p->b) ? 1 : -1;
+    return mfmm_path_emit(t, f, p->b) ? 1 : -1;
 }
 
-/* The best straight way from a point source to one vertex (start.c). */
+/* The best straight way from a point source to one vertex (start/straight.c). */
 typedef struct walk_find {
     int32_t target;
     double value, best;
@@ -726,6 +445,7 @@ static int finish_straight(tracer *t, int32_t v)
     const mfmm_mesh *m = t->m;
     double Tv = t->T[v];
     walk_find best;
+    memset(&best, 0, sizeof best); /* (GCC cannot see that depth < 0 skips it) */
     best.best = INFINITY;
     int32_t bs = -1;
     for (int32_t j = 0; j < t->n_fkeys; j++) {
@@ -746,7 +466,7 @@ static int finish_straight(tracer *t, int32_t v)
     for (int32_t i = best.depth - 1; i >= 0; i--) {
         double b[3];
         edge_bary(m, best.face[i + 1], best.a[i], best.b[i], best.t[i], b);
-        if (!emit(t, best.face[i + 1], b)) /* the piece to it ran through face[i + 1] */
+        if (!mfmm_path_emit(t, best.face[i + 1], b)) /* the piece to it ran through face[i + 1] */
             return -1;
     }
     /* the source, named in the start face the segment left */
@@ -765,226 +485,10 @@ static int finish_straight(tracer *t, int32_t v)
         return 0;
     for (int k = 0; k < 3; k++)
         b[k] /= sum;
-    return emit(t, f0, b) ? 1 : -1;
+    return mfmm_path_emit(t, f0, b) ? 1 : -1;
 }
 
-static int validate_point(const mfmm_mesh *m, const mfmm_source *s, const char *what, int64_t idx,
-                          mfmm_error *err)
-{
-    if (s->face == -1) {
-        if (s->vertex < 0 || s->vertex >= m->nv)
-            return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, idx, "%s vertex %d is out of range [0, %d)",
-                             what, (int)s->vertex, (int)m->nv);
-        return MFMM_OK;
-    }
-    if (s->face < 0 || s->face >= m->nf_in)
-        return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, idx, "%s face %d is out of range [0, %d)", what,
-                         (int)s->face, (int)m->nf_in);
-    double sum = 0.0;
-    for (int k = 0; k < 3; k++) {
-        if (!isfinite(s->bary[k]) || s->bary[k] < 0.0)
-            return mfmm_fail(err, MFMM_ERR_BAD_BARYCENTRIC, idx,
-                             "%s barycentric coordinate %d = %g is not finite and >= 0", what, k,
-                             s->bary[k]);
-        sum += s->bary[k];
-    }
-    if (fabs(sum - 1.0) > 1e-9)
-        return mfmm_fail(err, MFMM_ERR_BAD_BARYCENTRIC, idx,
-                         "%s barycentric coordinates sum to %.17g, not 1", what, sum);
-    /* as mfmm_solve refuses a source there: the walk reads T in the face's
-     * plane, which a zero-area face does not span (a target there went round
-     * through a corner: 1.20 long where the straight path is 0.86) */
-    if (mfmm_order_point_degenerate(m, s->face, s->bary))
-        return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, idx,
-                         "%s lies on face %d, which has zero area: give the same point on a face "
-                         "beside it",
-                         what, (int)s->face);
-    return MFMM_OK;
-}
-
-void mfmm_path_options_init(mfmm_path_options *options)
-{
-    if (!options)
-        return;
-    memset(options, 0, sizeof *options);
-    options->struct_size = sizeof *options;
-    options->max_points = 100000;
-    options->cost_location = MFMM_COST_NONE;
-    options->straighten = 1;
-}
-
-static mfmm_status trace(tracer *t, const mfmm_source *target);
-
-mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distances,
-                            const mfmm_source *target, const mfmm_path_options *options,
-                            mfmm_surface_point *points, int32_t capacity, int32_t *n_points,
-                            double *length, mfmm_error *err)
-{
-    mfmm_path_options defaults;
-    mfmm_path_options_init(&defaults);
-    const mfmm_path_options *o = &defaults;
-    if (n_points)
-        *n_points = 0;
-    if (length)
-        *length = 0.0;
-    if (!mesh)
-        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "mesh is NULL");
-    if (!distances)
-        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "distances is NULL");
-    if (!target)
-        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "target is NULL");
-    if (!n_points)
-        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "n_points is NULL");
-    if (options && mfmm_read_options(&defaults, options, sizeof defaults, "mfmm_path_options",
-                                     err) != MFMM_OK)
-        return MFMM_ERR_BAD_ARGUMENT;
-    if (capacity < 0)
-        return mfmm_fail(err, MFMM_ERR_BAD_COUNT, capacity, "capacity %d is negative",
-                         (int)capacity);
-    if (capacity > 0 && !points)
-        return mfmm_fail(err, MFMM_ERR_NULL_POINTER, -1, "points is NULL with capacity %d",
-                         (int)capacity);
-    if (o->max_points < 1)
-        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, o->max_points,
-                         "max_points %d is not >= 1", (int)o->max_points);
-    if (o->n_sources < 0 || (o->n_sources > 0 && !o->sources))
-        return mfmm_fail(err, o->n_sources < 0 ? MFMM_ERR_BAD_COUNT : MFMM_ERR_NULL_POINTER,
-                         o->n_sources, "n_sources is %d with sources %s", (int)o->n_sources,
-                         o->sources ? "given" : "NULL");
-    /* the whole cost, as mfmm_solve checks it: not only the faces the path
-     * happens to cross, and named by the caller's ids, not the mesh's
-     * internal order that the walk reads */
-    mfmm_status st = mfmm_check_cost(mesh, o->cost, o->cost_location, err);
-    if (st != MFMM_OK)
-        return st;
-    st = validate_point(mesh, target, "target", -1, err);
-    if (st != MFMM_OK)
-        return st;
-    for (int32_t i = 0; i < o->n_sources; i++) {
-        if ((st = validate_point(mesh, &o->sources[i], "source", i, err)) != MFMM_OK)
-            return st;
-        if (!isfinite(o->sources[i].value))
-            return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, i, "source %d has value %g", (int)i,
-                             o->sources[i].value);
-    }
-
-    /* the caller's T, target, sources and per-vertex cost in the mesh's
-     * internal vertex order (core/order.h); points hold faces only */
-    mfmm_mapped_args mapped = {0};
-    mfmm_source target_in = *target;
-    if (target_in.face == -1)
-        target_in.vertex = mfmm_vertex_in(mesh, target_in.vertex);
-    else
-        target_in.face = mfmm_order_point_in(mesh, target_in.face, target_in.bary, target_in.bary);
-    if (mfmm_order_map_args(mesh, o->sources, o->n_sources, NULL, 0, o->cost,
-                            o->cost ? (int)o->cost_location : 0, distances, &mapped) != MFMM_OK)
-        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "no memory for the distances");
-    tracer t;
-    memset(&t, 0, sizeof t);
-    t.m = mesh;
-    t.T = mapped.values;
-    t.src = mapped.sources;
-    t.n_src = o->n_sources;
-    t.cost = mapped.cost;
-    t.cost_loc = o->cost ? o->cost_location : MFMM_COST_NONE;
-    t.pts = points;
-    t.cap = capacity;
-    t.max_points = o->max_points;
-    t.err = err;
-    t.st = MFMM_OK;
-    /* The only scratch: the sources sorted by vertex and by face. */
-    if (t.n_src > 0) {
-        t.vkeys = malloc(sizeof(src_key) * (size_t)t.n_src);
-        t.fkeys = malloc(sizeof(src_key) * (size_t)t.n_src);
-        if (!t.vkeys || !t.fkeys) {
-            free(t.vkeys);
-            free(t.fkeys);
-            free(mapped.block);
-            return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "no memory for %d sources",
-                             (int)t.n_src);
-        }
-        for (int32_t i = 0; i < t.n_src; i++) {
-            const mfmm_source *s = &t.src[i];
-            if (s->face == -1)
-                t.vkeys[t.n_vkeys++] = (src_key){s->vertex, i};
-            else
-                t.fkeys[t.n_fkeys++] = (src_key){s->face, i};
-        }
-        qsort(t.vkeys, (size_t)t.n_vkeys, sizeof(src_key), cmp_key);
-        qsort(t.fkeys, (size_t)t.n_fkeys, sizeof(src_key), cmp_key);
-    }
-    /* straight pieces need the whole traced path: trace into our own buffer */
-    /* with a cost, the optimal path refracts where the cost changes (Snell):
-     * straight chords between the traced border crossings cost less than the
-     * traced path but bend at the wrong angles (ratio 0.93 +- 0.15 instead of
-     * 0.99 +- 0.01 on Fig. 8b), so weighted paths stay as traced */
-    int straight = o->straighten && !t.cost;
-    if (straight) {
-        t.pts = NULL;
-        t.cap = 0;
-        t.grow = 1;
-    }
-    st = trace(&t, &target_in);
-    free(t.vkeys);
-    free(t.fkeys);
-    if (straight) {
-        mfmm_surface_point *raw = t.pts;
-        int32_t n_raw = t.n;
-        mfmm_surface_point *sp = NULL;
-        int32_t n_sp = 0;
-        int r = st == MFMM_OK && n_raw > 1 ? mfmm_path_straighten(mesh, t.cost, raw, n_raw, &sp, &n_sp) : -1;
-        if (r == 0)
-            st = mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "no memory to straighten %d points",
-                           (int)n_raw);
-        if (st == MFMM_OK) {
-            double raw_len = t.len, raw_wlen = t.wlen;
-            const mfmm_surface_point *use = raw;
-            int32_t n_use = n_raw;
-            if (r > 0)
-                use = sp, n_use = n_sp;
-            /* re-emit into the caller's buffer (lengths recomputed) */
-            for (int pass = 0; pass < 2; pass++) {
-                t.pts = points;
-                t.cap = capacity;
-                t.grow = 0;
-                t.n = 0;
-                t.len = t.wlen = 0.0;
-                for (int32_t i = 0; i < n_use && st == MFMM_OK; i++)
-                    if (!emit(&t, use[i].face, use[i].bary))
-                        st = t.st;
-                if (st == MFMM_OK && t.len <= raw_len && t.wlen <= raw_wlen * (1.0 + 1e-12))
-                    break;
-                /* never longer than the traced path: else the traced path */
-                st = MFMM_OK;
-                use = raw;
-                n_use = n_raw;
-            }
-        } else {
-            t.n = t.n > capacity ? capacity : t.n;
-            if (t.n > 0 && points)
-                memcpy(points, raw, (size_t)t.n * sizeof *points);
-            t.n = n_raw;
-        }
-        free(raw);
-        free(sp);
-    }
-    free(mapped.block);
-    if (points) /* the points' faces in the caller's ids */
-        mfmm_order_points_out(mesh, points, t.n < capacity ? t.n : capacity);
-    *n_points = t.n;
-    if (length)
-        *length = t.len;
-    if (o->weighted_length)
-        *o->weighted_length = t.wlen;
-    if (st == MFMM_OK && t.n > t.cap)
-        st = mfmm_fail(err, MFMM_ERR_BAD_COUNT, t.n, "the path has %d points, capacity is %d",
-                       (int)t.n, (int)t.cap);
-    if (st == MFMM_OK)
-        mfmm_ok(err);
-    return st;
-}
-
-static mfmm_status trace(tracer *t, const mfmm_source *target)
+mfmm_status mfmm_path_trace(tracer *t, const mfmm_source *target)
 {
     const mfmm_mesh *m = t->m;
     pos p;
@@ -996,7 +500,7 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
         if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1])
             return mfmm_fail(t->err, MFMM_ERR_UNREACHED, mfmm_vertex_out(m, v),
                              "target vertex %d is in no face", (int)mfmm_vertex_out(m, v));
-        if (!read_T(t, v, &T0))
+        if (!mfmm_path_read_T(t, v, &T0))
             return t->st;
         set_vertex(&p, m, MFMM_WEDGE_FACE(m->vertex_wedge[m->vertex_face_offset[v]]), v);
     } else {
@@ -1004,10 +508,10 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
         p.vertex = -1;
         p.from = -1;
         memcpy(p.b, target->bary, sizeof p.b);
-        if (!frame_build(t, p.f, &fr))
+        if (!mfmm_path_frame_build(t, p.f, &fr))
             return t->st;
         have_frame = 1;
-        T0 = frame_T(&fr, p.b);
+        T0 = mfmm_path_frame_T(&fr, p.b);
         if (!fr.lin_ok)
             for (int k = 0; k < 3; k++)
                 if (p.b[k] > 0.0 && !isfinite(fr.T[k]))
@@ -1018,7 +522,7 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
                          target->face == -1 ? mfmm_vertex_out(m, target->vertex)
                                             : mfmm_face_out(m, target->face),
                          "the target's distance is infinite (not reached)");
-    if (!emit(t, p.f, p.b))
+    if (!mfmm_path_emit(t, p.f, p.b))
         return t->st;
 
     double best = T0;
@@ -1036,7 +540,7 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
             for (int32_t i = m->vertex_face_offset[v]; i < m->vertex_face_offset[v + 1]; i++) {
                 int32_t f = MFMM_WEDGE_FACE(m->vertex_wedge[i]);
                 frame cf;
-                if (!frame_build(t, f, &cf))
+                if (!mfmm_path_frame_build(t, f, &cf))
                     return t->st;
                 double b[3];
                 for (int k = 0; k < 3; k++)
@@ -1081,11 +585,11 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
             have_frame = 1;
             have_dir = 1;
         } else if (!have_frame || fr.f != p.f) {
-            if (!frame_build(t, p.f, &fr))
+            if (!mfmm_path_frame_build(t, p.f, &fr))
                 return t->st;
             have_frame = 1;
         }
-        Tcur = frame_T(&fr, p.b);
+        Tcur = mfmm_path_frame_T(&fr, p.b);
         if (!have_dir) {
             int r = try_finish(t, &fr, p.b, Tcur);
             if (r < 0)
@@ -1103,7 +607,7 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
                 return mfmm_fail(t->err, MFMM_ERR_PATH_STALLED, p.f,
                                  "face %d has no reached corner", (int)p.f);
             set_vertex(&p, m, fr.f, fr.v[lo]);
-            if (!emit(t, fr.f, p.b))
+            if (!mfmm_path_emit(t, fr.f, p.b))
                 return t->st;
             if (fr.T[lo] < best) {
                 best = fr.T[lo];
@@ -1116,10 +620,10 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
 
         /* Heun's step (section 5), at most a third of the face's longest edge. */
         double h = fr.max_edge / 3.0, x0[2];
-        bary_to_plane(&fr, p.b, x0);
+        mfmm_path_bary_to_plane(&fr, p.b, x0);
         if (!have_dir) {
             double g[2];
-            if (!field_grad(&fr, x0, g))
+            if (!mfmm_path_field_grad(&fr, x0, g))
                 return mfmm_fail(t->err, MFMM_ERR_PATH_STALLED, p.f,
                                  "grad T vanishes in face %d", (int)p.f);
             double gn = sqrt(g[0] * g[0] + g[1] * g[1]);
@@ -1130,7 +634,7 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
         double s1 = ray_exit(&fr, p.b, d, h, &edge);
         if (s1 > 0.0) {
             double x1[2] = {x0[0] + s1 * d[0], x0[1] + s1 * d[1]}, g2[2];
-            if (field_grad(&fr, x1, g2)) {
+            if (mfmm_path_field_grad(&fr, x1, g2)) {
                 double gn = sqrt(g2[0] * g2[0] + g2[1] * g2[1]);
                 double d2[2] = {-g2[0] / gn, -g2[1] / gn};
                 /* a sonic point (gradient jump): keep the first-order step */
@@ -1152,7 +656,7 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
             advance(&fr, p.b, d, s1, edge);
             p.from = -1;
         }
-        Tcur = frame_T(&fr, p.b);
+        Tcur = mfmm_path_frame_T(&fr, p.b);
         if (Tcur < best - 1e-14 * (1.0 + fabs(best))) {
             best = Tcur;
             stall = 0;
@@ -1169,13 +673,13 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
                 corner = 3 - k - edge;
         if (corner >= 0) {
             set_vertex(&p, m, fr.f, fr.v[corner]);
-            if (!emit(t, fr.f, p.b))
+            if (!mfmm_path_emit(t, fr.f, p.b))
                 return t->st;
             continue;
         }
         int32_t g = m->face_neighbor[3 * fr.f + edge];
         if (g >= 0 && g != p.from) {
-            if (s1 > 0.0 && !emit(t, fr.f, p.b))
+            if (s1 > 0.0 && !mfmm_path_emit(t, fr.f, p.b))
                 return t->st;
             double bg[3];
             map_bary(m, &fr, p.b, g, bg);
@@ -1194,7 +698,7 @@ static mfmm_status trace(tracer *t, const mfmm_source *target)
             return mfmm_fail(t->err, MFMM_ERR_PATH_STALLED, p.f,
                              "the path runs into an edge of face %d and stops", (int)p.f);
         if (p.vertex < 0) {
-            double Tn = frame_T(&fr, p.b);
+            double Tn = mfmm_path_frame_T(&fr, p.b);
             if (Tn < best) {
                 best = Tn;
                 stall = 0;

@@ -1,15 +1,17 @@
 /* The public solver: a reusable workspace, the checks, and one march
- * (core/march.h) from the exact start (seed.h) or the straight one
- * (core/start.h). */
+ * (march/march.h) from the exact start (start/seed.h) or the straight
+ * one (start/straight.h). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/check.h"
-#include "core/mesh.h"
-#include "core/order.h"
-#include "core/start.h"
-#include "seed.h"
+#include "base/error.h"
+#include "mesh/check.h"
+#include "mesh/mesh.h"
+#include "mesh/order.h"
+#include "mesh/spokes.h"
+#include "start/straight.h"
+#include "start/seed.h"
 #include "solve.h"
 
 struct mfmm_solver {

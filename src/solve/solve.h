@@ -3,8 +3,8 @@
 #ifndef MFMM_SOLVE_H
 #define MFMM_SOLVE_H
 
-#include "core/check.h"
-#include "core/mesh.h"
+#include "mesh/check.h"
+#include "mesh/mesh.h"
 #include "exact/exact.h"
 
 /* mfmm_solve without the checks, for callers that checked the arguments

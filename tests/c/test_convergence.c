@@ -2,7 +2,7 @@
  * icosphere (great circle), and the stretched lattice whose corners are all
  * 120 degrees, with and without the unfolding of section 4.2. The calibrated
  * orders are the paper's plain start's (exact_start_radius 0); the exact
- * start (issue 12) is checked against it on the same meshes. */
+ * start is checked against it on the same meshes. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -131,7 +131,7 @@ static void test_obtuse_lattice_needs_unfolding(void **state)
 
 /* The exact start (default radius) against the plain start on the meshes
  * above: never worse in mean error; on the icospheres of 2.5k and 10k
- * vertices at most 0.6x (issue 12's target). Prints the rows of the
+ * vertices at most 0.6x. Prints the rows of the
  * convergence table of bench/RESULTS.md. */
 static void test_exact_start_lowers_error(void **state)
 {

@@ -16,7 +16,8 @@
 
 #include "testutil.h"
 #include "exact/exact.h"
-#include "core/mesh.h"
+#include "start/patch.h"
+#include "mesh/mesh.h"
 
 /* ---------------------------------------------------------------- helpers */
 

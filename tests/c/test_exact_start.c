@@ -1,8 +1,8 @@
-/* The exact start of a march (issue 12.2, src/solve/seed.h): its patch
+/* The exact start of a march (src/start/seed.h): its patch
  * equals the exact solver; the march from it is never worse than the
  * paper's start on the test meshes; the option off gives the rows of the
- * plain start as they were before the option existed; a point beside a
- * saddle vertex gives T continuous with the vertex (issue 9.3b); the
+ * plain start; a point beside a
+ * saddle vertex gives T continuous with the vertex; the
  * patch's inner vertices settle at seeding with the same rows. */
 #include <math.h>
 #include <setjmp.h>
@@ -13,9 +13,10 @@
 #include <string.h>
 #include <cmocka.h>
 
-#include "core/mesh.h"
-#include "core/order.h"
+#include "mesh/mesh.h"
+#include "mesh/order.h"
 #include "exact/exact.h"
+#include "start/patch.h"
 #include "testutil.h"
 
 static double *exact_row(const mfmm_mesh *mesh, const mfmm_source *src)
@@ -86,7 +87,7 @@ static void test_patch_is_exact(void **state)
             const int32_t *pv = NULL;
             const double *pd = NULL;
             /* the patch API is internal: internal vertex ids, and a face
-             * point in the piece that holds it (core/order.h) */
+             * point in the piece that holds it (src/mesh/order.h) */
             mfmm_source isrc = src;
             if (isrc.face < 0)
                 isrc.vertex = mfmm_vertex_in(mesh, isrc.vertex);
@@ -94,7 +95,7 @@ static void test_patch_is_exact(void **state)
                 isrc.face = mfmm_order_point_in(mesh, isrc.face, isrc.bary, isrc.bary);
             assert_int_equal(mfmm_exact_patch(ws, &isrc, 1, R, 0, &n, &pv, &pd, NULL), MFMM_OK);
             assert_true(n >= 10);
-            /* every vertex within R, and a ring beyond it (exact.c) */
+            /* every vertex within R, and a ring beyond it (start/patch.c) */
             int32_t inside = 0, beyond = 0;
             for (int32_t v = 0; v < nv; v++)
                 inside += e[v] <= R;
@@ -157,7 +158,7 @@ static int32_t march_patch(const mfmm_mesh *mesh, const int32_t *pv, const doubl
 }
 
 /* The patch's inner vertices settle at seeding (mfmm_march_seed_patch,
- * core/march.h): the rows and the settled counts equal those of seeding
+ * src/march/march.h): the rows and the settled counts equal those of seeding
  * every patch vertex through the heap, bit for bit, with and without
  * unfolding and max_distance (inside the patch too), and most of a patch
  * settles early. */
@@ -211,7 +212,7 @@ static void test_patch_settles_early(void **state)
  * exact start is no worse than with the plain start. (The point was only
  * reported before: the straight start's walk reaches the mesh's longest
  * edge, beyond a radius-6 patch on fertility and beetle, and the exact start
- * dropped those seeds; seed.c now keeps them beyond the patch.) */
+ * dropped those seeds; src/start/seed.c keeps them beyond the patch.) */
 static void test_never_worse(void **state)
 {
     (void)state;
@@ -265,10 +266,10 @@ static void test_never_worse(void **state)
 
 /* Workspaces on one set of shared tables (as a matrix job's threads) give
  * the patches of a workspace on the mesh's tables, bit for bit; a
- * workspace's own state is a small part of the tables (issue 12: each
- * thread held ~430 bytes per vertex). The mesh builds its tables on first
- * use and keeps them: later workspaces and jobs reuse them (issue 11: each
- * job built them, 0.48 s on a 1M-vertex mesh whatever its rows reach). */
+ * workspace's own state is a small part of the tables (a workspace
+ * with its own tables held ~430 bytes per vertex). The mesh builds its tables on first
+ * use and keeps them: later workspaces and jobs reuse them (built per
+ * job, they cost 0.48 s on a 1M-vertex mesh whatever its rows reach). */
 static void test_shared_tables(void **state)
 {
     (void)state;
@@ -338,7 +339,7 @@ static void test_shared_tables(void **state)
 /* exact_start_radius 0 gives the rows of the plain start as the library gave
  * them before the option existed (values recorded from that build, commit
  * 7d9f5ad, which has no such option; %.17g round-trips): to a few ulps since
- * the triangle update is solved in closed form (session 8: 0-2 ulps here),
+ * the triangle update is solved in closed form (0-2 ulps here),
  * and bit for bit as recorded from that change (sum_now, now). */
 static void check_recorded(mfmm_gen_mesh g, mfmm_source s, double sum, const double want[5],
                            double sum_now, const double now[5])
@@ -395,7 +396,7 @@ static void test_off_is_plain_start(void **state)
                    n3);
 }
 
-/* Issue 9.3b: at vertices whose angle sum exceeds 2 pi (hand), a point 1e-9
+/* At vertices whose angle sum exceeds 2 pi (hand), a point 1e-9
  * beside the vertex, in each face around it, gives T continuous with the
  * vertex source. The straight start reached vertices behind such a corner
  * through it from the corner but not from beside it (16 % of approaches
@@ -436,7 +437,7 @@ static void test_saddle_corner_continuous(void **state)
             p.bary[c % 3] = 1.0 - 2e-9;
             solve_r(solver, &p, MFMM_EXACT_START_RADIUS, d1);
             /* the exact solver itself: within the move (1-Lipschitz); it left
-             * vertices at +inf before its near-source fix (exact.c, EX_NEAR) */
+             * vertices at +inf before its near-source fix (exact/state.h, EX_NEAR) */
             double *e1 = exact_row(mesh, &p);
             double move = 0.0;
             for (int j = 0; j < 3; j++) {

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <cmocka.h>
 
-#include "core/march.h"
+#include "march/march.h"
 
 #define N 2000
 

@@ -728,7 +728,7 @@ static void test_io_errors(void **state)
 }
 
 
-/* ------------------------------------------------------ STL (issue 10) */
+/* ------------------------------------------------------------------ STL */
 
 static void put_le32(unsigned char *p, uint32_t v)
 {
@@ -849,8 +849,8 @@ static void test_unsupported(void **state)
                  "meshfmm reads OBJ");
 }
 
-/* /dev/zero, a FIFO with no writer and a directory are refused at once
- * (issue 9 item 10), naming the path and what it is. */
+/* /dev/zero, a FIFO with no writer and a directory are refused at once,
+ * naming the path and what it is. */
 static void test_not_regular(void **state)
 {
     loaded r = load("/dev/zero");
@@ -956,7 +956,7 @@ static int set_comma_locale(const char *dir)
     return 0;
 }
 
-/* Issue 9 item 4: under a decimal-comma locale the text readers read '.'
+/* Under a decimal-comma locale the text readers read '.'
  * numbers and the .txt writers' formatter writes '.'. */
 static void test_comma_locale(void **state)
 {

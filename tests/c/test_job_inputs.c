@@ -1,4 +1,4 @@
-/* Issue 9.5 and 9.6: what a job reads. max_distance negative or NaN is
+/* What a job reads. max_distance negative or NaN is
  * refused (mfmm_solve, mfmm_distance_matrix); mfmm_distance_matrix re-reads
  * the sources and the cost for every row, so it works on its own copies: an
  * out buffer that holds the caller's sources array gives the same rows as a

@@ -8,7 +8,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
-#include "core/local_update.h"
+#include "march/local_update.h"
 #include "testutil.h"
 
 static const double PI = 3.14159265358979323846;

@@ -182,7 +182,7 @@ static int on_sparse(void *user, int32_t first, int32_t n, const int64_t *indptr
 
 /* Target columns (S x T, any order, duplicates) equal the full rows'
  * columns and settle fewer vertices; sparse rows equal the dense rows'
- * finite entries (issue 11). Serial and threads, both dtypes. */
+ * finite entries. Serial and threads, both dtypes. */
 static void test_targets_and_sparse(void **state)
 {
     (void)state;

@@ -1,4 +1,4 @@
-/* A built mesh's memory (issue 13.3): at most 300 bytes per vertex on every
+/* A built mesh's memory: at most 300 bytes per vertex on every
  * shared mesh and on generated sine and sphere meshes, counted array by
  * array (mfmm_mesh_memory); and the virtual edges' strips, which the mesh
  * keeps only as their vertices (mesh.h), re-walked (mfmm_strip_next) to the
@@ -14,7 +14,8 @@
 #include <cmocka.h>
 
 #include "testutil.h"
-#include "core/mesh.h"
+#include "mesh/mesh.h"
+#include "mesh/unfold.h"
 #include "io/generate.h"
 
 static double bytes_per_vertex(const mfmm_mesh *mesh)

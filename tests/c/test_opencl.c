@@ -258,7 +258,7 @@ static void test_cache_corrupt_and_unwritable(void **state)
 }
 
 #ifdef MESHFMM_TEST_HAVE_CL
-/* The cache file format of opencl_host.c: magic, key length, key, binary
+/* The cache file format of src/matrix/opencl/cache.c: magic, key length, key, binary
  * length, binary, checksum: FNV-1a of the folder's secret, key, binary and
  * secret (uint64 in host order). */
 static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
@@ -382,8 +382,8 @@ static unsigned char *other_binary(const char *src, size_t src_len, const char *
     return bin;
 }
 
-/* Issue 9 point 11: an altered cache entry (checksum recomputed) crashed
- * every OpenCL and auto run until deleted. Each altered entry here must give
+/* An altered cache entry (checksum recomputed) must not reach the driver:
+ * PoCL crashes on such a binary. Each altered entry here must give
  * rows equal to the serial core's, and be replaced by a good one. */
 static void test_cache_altered_entries(void **state)
 {
@@ -508,7 +508,7 @@ static int first_batch(void *user, int32_t first, int32_t n, const void *rows)
     return 0;
 }
 
-/* Issue 13: with the default memory budget (16 MiB) a batch held one row of a
+/* With the default memory budget (16 MiB) a batch could hold one row of a
  * mesh above ~227k vertices (37 bytes per vertex and row), and OpenCL ran on
  * one core. A batch now holds a row per compute unit (this machine's cores,
  * on PoCL); and auto runs threads, saying why, when memory_limit keeps
@@ -576,7 +576,7 @@ static void test_batches_fill_compute_units(void **state)
 /* The device and cache folder through mfmm_opencl_options (they win over the
  * environment); a wrong struct_size is refused. */
 /* Target columns on OpenCL (the kernel marches to its targets and writes
- * their columns) equal the serial backend's bit for bit (issue 11), with and
+ * their columns) equal the serial backend's bit for bit, with and
  * without a cost, into out and by callback over many batches. Sparse rows
  * are refused with a reason. */
 static void test_targets(void **state)

@@ -1,4 +1,4 @@
-/* Vertex and face renumbering (issue 13.1): the library numbers vertices
+/* Vertex and face renumbering: the library numbers vertices
  * internally by position, and faces along that order, so a mesh given with
  * its vertices and faces in another order is the same mesh inside. Per input
  * vertex, every public result (distances with and without costs, per vertex
@@ -17,7 +17,7 @@
 #include <cmocka.h>
 
 #include "testutil.h"
-#include "core/mesh.h"
+#include "mesh/mesh.h"
 #include "io/generate.h"
 
 /* g's vertices, plus one unreferenced vertex, and its faces in a shuffled
@@ -371,7 +371,7 @@ static void test_deterministic(void **state)
     mfmm_gen_free(&g);
 }
 
-/* Each vertex's corner list in fan order (mesh.c, for the march): the list
+/* Each vertex's corner list in fan order (src/mesh/build.c, for the march): the list
  * holds exactly the vertex's corners, and face (x, p, q) is followed by a
  * face (x, q, r) except where a fan ends: never on a closed, consistently
  * oriented surface (and the last face closes the cycle), never on an open

@@ -677,7 +677,7 @@ static void test_errors(void **state)
     tm_fixture_free(&fx);
 }
 
-/* Issue 9.2 and 9.3a on the shared meshes: the path ends at the source or
+/* On the shared meshes: the path ends at the source or
  * fails, never elsewhere. wingnut from vertex 2593 to 128: T(2793) comes
  * through a virtual edge and is below all its edge neighbours; the default
  * call (no sources) ended there silently (length 1.08 for T(128) = 1.56),

@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <cmocka.h>
 
-#include "core/mesh.h"
+#include "mesh/mesh.h"
 #include "testutil.h"
 
 static int32_t root(int32_t *parent, int32_t x)

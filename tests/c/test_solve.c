@@ -249,7 +249,7 @@ static void test_early_stop(void **state)
     tm_fixture_free(&fx);
 }
 
-/* The solver resets only the vertices its last march touched (issue 11):
+/* The solver resets only the vertices its last march touched:
  * a sequence of solves with different sources, limits, targets, costs,
  * point sources and failing calls in between leaves every solve bit-equal
  * to the same solve on a fresh solver. */
@@ -504,10 +504,10 @@ static void test_bad_solves(void **state)
     tm_fixture_free(&fx);
 }
 
-/* Issue 9.3b: a point on an edge or at a vertex is a point of every face
- * holding it: the same T (bit for bit) whichever face names it, and T moves
- * continuously with the point. Before the fix a hand edge midpoint was not
- * seeded across its edge: naming it by the other face changed T by up to 3 %
+/* A point on an edge or at a vertex is a point of every face holding it:
+ * the same T (bit for bit) whichever face names it, and T moves
+ * continuously with the point. Seeded from one face only, a hand edge
+ * midpoint was not seeded across its edge: naming it by the other face changed T by up to 3 %
  * of the diagonal, and so did a move of 1e-9 off the edge. A move of d
  * changes the exact distance by at most d: allowed here 10 d. */
 static void solve_point(mfmm_solver *solver, int32_t face, const double bary[3], double *d)

@@ -13,7 +13,8 @@
 #include <string.h>
 #include <cmocka.h>
 
-#include "core/mesh.h"
+#include "mesh/mesh.h"
+#include "mesh/spokes.h"
 #include "testutil.h"
 
 typedef struct ws {

@@ -1,4 +1,4 @@
-/* T-junctions closed by zero-area needle faces (src/core/tjunction.c): the
+/* T-junctions closed by zero-area needle faces (src/mesh/tjunction.c): the
  * library splits the face across the needle's long edge at the needle's
  * middle vertex and drops the needle. The reference is the same surface
  * given resolved by hand (those pieces, no needle): every result per input

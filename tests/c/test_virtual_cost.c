@@ -1,4 +1,4 @@
-/* Issue 9.1: a virtual stencil (section 4.2) under a cost. An obtuse
+/* A virtual stencil (section 4.2) under a cost. An obtuse
  * corner's virtual edge and triangles lie over other faces than the corner's;
  * with a cost they are used only where the cost is the same over that
  * footprint, else the plain stencil. Checked against a solve on the same mesh
@@ -24,7 +24,7 @@
  * Off the band the coarse solves lie below the subdivided ones where the
  * subdivided mesh keeps the plain stencil at obtuse corners next to the band
  * (it does not converge there); further 1-to-4 splits raise those values.
- * The issue's camelhead band (76 of 553 vertices > 20 % low) could not be
+ * The camelhead band first reported (76 of 553 vertices > 20 % low) could not be
  * rebuilt exactly; planes x, y, z at 0.3, 0.5, 0.7 of the box and two
  * iso-distance bands, sources on and off the band, give 0 band vertices
  * > 20 % low now (bench/studies/sweep_cost_bands.py). */
@@ -190,7 +190,7 @@ static void check_against_subdivided(const char *name, const double *V, int32_t 
             fail_msg("%s per %s: the default solve is %.4f below the subdivided one, the plain "
                      "stencil only %.4f",
                      name, per_vertex ? "vertex" : "face", -r, -rp);
-        if (band) { /* the issue's measure: no band vertex > 20 % low */
+        if (band) { /* no band vertex > 20 % low */
             assert_true(below <= below_plain);
             assert_int_equal(below, 0);
         }
@@ -204,7 +204,7 @@ static void check_against_subdivided(const char *name, const double *V, int32_t 
     mfmm_mesh_destroy(fine);
 }
 
-/* The reproducer of issue 9.1, exactly: a 30-30-120 lattice. */
+/* The first reproducer, exactly: a 30-30-120 lattice. */
 #define LN 13
 static void lattice(double *V, int32_t *F)
 {

@@ -1,5 +1,5 @@
-/* Test helpers: generated meshes with known distances (src/generate.h), and
- * the accuracy metrics of DESIGN.md. */
+/* Test helpers: generated meshes with known distances (src/io/generate.h), and
+ * the accuracy metrics of docs/methods.md#metrics. */
 #ifndef MFMM_TESTUTIL_H
 #define MFMM_TESTUTIL_H
 
@@ -35,7 +35,7 @@ size_t tm_memory_entry(const mfmm_mesh *mesh, const char *name);
 /* The vertex nearest to p. */
 int32_t tm_nearest_vertex(const mfmm_gen_mesh *m, const double p[3]);
 
-/* DESIGN.md's metrics over vertices with exact[i] > 0 and finite:
+/* The metrics of docs/methods.md#metrics over vertices with exact[i] > 0 and finite:
  * mean relative error in percent, and max error in percent of `diameter`. */
 double tm_mean_rel_error(const double *d, const double *exact, int32_t n);
 double tm_max_error(const double *d, const double *exact, int32_t n, double diameter);

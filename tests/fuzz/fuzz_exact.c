@@ -47,8 +47,9 @@
 
 #include "meshfmm.h"
 #include "byte_reader.h"
-#include "core/order.h"
+#include "mesh/order.h"
 #include "exact/exact.h"
+#include "start/patch.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -65,7 +66,7 @@ static double dist3(const double *a, const double *b)
 }
 
 /* A face of nonzero area with a factor 4 over the library's zero-area test
- * (src/core/mesh.c: the sine between two unit edge vectors above
+ * (src/mesh/build.c: the sine between two unit edge vectors above
  * 64 eps (lmax / l0) (lmax / l1)). */
 static int solid_face(const double *V, const int32_t *f)
 {
@@ -275,7 +276,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         const int32_t *pv = NULL;
         const double *pd = NULL;
         double R = radius * 0.5;
-        mfmm_source isrc = src[0]; /* the patch API takes internal ids (core/order.h) */
+        mfmm_source isrc = src[0]; /* the patch API takes internal ids (src/mesh/order.h) */
         if (isrc.face < 0)
             isrc.vertex = mfmm_vertex_in(mesh, isrc.vertex);
         else /* faces are numbered internally too, and split at T-junctions */
@@ -284,7 +285,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             int32_t inside = 0, in_r = 0;
             for (int32_t v = 0; v < nv; v++)
                 inside += e[v] <= R;
-            /* every value exact, those beyond R too (the ring of exact.c);
+            /* every value exact, those beyond R too (the ring of start/patch.c);
              * where the full solve fell back to walls at non-manifold edges
              * (its budget passed beyond R), the patch's values are at most
              * its upper bounds */

@@ -1,0 +1,180 @@
+/* Windows at non-manifold edges: a window fanned out into the other faces
+ * on such an edge (propagate.c, ex_fan_out) is kept, per face entered, and
+ * trims the windows that enter that face there later (nonmanifold.h). */
+#include <math.h>
+#include <stdlib.h>
+
+#include "nonmanifold.h"
+#include "queue.h"
+
+/* D(x) - D'(x) of two windows on one edge, in units of the edge */
+static double ex_diff(double x, double px, double py, double dsig, double pa, double qa)
+{
+    return dsig + sqrt((x - px) * (x - px) + py * py) - sqrt((x - pa) * (x - pa) + qa * qa);
+}
+
+/* Trims the window [*s0, *s1] (pseudo-source (px, py), sigma; the frame of
+ * a half-edge of length L) against the windows kept at that half-edge's
+ * slot: the part where a kept window gives no more is dropped, as MMP does
+ * with the windows of an edge (Surazhsky et al. 2005, section 3.3), here
+ * only from the ends, so that it stays one interval. Sound in any order:
+ * kept windows are never removed, and a kept window trimmed later against
+ * a vertex is beaten there by a path through that vertex. Returns 0 when
+ * nothing is left. Without it, folded fans of 5-8 faces on one edge passed
+ * windows round without bound (fuzz input nonmanifold-fans-window-blowup). */
+int ex_dominate(const mfmm_exact_ws *ws, int32_t slot, double L, double *s0p,
+                       double *s1p, double px, double py, double sigma)
+{
+    double il = 1.0 / L, s0 = *s0p * il, s1 = *s1p * il;
+    double pw = px * il, qw = py * il;
+    if (fabs(qw) <= EX_POS_TOL) {
+        /* I on the edge (a needle's middle vertex, ex_start_vertex): its
+         * rays leave from I and cross the edge nowhere else, so [s0, s1]
+         * holds directions, not points, and cutting it point by point drops
+         * rays that no kept window carries (a fuzzed mesh's needle lost the
+         * half of its fan that gave d(20) 4.24, not 4.41). Nor may a kept
+         * window that reaches I as soon drop it: the paths that bend at I
+         * are this window's alone. It goes only when it is a kept one come
+         * round again (alike to rounding, as below). */
+        for (int32_t i = ws->nm_head[slot]; i >= 0; i = ws->rec[i].next) {
+            const ex_rec *a = ws->rec + i;
+            double ds = (sigma - a->sigma) * il, pa = a->px * il, qa = a->py * il;
+            if (fabs(ds) + fabs(pw - pa) + fabs(qw - qa) <=
+                EX_TIE * (1.0 + fabs(sigma * il) + fabs(pw) + fabs(qw)))
+                return 0;
+        }
+        return 1;
+    }
+    for (int32_t i = ws->nm_head[slot]; i >= 0; i = ws->rec[i].next) {
+        const ex_rec *a = ws->rec + i;
+        double a0 = a->b0 * il, a1 = a->b1 * il;
+        int left = a0 <= s0, right = a1 >= s1;
+        if (!left && !right)
+            continue; /* inside the new window: its ends stay */
+        double lo = left ? s0 : a0, hi = right ? s1 : a1;
+        if (!(hi > lo))
+            continue;
+        double pa = a->px * il, qa = a->py * il, ds = (sigma - a->sigma) * il;
+        double k0 = INFINITY, k1 = -INFINITY;
+        /* |D - D_a| <= |ds| + |pw - pa| + |qw - qa| everywhere: windows
+         * alike to rounding (the same window come round a fan of folded
+         * faces, which otherwise went round without end) are ties, and the
+         * kept one stays */
+        if (fabs(ds) + fabs(pw - pa) + fabs(qw - qa) <=
+            EX_TIE * (1.0 + fabs(sigma * il) + fabs(pw) + fabs(qw)))
+            goto trim;
+        /* D = D_a squared twice: a quadratic whose roots hold the zeros of
+         * D - D_a, which keeps its sign between them */
+        double al = 2.0 * (pw - pa), be = pa * pa - pw * pw + qa * qa - qw * qw + ds * ds;
+        double d4 = 4.0 * ds * ds;
+        double A = d4 - al * al, B = -2.0 * (d4 * pa + al * be);
+        double C = d4 * (pa * pa + qa * qa) - be * be;
+        double r[2];
+        int nr = 0;
+        double disc = B * B - 4.0 * A * C;
+        if (A != 0.0 && disc >= 0.0) {
+            double q = -0.5 * (B + (B >= 0.0 ? sqrt(disc) : -sqrt(disc)));
+            r[nr++] = q / A;
+            if (q != 0.0)
+                r[nr++] = C / q;
+        } else if (A == 0.0 && B != 0.0) {
+            r[nr++] = -C / B;
+        }
+        double x[4];
+        int n = 0;
+        x[n++] = lo;
+        for (int j = 0; j < nr; j++) {
+            /* Newton on D - D_a itself: the squared form loses digits when
+             * the two windows are alike */
+            double t = r[j];
+            for (int it = 0; it < 2; it++) {
+                double rw = sqrt((t - pw) * (t - pw) + qw * qw);
+                double ra = sqrt((t - pa) * (t - pa) + qa * qa);
+                double tn = t - (ds + rw - ra) / ((t - pw) / rw - (t - pa) / ra);
+                if (!(fabs(tn - t) < 1.0))
+                    break;
+                t = tn;
+            }
+            if (t > lo && t < hi) {
+                if (n == 2 && t < x[1]) {
+                    x[2] = x[1];
+                    x[1] = t;
+                    n = 3;
+                } else {
+                    x[n++] = t;
+                }
+            }
+        }
+        x[n++] = hi;
+        /* the hull of the part of [lo, hi] where the new window is shorter */
+        for (int j = 0; j + 1 < n; j++) {
+            if (!(ex_diff(0.5 * (x[j] + x[j + 1]), pw, qw, ds, pa, qa) >= 0.0)) {
+                if (k0 > x[j])
+                    k0 = x[j];
+                k1 = x[j + 1];
+            }
+        }
+    trim:
+        if (left && right) {
+            if (!(k1 >= k0))
+                return 0;
+            s0 = k0;
+            s1 = k1;
+        } else if (left) {
+            s0 = k1 >= k0 ? k0 : hi;
+        } else {
+            s1 = k1 >= k0 ? k1 : lo;
+        }
+        if (!(s1 - s0 > EX_MIN_WIDTH))
+            return 0;
+    }
+    *s0p = s0 * L;
+    *s1p = s1 * L;
+    return 1;
+}
+
+/* Keeps a fanned-out window at its slot for ex_dominate, while memory
+ * allows (one not kept only trims nothing). */
+void ex_keep(mfmm_exact_ws *ws, int32_t slot, double b0, double b1, double px, double py,
+                    double sigma)
+{
+    if (ws->rec_n == ws->rec_cap) {
+        int32_t cap = ws->rec_cap;
+        if (cap >= INT32_MAX / 2)
+            return;
+        int32_t ncap = cap ? 2 * cap : 256;
+        if (ws->memory_limit &&
+            ex_bytes(ws, ws->heap_cap) + (size_t)(ncap - cap) * sizeof(ex_rec) > ws->memory_limit)
+            return;
+        ex_rec *p = realloc(ws->rec, (size_t)ncap * sizeof *p);
+        if (!p)
+            return;
+        ws->rec = p;
+        ws->rec_cap = ncap;
+        if (ex_bytes(ws, ws->heap_cap) > ws->peak_bytes)
+            ws->peak_bytes = ex_bytes(ws, ws->heap_cap);
+    }
+    ex_rec *r = ws->rec + ws->rec_n;
+    r->b0 = b0;
+    r->b1 = b1;
+    r->px = px;
+    r->py = py;
+    r->sigma = sigma;
+    r->slot = slot;
+    r->next = ws->nm_head[slot];
+    ws->nm_head[slot] = ws->rec_n++;
+}
+
+/* The slot of half-edge g in nm_he (binary search), -1 if none. */
+int32_t ex_nm_slot(const mfmm_exact_ws *ws, int32_t g)
+{
+    int32_t lo = 0, hi = ws->n_nm - 1;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (ws->nm_he[mid] < g)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return ws->n_nm > 0 && ws->nm_he[lo] == g ? lo : -1;
+}

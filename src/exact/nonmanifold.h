@@ -1,0 +1,28 @@
+/* Windows at non-manifold edges (nonmanifold.c): those kept per face
+ * entered, and the trimming of a later window against them. */
+#ifndef MFMM_EXACT_NONMANIFOLD_H
+#define MFMM_EXACT_NONMANIFOLD_H
+
+#include "state.h"
+
+/* Trims the window [*s0, *s1] (pseudo-source (px, py), sigma; the frame of
+ * a half-edge of length L) against the windows kept at that half-edge's
+ * slot: the part where a kept window gives no more is dropped, as MMP does
+ * with the windows of an edge (Surazhsky et al. 2005, section 3.3), here
+ * only from the ends, so that it stays one interval. Sound in any order:
+ * kept windows are never removed, and a kept window trimmed later against
+ * a vertex is beaten there by a path through that vertex. Returns 0 when
+ * nothing is left. Without it, folded fans of 5-8 faces on one edge passed
+ * windows round without bound (fuzz input nonmanifold-fans-window-blowup). */
+int ex_dominate(const mfmm_exact_ws *ws, int32_t slot, double L, double *s0p,
+                       double *s1p, double px, double py, double sigma);
+
+/* Keeps a fanned-out window at its slot for ex_dominate, while memory
+ * allows (one not kept only trims nothing). */
+void ex_keep(mfmm_exact_ws *ws, int32_t slot, double b0, double b1, double px, double py,
+                    double sigma);
+
+/* The slot of half-edge g in nm_he (binary search), -1 if none. */
+int32_t ex_nm_slot(const mfmm_exact_ws *ws, int32_t g);
+
+#endif

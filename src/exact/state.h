@@ -1,0 +1,194 @@
+/* The exact solver's state (private to src/exact and the exact start's
+ * patch, start/patch.c): its constants, a mesh's read-only tables (face
+ * records, fans, non-manifold edges), a workspace (one solve's distances
+ * and its queue of windows), and small helpers on them. The algorithm:
+ * solver.c. */
+#ifndef MFMM_EXACT_STATE_H
+#define MFMM_EXACT_STATE_H
+
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "exact.h"
+#include "mesh/mesh.h"
+
+#define EX_PI 3.14159265358979323846264338328
+#define EX_TWO_PI 6.283185307179586476925286766559
+/* the shadow of a saddle is widened by this angle on each side */
+#define EX_SHADOW_MARGIN 1e-7
+/* distances equal to this relative amount are ties */
+#define EX_TIE 1e-12
+/* buckets in the queue's window (a power of 2), and their width in mean
+ * edge lengths */
+#define EX_NB 4096
+#define EX_BUCKET_WIDTH 0.25
+/* a window narrower than this fraction of its edge is dropped */
+#define EX_MIN_WIDTH 1e-13
+/* a point of an edge this close (relative) to a window's end is in it */
+#define EX_POS_TOL 1e-12
+/* a vertex this near (in edge lengths) to the pseudo-source of the path
+ * that reached it starts windows all around (ex_set_in) */
+#define EX_NEAR 1e-3
+/* a vertex this close (in edge lengths) outside a window's rays is
+ * reached over the window's end (ex_propagate) */
+#define EX_GRAZE 1e-6
+/* a patch distance outside its bounds by more than this times (the
+ * distance + a mean edge) is a defect (mfmm_exact_patch_check) */
+#define EX_PATCH_TOL 1e-9
+/* a face's edge shorter than this times the edge a window enters by gets
+ * its direction normalised by the length of its own vector in that frame
+ * (ex_propagate): its corners are placed to rounding of the longer edge, so
+ * the table's length would scale the frame, and every distance in it */
+#define EX_SHORT_CHILD 1e-3
+/* an edge shorter than this times the longest edge of a face at its ends
+ * is a wall (ex_wall_short_edges) */
+#define EX_SHORT_EDGE 1e-6
+/* zero-area faces one window may pass through in a row (ex_pass) */
+#define EX_MAX_PASS 8
+/* a vertex whose angle sum exceeds 2 pi by this much is a saddle */
+#define EX_SADDLE_TOL 1e-12
+
+/* k + 1 and k - 1 modulo 3, looked up: with k of a random window, a
+ * comparison there is a branch mispredicted about half the time */
+static const int8_t ex_next[3] = {1, 2, 0}, ex_prev[3] = {2, 0, 1};
+
+/* A face: for each corner k, the edge opposite it (half-edge 3f+k, from
+ * corner k+1 to k+2): its length, corner k in its frame (x along the edge,
+ * y > 0), and the same edge in the face across it (3g+m, -1 at a wall) with
+ * whether it runs the other way there; the corners' vertices and angles;
+ * whether it is skipped (1: zero area, its vertices pseudo-sources; 2: a
+ * copy of another face, mfmm_mesh_copy, no part of the surface). 128 bytes,
+ * aligned to cache lines. */
+typedef struct ex_face {
+    double len[3], cx[3], cy[3];
+    double angle[3]; /* the corners' angles */
+    int32_t v[3], across[3];
+    uint8_t flip[3], skip;
+    int8_t sgn[3];   /* the corners' fan_sgn (see mfmm_exact_tables) */
+    uint8_t tie;     /* bit k: corner k starts no windows, so a window tied with a
+                        path through it is kept (ex_enqueue) */
+} ex_face;
+
+/* An entry of the queue: a window, or a vertex to start as a pseudo-source. */
+typedef struct ex_entry {
+    double key;      /* the least distance of the window; a vertex's distance */
+    double b0, b1;   /* interval on the edge, from its first vertex */
+    double px, py;   /* pseudo-source in the edge's frame, py <= 0 */
+    double sigma;    /* distance at the pseudo-source */
+    int32_t he;      /* >= 0: 3 f + k, the edge opposite corner k of face f, the
+                        window about to cross f; < 0: vertex -he-1 */
+    int32_t next;    /* the next entry in its bucket or in the free list */
+} ex_entry;
+
+/* A window queued into a face through a non-manifold edge (ex_fan_out),
+ * kept to trim the later ones there (ex_dominate): its function and the
+ * interval it crosses with, in that half-edge's frame. */
+typedef struct ex_rec {
+    double b0, b1, px, py, sigma;
+    int32_t slot, next;
+} ex_rec;
+
+/* The read-only tables of a mesh (exact.h): built once, shared by the
+ * workspaces of any number of threads. Faces are laid out in the order of
+ * their least (internal, Morton-ordered: mesh/order.c) vertex, so that a
+ * patch's faces lie together in memory: in the files' order the faces
+ * around a vertex were 12,000 records apart on the bunny. */
+struct mfmm_exact_tables {
+    const mfmm_mesh *mesh;
+    int32_t nv, nf;
+    const int32_t *vf_offset;
+    const int32_t *vf_corner; /* the mesh's vertex -> face CSR, MFMM_WEDGE entries (ex_corner) */
+    int32_t *face_in;   /* (nf,) the mesh's face id -> its record */
+    /* per face, its three half-edges 3f+k (the edge opposite corner k, from
+     * corner k+1 to k+2) in one record, so that crossing a face reads one or
+     * two cache lines: see ex_face */
+    ex_face *fr;
+    void *fr_block;    /* fr's allocation (fr is aligned to 64 bytes in it) */
+    uint8_t *pseudo;   /* (nv,) vertices that may bend a path */
+    /* the fan of corners around a vertex, by angle: corner 3f+k (at v = f[k])
+     * spans the angles between fan_a0 (the direction to f[k+1]) and
+     * fan_a0 + sgn * angle (to f[k+2], ex_face); fan_total (nv) is the angle sum,
+     * NaN where the fan is not one closed disk (walls, zero-area faces,
+     * non-manifold vertices): those start windows in every direction */
+    double *fan_a0, *fan_total;
+    /* (nv,) a vertex's least height over the opposite edges of its faces
+     * (+inf with none): the patch's free ring (mfmm_exact_patch) */
+    double *height;
+    /* the half-edges of non-manifold edges (flip 2 in their record), sorted,
+     * each with the next half-edge of the same edge (a cycle through the
+     * edge's faces; ex_fan_out): n_nm of them */
+    int32_t *nm_he, *nm_next;
+    int32_t n_nm;
+    double inv_w;      /* 1 / bucket width */
+    size_t bytes;
+};
+
+/* A workspace: shared tables (the mesh's) and one solve's state. */
+struct mfmm_exact_solver {
+    const mfmm_exact_tables *t;
+    const mfmm_mesh *mesh;
+    int32_t nv, nf;
+    /* the tables' arrays (see mfmm_exact_tables) */
+    const int32_t *vf_offset, *vf_corner, *face_in;
+    const ex_face *fr;
+    const uint8_t *pseudo;
+    const double *fan_a0, *fan_total, *height;
+    const int32_t *nm_he, *nm_next;
+    int32_t n_nm;
+    double inv_w;
+    double *in_angle;  /* (nv,) direction (fan angle) back along the path that gave d */
+    double *d;         /* (nv,) best distance so far, +inf untouched */
+    double *emitted;   /* (nv,) the distance a pseudo-source was started with */
+    int32_t *touched;  /* vertices with finite d, in order of first touch */
+    int32_t n_touched;
+    double *patch_d;   /* (nv,) distances of mfmm_exact_patch */
+    uint8_t *in_patch; /* (nv,) whether in the last patch (mfmm_exact_in_patch) */
+    /* the queue */
+    ex_entry *heap;    /* the entries of the bucket queue, linked by next */
+    int32_t heap_cap, heap_n, heap_used, qfree;
+    /* the buckets in the window: (3 EX_NB,) heads and tails of their FIFO
+     * lists of windows, then heads of their lists of vertex events */
+    int32_t *bhead;
+    int32_t over;      /* entries beyond the window, unsorted */
+    int64_t cur, redist; /* current bucket; where the window was last refilled */
+    int32_t n_in;      /* entries in the window's buckets */
+    size_t fixed_bytes, memory_limit, peak_bytes;
+    double max_d;
+    int failed; /* MFMM_ERR_MEMORY_LIMIT or MFMM_ERR_OUT_OF_MEMORY once a growth fails,
+                   MFMM_ERR_CANCELLED once interrupt asked to stop */
+    int (*interrupt)(void *user); /* mfmm_exact_options' (NULL for a patch) */
+    void *interrupt_user;
+    int pass_depth; /* zero-area faces a window is passing through (ex_pass) */
+    /* with non-manifold edges crossed, windows past a budget (over_budget):
+     * the run is redone with those edges as walls (walls; ex_run); past it
+     * otherwise, the run stops (stalled) and edge paths finish it */
+    int over_budget, walls, stalled;
+    double budget; /* windows a reached vertex may cost (ex_over_budget) */
+    int64_t n_windows, n_propagated, n_pseudo, peak_windows;
+    /* the windows fanned out at non-manifold edges, by nm_he slot: (n_nm,)
+     * heads of lists in rec, -1: none */
+    int32_t *nm_head;
+    ex_rec *rec;
+    int32_t rec_n, rec_cap;
+};
+
+static inline double vdist(const double *p, const double *q)
+{
+    double a = p[0] - q[0], b = p[1] - q[1], c = p[2] - q[2];
+    return sqrt(a * a + b * b + c * c);
+}
+
+/* Entry i of the vertex -> face CSR, as corner 3 * record + k. */
+static inline int32_t ex_corner(const int32_t *vf_corner, const int32_t *face_in, int32_t i)
+{
+    int32_t w = vf_corner[i];
+    return 3 * face_in[MFMM_WEDGE_FACE(w)] + MFMM_WEDGE_K(w);
+}
+
+static inline int ex_corner_of(const int32_t *fv, int32_t v)
+{
+    return fv[0] == v ? 0 : fv[1] == v ? 1 : fv[2] == v ? 2 : -1;
+}
+
+#endif

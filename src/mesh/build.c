@@ -1,0 +1,530 @@
+/* The precomputation every solve reuses, from checked arrays: vertex and
+ * face order (order.c), adjacency, edge lengths, corner angles (section
+ * 4.1), virtual edges (section 4.2, in unfold.c) and the face records the
+ * march reads; and the mesh's destruction. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "base/error.h"
+#include "build.h"
+#include "order.h"
+#include "unfold.h"
+
+/* Smallest extent: lengths are squared once (1e-200 is far from
+ * underflow). */
+#define MFMM_MIN_DIAGONAL 1e-100
+
+void mfmm_mesh_destroy(mfmm_mesh *mesh)
+{
+    if (!mesh)
+        return;
+    free(mesh->to_internal);
+    free(mesh->to_external);
+    free(mesh->face_to_internal);
+    free(mesh->face_to_external);
+    free(mesh->piece_next);
+    free(mesh->piece_bary);
+    free(mesh->xyz);
+    free(mesh->face_neighbor);
+    free(mesh->vertex_face_offset);
+    free(mesh->vertex_wedge);
+    free(mesh->full);
+    free(mesh->face_block);
+    free(mesh->virts);
+    free(mesh->virt_first);
+    free(mesh->virt_strip);
+    free(mesh->strip);
+    free(mesh->build_steps);
+    if (mesh->exact_tables)
+        mesh->exact_tables_free(mesh->exact_tables);
+    free(mesh->spoke_offset);
+    free(mesh->spoke_block);
+    pthread_mutex_destroy(&mesh->cache_lock);
+    free(mesh);
+}
+
+/* A half-edge key: the corner opposite the edge (lo, hi). */
+typedef struct half_edge {
+    int32_t lo, hi, corner;
+} half_edge;
+
+static int half_edge_cmp(const void *pa, const void *pb)
+{
+    const half_edge *a = pa, *b = pb;
+    if (a->lo != b->lo)
+        return a->lo < b->lo ? -1 : 1;
+    if (a->hi != b->hi)
+        return a->hi < b->hi ? -1 : 1;
+    return (a->corner > b->corner) - (a->corner < b->corner);
+}
+
+/* Face adjacency across edges, boundary and non-manifold counts, edge-length
+ * statistics. */
+static mfmm_status build_edges(mfmm_mesh *m)
+{
+    size_t nc = (size_t)m->nf * 3;
+    half_edge *he = malloc(nc * sizeof *he);
+    if (!he)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    for (size_t c = 0; c < nc; c++) {
+        size_t f = c / 3, k = c % 3;
+        int32_t u = m->face_records[f].v[(k + 1) % 3], v = m->face_records[f].v[(k + 2) % 3];
+        he[c].lo = u < v ? u : v;
+        he[c].hi = u < v ? v : u;
+        he[c].corner = (int32_t)c;
+    }
+    qsort(he, nc, sizeof *he, half_edge_cmp);
+    double sum = 0.0, lmin = INFINITY, lmax = 0.0;
+    int32_t n_edges = 0, n_boundary = 0, n_nonmanifold = 0;
+    for (size_t i = 0; i < nc;) {
+        size_t j = i + 1;
+        while (j < nc && he[j].lo == he[i].lo && he[j].hi == he[i].hi)
+            j++;
+        n_edges++;
+        const double *p = m->xyz + 3 * (size_t)he[i].lo, *q = m->xyz + 3 * (size_t)he[i].hi;
+        double len = sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                          (p[2] - q[2]) * (p[2] - q[2]));
+        sum += len;
+        lmin = fmin(lmin, len);
+        lmax = fmax(lmax, len);
+        /* copies of a face stand aside: the edge is what the other faces
+         * make it (two copies of a face made its edges walls) */
+        size_t real[2] = {0, 0}, n_real = 0;
+        for (size_t t = i; t < j; t++)
+            if (!mfmm_mesh_copy(m, he[t].corner / 3)) {
+                if (n_real < 2)
+                    real[n_real] = t;
+                n_real++;
+            }
+        if (n_real == 2) {
+            m->face_neighbor[he[real[0]].corner] = he[real[1]].corner / 3;
+            m->face_neighbor[he[real[1]].corner] = he[real[0]].corner / 3;
+        } else {
+            /* boundary, or non-manifold: the walk of section 4.2 stops here */
+            for (size_t t = i; t < j; t++)
+                m->face_neighbor[he[t].corner] = -1;
+            if (n_real == 1)
+                n_boundary++;
+            else
+                n_nonmanifold++;
+        }
+        /* a copy's edge leads where its original's does: copies follow
+         * their original in face order, hence in the group (O(faces), even
+         * for a million copies of one face) */
+        for (size_t t = i, s = i; t < j; t++) {
+            if (!mfmm_mesh_copy(m, he[t].corner / 3))
+                s = t;
+            else
+                m->face_neighbor[he[t].corner] = m->face_neighbor[he[s].corner];
+        }
+        i = j;
+    }
+    free(he);
+    int32_t n_copies = 0;
+    for (int32_t f = 1; f < m->nf; f++)
+        n_copies += mfmm_mesh_copy(m, f);
+    m->info.n_duplicate_faces = n_copies;
+    m->info.n_edges = n_edges;
+    m->info.n_boundary_edges = n_boundary;
+    m->info.n_nonmanifold_edges = n_nonmanifold;
+    m->info.min_edge_length = lmin;
+    m->info.max_edge_length = lmax;
+    m->info.mean_edge_length = n_edges ? sum / n_edges : 0.0;
+    return MFMM_OK;
+}
+
+/* The corner of face f in x's corner list list[0..n) (sorted by face, as
+ * build_vertex_faces makes it), or -1. */
+static int32_t find_corner(const int32_t *list, int32_t n, int32_t f)
+{
+    int32_t lo = 0, hi = n;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (list[mid] / 3 < f)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < n && list[lo] / 3 == f ? lo : -1;
+}
+
+/* Puts each vertex's corners in fan order: face (x, p, q) is followed by
+ * the face across edge xq when that face has x, q in the same orientation
+ * (its vertex after x is q), so that consecutive faces share a neighbour
+ * of x: the march (march.h) then meets x's settled neighbours in runs, which
+ * its branches predict, and offers a shared neighbour once. Fans start at a
+ * face with no predecessor (a boundary, non-manifold or flipped edge);
+ * closed fans follow. Any order is correct: this one saves work. */
+static mfmm_status fan_order(mfmm_mesh *m)
+{
+    int32_t dmax = 0;
+    for (int32_t v = 0; v < m->nv; v++) {
+        int32_t d = m->vertex_face_offset[v + 1] - m->vertex_face_offset[v];
+        dmax = d > dmax ? d : dmax;
+    }
+    int32_t *next = malloc(((size_t)dmax + 1) * 3 * sizeof *next);
+    if (!next)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    int32_t *has_prev = next + dmax + 1, *out = has_prev + dmax + 1;
+    for (int32_t v = 0; v < m->nv; v++) {
+        int32_t *list = m->vertex_wedge + m->vertex_face_offset[v];
+        int32_t n = m->vertex_face_offset[v + 1] - m->vertex_face_offset[v];
+        for (int32_t i = 0; i < n; i++)
+            has_prev[i] = 0;
+        for (int32_t i = 0; i < n; i++) {
+            int32_t c = list[i], f = c / 3, k = c % 3;
+            int32_t kp = k == 2 ? 0 : k + 1, kq = kp == 2 ? 0 : kp + 1;
+            int32_t q = m->face_records[f].v[kq];
+            int32_t g = m->face_neighbor[3 * f + kp]; /* across edge x q */
+            int32_t j = g >= 0 ? find_corner(list, n, g) : -1;
+            next[i] = -1;
+            if (j >= 0 && j != i && !has_prev[j]) {
+                int32_t kg = list[j] % 3;
+                if (m->face_records[g].v[kg == 2 ? 0 : kg + 1] == q) {
+                    next[i] = j;
+                    has_prev[j] = 1;
+                }
+            }
+        }
+        int32_t n_out = 0;
+        for (int pass = 0; pass < 2; pass++)
+            for (int32_t i = 0; i < n; i++) {
+                if (has_prev[i] == 2 || (pass == 0 && has_prev[i]))
+                    continue;
+                for (int32_t j = i; j >= 0 && has_prev[j] != 2; j = next[j]) {
+                    out[n_out++] = list[j];
+                    has_prev[j] = 2;
+                }
+            }
+        memcpy(list, out, (size_t)n * sizeof *list);
+    }
+    free(next);
+    return MFMM_OK;
+}
+
+/* Vertex -> corner CSR. */
+static mfmm_status build_vertex_faces(mfmm_mesh *m)
+{
+    size_t nc = (size_t)m->nf * 3;
+    int32_t *off = calloc((size_t)m->nv + 1, sizeof *off);
+    int32_t *list = malloc(nc * sizeof *list);
+    if (!off || !list) {
+        free(off);
+        free(list);
+        return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    for (size_t c = 0; c < nc; c++)
+        off[mfmm_mesh_corner_vertex(m, (int32_t)c) + 1]++;
+    for (int32_t v = 0; v < m->nv; v++)
+        off[v + 1] += off[v];
+    for (size_t c = 0; c < nc; c++) {
+        int32_t v = mfmm_mesh_corner_vertex(m, (int32_t)c);
+        list[off[v]++] = (int32_t)c;
+    }
+    for (int32_t v = m->nv; v > 0; v--)
+        off[v] = off[v - 1];
+    off[0] = 0;
+    m->vertex_face_offset = off;
+    m->vertex_wedge = list;
+    mfmm_status st = fan_order(m);
+    if (st != MFMM_OK)
+        return st;
+    for (size_t i = 0; i < nc; i++)
+        list[i] = MFMM_WEDGE(list[i] / 3, list[i] % 3);
+    return MFMM_OK;
+}
+
+static int32_t uf_find(int32_t *parent, int32_t x)
+{
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    return x;
+}
+
+/* Connected components (through faces) of referenced vertices: their count
+ * (the ids are not kept). */
+static mfmm_status build_components(mfmm_mesh *m)
+{
+    int32_t *parent = malloc((size_t)m->nv * sizeof *parent);
+    int32_t *component = malloc((size_t)m->nv * sizeof *component);
+    if (!parent || !component) {
+        free(parent);
+        free(component);
+        return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    for (int32_t v = 0; v < m->nv; v++)
+        parent[v] = v;
+    for (int32_t f = 0; f < m->nf; f++) {
+        int32_t r0 = uf_find(parent, m->face_records[f].v[0]);
+        for (int k = 1; k < 3; k++) {
+            int32_t r = uf_find(parent, m->face_records[f].v[k]);
+            if (r != r0)
+                parent[r] = r0;
+        }
+    }
+    int32_t n_comp = 0, n_unref = 0;
+    for (int32_t v = 0; v < m->nv; v++)
+        component[v] = -1;
+    for (int32_t v = 0; v < m->nv; v++) {
+        if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1]) {
+            n_unref++;
+            continue;
+        }
+        int32_t r = uf_find(parent, v);
+        if (component[r] < 0)
+            component[r] = n_comp++;
+        component[v] = component[r];
+    }
+    free(parent);
+    free(component);
+    m->info.n_components = n_comp;
+    m->info.n_unreferenced_vertices = n_unref;
+    return MFMM_OK;
+}
+
+static void sub3(double *o, const double *a, const double *b)
+{
+    o[0] = a[0] - b[0];
+    o[1] = a[1] - b[1];
+    o[2] = a[2] - b[2];
+}
+
+static double dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* Corner lengths and angles; degenerate faces; obtuse corners; the face
+ * records' lengths and cosines. */
+static void build_corners(mfmm_mesh *m)
+{
+    int32_t n_degenerate = 0, n_obtuse = 0;
+    for (int32_t f = 0; f < m->nf; f++) {
+        const int32_t *fv = m->face_records[f].v;
+        double e[3][3], len[3]; /* e[k]: edge opposite corner k, from k+1 to k+2 */
+        for (int k = 0; k < 3; k++) {
+            sub3(e[k], m->xyz + 3 * (size_t)fv[(k + 2) % 3], m->xyz + 3 * (size_t)fv[(k + 1) % 3]);
+            len[k] = sqrt(dot3(e[k], e[k]));
+        }
+        /* zero area up to rounding (twice the area |e0 x e1| <= 64 eps lmax^2),
+         * tested on unit vectors so that no length is squared twice: no
+         * triangle update there, edges only */
+        double lmax = fmax(len[0], fmax(len[1], len[2]));
+        int degenerate = !(len[0] > 0.0 && len[1] > 0.0);
+        if (!degenerate) {
+            double u0[3], u1[3];
+            for (int d = 0; d < 3; d++) {
+                u0[d] = e[0][d] / len[0];
+                u1[d] = e[1][d] / len[1];
+            }
+            double cr[3] = {u0[1] * u1[2] - u0[2] * u1[1], u0[2] * u1[0] - u0[0] * u1[2],
+                            u0[0] * u1[1] - u0[1] * u1[0]};
+            double sine = sqrt(dot3(cr, cr));
+            degenerate = !(sine > 64.0 * DBL_EPSILON * (lmax / len[0]) * (lmax / len[1]));
+        }
+        n_degenerate += degenerate;
+        for (int k = 0; k < 3; k++) {
+            mfmm_corner_full *c = m->full + 3 * (size_t)f + k;
+            int ka = (k + 1) % 3, kb = (k + 2) % 3;
+            c->face = f;
+            c->a = fv[ka];
+            c->b = fv[kb];
+            c->len_a = len[ka]; /* |BC| is opposite A */
+            c->len_b = len[kb]; /* |AC| is opposite B */
+            c->cos_c = 0.0;
+            c->virt = degenerate ? MFMM_VIRT_DEGENERATE : MFMM_VIRT_NONE;
+            c->virt_len = 0.0;
+            c->virt_cos_a = 0.0;
+            c->virt_cos_b = 0.0;
+            if (degenerate)
+                continue;
+            /* cos at C from the edge vectors C->A = e[kb], C->B = -e[ka] */
+            double cosv = -dot3(e[kb], e[ka]) / (len[kb] * len[ka]);
+            c->cos_c = fmax(-1.0, fmin(1.0, cosv));
+            if (c->cos_c < MFMM_OBTUSE_COS) {
+                c->virt = MFMM_VIRT_FAILED; /* until unfolding finds its virtual edge */
+                n_obtuse++;
+            }
+        }
+        /* the march's record (NaN cosines: zero area, mfmm_mesh_degenerate),
+         * which unfolding reads already */
+        mfmm_face *r = m->face_records + f;
+        for (int k = 0; k < 3; k++) {
+            r->len[k] = len[k];
+            r->cosv[k] = degenerate ? NAN : m->full[3 * (size_t)f + k].cos_c;
+        }
+    }
+    m->info.n_degenerate_faces = n_degenerate;
+    m->info.n_obtuse_corners = n_obtuse;
+}
+
+/* The march's records from the build's corners: each face record's obtuse
+ * corner (its vertices, lengths and cosines are in place: mesh creation,
+ * build_corners), and one mfmm_virt per obtuse corner whose
+ * virtual edge unfolding found, sorted by V (counting sort, so by corner
+ * within one V), the face naming V (the march reads the record from V's
+ * list once V is Alive). The strips' vertices (for the
+ * virtual stencils' cost test) per virtual edge but V, in virts' order (the
+ * strips' other fields are re-walked when needed, mfmm_strip_next). Frees
+ * m->full and m->build_steps. */
+static mfmm_status build_records(mfmm_mesh *m)
+{
+    size_t nf = (size_t)m->nf, nc = 3 * nf;
+    size_t n_steps = 0;
+    size_t n_virts = 0;
+    for (size_t c = 0; c < nc; c++)
+        if (m->full[c].virt >= 0) {
+            n_virts++;
+            n_steps += (size_t)m->full[c].strip_n - 1; /* (V aside) */
+        }
+    if (n_steps > (size_t)INT32_MAX)
+        return MFMM_ERR_BAD_COUNT;
+    if (n_virts > (size_t)INT32_MAX ||
+        (n_virts > 0 && m->nv > INT32_MAX / 4)) /* (mfmm_face.virt packs 4 V + k) */
+        return MFMM_ERR_BAD_COUNT;
+    m->n_virts = (int32_t)n_virts;
+    m->virts = malloc((n_virts ? n_virts : 1) * sizeof *m->virts);
+    m->virt_first = calloc((size_t)m->nv + 1, sizeof *m->virt_first);
+    m->virt_strip = malloc((n_virts + 1) * sizeof *m->virt_strip);
+    m->strip = malloc((n_steps ? n_steps : 1) * sizeof *m->strip);
+    if (!m->virts || !m->virt_first || !m->virt_strip || !m->strip)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    int32_t *first = m->virt_first;
+    for (size_t c = 0; c < nc; c++)
+        if (m->full[c].virt >= 0)
+            first[m->full[c].virt + 1]++;
+    for (int32_t v = 0; v < m->nv; v++)
+        first[v + 1] += first[v];
+    for (size_t f = 0; f < nf; f++) {
+        mfmm_face *r = m->face_records + f;
+        r->virt = 3;
+        for (int k = 0; k < 3; k++) {
+            const mfmm_corner_full *x = m->full + 3 * f + k;
+            if (x->virt < 0)
+                continue;
+            /* (a face has at most one obtuse corner) */
+            int32_t at = first[x->virt]++;
+            mfmm_virt *vr = m->virts + at;
+            vr->corner = (int32_t)(3 * f + (size_t)k);
+            vr->c = m->face_records[f].v[k];
+            vr->len = x->virt_len;
+            vr->cos_a = x->virt_cos_a;
+            vr->cos_b = x->virt_cos_b;
+            r->virt = 4 * x->virt + k;
+            m->virt_strip[at + 1] = x->strip_n - 1;
+        }
+    }
+    for (int32_t v = m->nv; v > 0; v--)
+        first[v] = first[v - 1];
+    first[0] = 0;
+    m->virt_strip[0] = 0;
+    for (size_t j = 0; j < n_virts; j++) {
+        const mfmm_corner_full *x = m->full + m->virts[j].corner;
+        int32_t at = m->virt_strip[j];
+        for (int32_t i = 0; i < x->strip_n - 1; i++)
+            m->strip[at + i] = m->build_steps[x->strip_at + i].far;
+        m->virt_strip[j + 1] += at;
+    }
+    free(m->full);
+    m->full = NULL;
+    free(m->build_steps);
+    m->build_steps = NULL;
+    return MFMM_OK;
+}
+
+mfmm_status mfmm_mesh_build(const double *vertices, int32_t nv, const int32_t *faces,
+                            int32_t nf, const mfmm_mesh_options *options, mfmm_mesh **out,
+                            mfmm_error *err)
+{
+    mfmm_mesh_options opt = *options;
+    mfmm_status st;
+    mfmm_mesh *m = calloc(1, sizeof *m);
+    if (!m)
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
+    if (pthread_mutex_init(&m->cache_lock, NULL) != 0) {
+        free(m);
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "cannot make the mesh's lock");
+    }
+    m->nv = nv;
+    m->nf = nf;
+    m->nf_in = nf;
+    m->spokes_allowed = opt.spokes;
+    size_t nc = (size_t)nf * 3;
+    m->xyz = malloc((size_t)nv * 3 * sizeof *m->xyz);
+    /* the face records, on cache-line boundaries (one record, one line):
+     * their vertices now, the rest once the corners are known */
+    m->face_block = malloc((size_t)nf * sizeof *m->face_records + 64);
+    if (m->face_block)
+        m->face_records = (mfmm_face *)(void *)((char *)m->face_block +
+                                                (64 - (uintptr_t)m->face_block % 64) % 64);
+    m->face_neighbor = malloc(nc * sizeof *m->face_neighbor);
+    m->full = malloc(nc * sizeof *m->full);
+    if (!m->xyz || !m->face_block || !m->face_neighbor ||
+        !m->full) {
+        mfmm_mesh_destroy(m);
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
+    }
+    /* renumbered: coordinates in internal order, faces' vertex ids mapped
+     * (face_neighbor holds them in input face order until the faces are
+     * ordered by them) */
+    if (mfmm_order_build(vertices, nv, &m->to_internal, &m->to_external) != MFMM_OK) {
+        mfmm_mesh_destroy(m);
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
+    }
+    for (int32_t v = 0; v < nv; v++)
+        memcpy(m->xyz + 3 * (size_t)v, vertices + 3 * (size_t)m->to_external[v], 3 * sizeof *m->xyz);
+    for (size_t c = 0; c < nc; c++)
+        m->face_neighbor[c] = m->to_internal[faces[c]];
+    if (mfmm_order_faces(m->face_neighbor, nf, &m->face_to_internal, &m->face_to_external) !=
+        MFMM_OK) {
+        mfmm_mesh_destroy(m);
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
+    }
+    for (int32_t f = 0; f < nf; f++)
+        memcpy(m->face_records[f].v, m->face_neighbor + 3 * (size_t)m->face_to_external[f],
+               sizeof m->face_records[f].v);
+    m->info.n_vertices = nv;
+    m->info.n_faces = nf;
+
+    st = build_edges(m);
+    if (st == MFMM_OK)
+        st = build_vertex_faces(m);
+    if (st == MFMM_OK)
+        st = build_components(m);
+    if (st == MFMM_OK) {
+        build_corners(m);
+        st = mfmm_mesh_unfold_obtuse(m, opt.max_unfold_steps);
+    }
+    if (st == MFMM_OK)
+        st = build_records(m);
+    if (st != MFMM_OK) {
+        mfmm_mesh_destroy(m);
+        return mfmm_fail(err, st, -1, NULL);
+    }
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t v = 0; v < nv; v++) {
+        if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1])
+            continue; /* unreferenced */
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], m->xyz[3 * (size_t)v + k]);
+            hi[k] = fmax(hi[k], m->xyz[3 * (size_t)v + k]);
+        }
+    }
+    /* hypot: squares of 1e-200 underflow to 0 */
+    m->info.bbox_diagonal = hypot(hypot(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
+    /* below this, squared lengths underflow and every edge would measure 0 */
+    if (!(m->info.bbox_diagonal >= MFMM_MIN_DIAGONAL)) {
+        double diag = m->info.bbox_diagonal;
+        mfmm_mesh_destroy(m);
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "the mesh's bounding box diagonal is %g; it must be at least %g "
+                         "(rescale the mesh)",
+                         diag, MFMM_MIN_DIAGONAL);
+    }
+    *out = m;
+    return MFMM_OK;
+}
