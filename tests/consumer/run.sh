@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Installs the build into a temporary prefix (cmake --install), then builds
-# the README's C example as another project would and runs it, checking the
+# the complete C program of docs/getting-started.md as another project would
+# and runs it, checking the
 # distances on the unit square (0, 1, 1, sqrt(2)):
 #   - CMake find_package: meshfmm::meshfmm (shared) and meshfmm::meshfmm_static,
 #     and a C++ translation unit that includes meshfmm.h;
-#   - pkg-config: dynamic (the README's line, with -Wl,-rpath for the prefix)
+#   - pkg-config: dynamic (the page's line, with -Wl,-rpath for the prefix)
 #     and static (pkg-config --static, linked with -static);
 # and that libmeshfmm.so does not depend on libOpenCL (it is dlopen'ed).
 # Usage: run.sh SOURCE_DIR BUILD_DIR
@@ -16,8 +17,8 @@ prefix="$tmp/prefix"
 cmake --install "$build" --prefix "$prefix" >/dev/null
 mkdir -p "$tmp/consumer"
 cp "$src/tests/consumer/CMakeLists.txt" "$src/tests/consumer/cxx_example.cpp" "$tmp/consumer/"
-# the first ```c block of the README
-awk '/^```c$/ {on = 1; next} /^```$/ && on {exit} on' "$src/README.md" > "$tmp/consumer/readme_example.c"
+# the first ```c block of the getting-started page (a complete program)
+awk '/^```c$/ {on = 1; next} /^```$/ && on {exit} on' "$src/docs/getting-started.md" > "$tmp/consumer/readme_example.c"
 test -s "$tmp/consumer/readme_example.c"
 fail() { echo "consumer: $*" >&2; exit 1; }
 expected="0 0.000000000000
@@ -50,7 +51,7 @@ ldd "$tmp/consumer/build/readme_example_static" | grep -q libmeshfmm \
     && fail "the static consumer needs libmeshfmm.so"
 check "C++ consumer" env LD_LIBRARY_PATH="$libdir" "$tmp/consumer/build/cxx_example"
 
-# pkg-config for a non-system prefix, as the README says
+# pkg-config for a non-system prefix, as the page says
 export PKG_CONFIG_PATH="$libdir/pkgconfig"
 cc -std=c99 -Wall -Wextra -Werror "$tmp/consumer/readme_example.c" -o "$tmp/pc_dynamic" \
    $(pkg-config --cflags --libs meshfmm) -Wl,-rpath,"$libdir"
