@@ -202,7 +202,7 @@ fi
 # An unwritable output: exit 1.
 expect 1 "unwritable output" "$BIN" distance "$T/g.obj" --source "$C" -o "$T/no/such/dir/d.txt"
 
-# ---- getopt_long conventions (issue 10): --opt=value, -o -, --help ----
+# ---- getopt_long conventions: --opt=value, -o -, options in any order, --help ----
 if expect 0 "distance --source=C --output=FILE" "$BIN" distance "$T/g.obj" --source="$C" --output="$T/eq.txt"; then
     cmp -s "$T/eq.txt" "$T/d.txt" && ok "--source=C equals --source C" || fail "--source=C differs"
 fi
@@ -223,7 +223,7 @@ expect 2 "unknown long option" "$BIN" distance "$T/g.obj" --source 0 --frobnicat
 expect 2 "allpairs -o - refused" "$BIN" allpairs "$T/g.obj" -o -
 expect 0 "generate -o -" "$BIN" generate grid 2 -o - && { grep -c '^v ' "$T/out" | grep -qx 9 && ok "generate to stdout" || fail "generate stdout"; }
 
-# ---- allpairs --cost and --threads 0 (issue 10) ----
+# ---- allpairs --cost equals distance --cost; --threads 0 and bad counts ----
 # A single-source allpairs row equals `distance` with the same cost, bit for bit.
 echo "$C" >"$T/one.txt"
 if expect 0 "allpairs --cost --threads 0" "$BIN" allpairs "$T/g.obj" --sources "$T/one.txt" --cost "$T/fcost.txt" --cost-per-face --dtype float64 --threads 0 --backend threads -o "$T/ap.npy"; then
@@ -235,8 +235,8 @@ fi
 expect 1 "allpairs cost count mismatch" "$BIN" allpairs "$T/g.obj" --sources "$T/one.txt" --cost "$T/fcost.txt" -o "$T/x.npy"
 expect 2 "allpairs --threads -1" "$BIN" allpairs "$T/g.obj" --threads -1 -o "$T/x.npy"
 
-# ---- outputs: unique temporary, exclusive create, rename (issue 9 item 8) ----
-# A symlink planted at the old predictable name OUT.partial is not followed.
+# ---- outputs: unique temporary, exclusive create, rename ----
+# A symlink planted at the predictable name OUT.partial is not followed.
 echo "precious" >"$T/victim"
 ln -s "$T/victim" "$T/sym.txt.partial"
 expect 0 "distance beside a planted symlink" "$BIN" distance "$T/g.obj" --source "$C" -o "$T/sym.txt" &&
@@ -258,7 +258,7 @@ kill -TERM $p; wait $p; r=$?
     fail "SIGTERM: exit $r, left: $(ls "$T" | grep sig)"
 
 # A target name of 250 characters (NAME_MAX 255): its temporary's name is
-# cut to fit (mkstemp failed with "File name too long" before).
+# cut to fit, so that mkstemp does not fail with "File name too long".
 long=$(printf 'l%.0s' $(seq 246)).txt
 expect 0 "distance -o a 250-character name" "$BIN" distance "$T/g.obj" --source "$C" -o "$T/$long" &&
     { cmp -s "$T/$long" "$T/d.txt" && ! ls "$T" | grep -q '^lll.*\.......$' && ok "long name: complete, no temporary" ||
@@ -295,7 +295,7 @@ if [ -w /dev/full ]; then
     expect 1 "path with stdout full" sh -c '"$1" path "$2" --source "$3" --target "$4" -o "$5" >/dev/full' sh "$BIN" "$T/g.obj" "$C" "$C2" "$T/p.csv"
 fi
 
-# ---- an output that is an input is refused (issue 9 item 9) ----
+# ---- an output that is an input (any spelling, hard link) is refused ----
 cp "$T/g.obj" "$T/in.obj"; cp "$T/cost.txt" "$T/incost.txt"
 ln "$T/in.obj" "$T/hard.txt"
 mkdir -p "$T/sub"
@@ -309,7 +309,7 @@ ln "$T/in.obj" "$T/meshlink.npy"
 expect 2 "allpairs output hard-linked to the mesh" "$BIN" allpairs "$T/in.obj" -o "$T/meshlink.npy"
 cmp -s "$T/in.obj" "$T/g.obj" && cmp -s "$T/incost.txt" "$T/cost.txt" && ok "inputs untouched" || fail "an input was overwritten"
 
-# ---- not regular files (issue 9 item 10): refused at once, with the path ----
+# ---- not regular files: refused at once, with the path ----
 mkfifo "$T/fifo.obj" "$T/fifo.txt"
 for m in /dev/zero "$T/fifo.obj" "$T/sub"; do
     expect 1 "info $m refused" timeout 20 "$BIN" info "$m" &&
@@ -321,10 +321,11 @@ expect 1 "--cost FIFO refused" timeout 20 "$BIN" distance "$T/g.obj" --source 0 
 expect 1 "--sources FIFO refused" timeout 20 "$BIN" allpairs "$T/g.obj" --sources "$T/fifo.txt" -o "$T/x.npy"
 expect 1 "--sources /dev/zero (.npy) refused" timeout 20 "$BIN" allpairs "$T/g.obj" --sources /dev/zero -o "$T/x.npy"
 
-# ---- .npy --sources (issue 9 item 12) ----
+# ---- .npy --sources: truncated and malformed headers are refused ----
 # npy_file FILE HLEN DICT [DATA]: a version-1 .npy with a declared header length.
 npy_file() { { printf '\223NUMPY\001\000'; printf "\\$(printf %o $(($2 % 256)))\\$(printf %o $(($2 / 256)))"; printf '%s' "$3"; printf "${4:-}"; } >"$1"; }
-# 36 bytes, the header length promising more than the file: read past its buffer before.
+# 36 bytes, the header length promising more than the file: refused without
+# reading past the buffer.
 npy_file "$T/s36.npy" 26 "{'shape': (1,), 'descr': '"
 [ "$(wc -c <"$T/s36.npy")" -eq 36 ] || fail "s36.npy is not 36 bytes"
 expect 1 "36-byte --sources .npy" "$BIN" allpairs "$T/g.obj" --sources "$T/s36.npy" -o "$T/x.npy"
@@ -348,7 +349,7 @@ npy_file "$T/s3.npy" 118 "$(printf '%-117s' "$d")
 " "\\0\\0\\0\\0\\$(printf %o "$C")\\0\\0\\0\\2\\0\\0\\0"
 expect 0 "a valid (3,) --sources" "$BIN" allpairs "$T/g.obj" --sources "$T/s3.npy" -o "$T/ok3.npy"
 
-# ---- STL and unsupported formats (issue 10) ----
+# ---- STL is read; unsupported formats are refused, naming those read ----
 awk 'BEGIN { print "solid g" } /^v / { v[++n] = $2 " " $3 " " $4 }
      /^f / { print "facet normal 0 0 1\nouter loop"; for (i = 2; i <= 4; i++) print "vertex " v[$i]
              print "endloop\nendfacet" } END { print "endsolid g" }' "$T/g.obj" >"$T/g.stl"
