@@ -1,33 +1,15 @@
-/* The "exact start" of a march: mfmm_exact_patch (src/exact/exact.h) from
- * many vertex sources with a radius of a few edges, against one full
- * mfmm_solve_exact. Usage:
- *   bench_exact_patch [--edges K] [--sources S] MESH...
- * radius = K mean edge lengths (default MFMM_EXACT_START_RADIUS, the library's
- * base radius); S sources spread over the mesh (default 200). Prints per
- * mesh: mean patch size, mean time per patch, the full solve's time, and the
+/* The cost of the exact start's patch: mfmm_exact_patch (start/patch.h)
+ * from many vertex sources with a radius of a few edges, against one full
+ * mfmm_solve_exact on the same mesh (the peer: what the patch saves over
+ * solving exactly everywhere). Prints per mesh: mean patch size (vertices,
+ * windows), mean time per patch, the full solve's time, and the
  * workspace's peak bytes.
  *
- * Session 28 (issue 13: the patch is 15-20 % of an all-pairs row on
- * camelhead, and doubles a row on meshes under 3k vertices):
- * - Cost against radius (--edges 3 / 5 / 7 / 10, 400 sources): camelhead
- *   80 / 179 / 308 / 561 vertices, 568 / 1818 / 4041 / 9757 windows,
- *   31 / 84 / 172 / 391 us a patch; nefertiti 19 / 56 / 124 / 308 us; hand
- *   19 / 38 / 66 / 127 us; beetle 29 / 71 / 128 / 248 us. Windows per
- *   vertex grow with r (camelhead 7, 10, 13, 17), so a patch costs about
- *   r^2.2. All pairs, camelhead, 2000 rows, serial, two rounds:
- *   r = 7 2.46-2.50 s, r = 5 2.16-2.17, r = 3 2.04-2.06, plain 1.95.
- * - Pruning is saturated. A probe (not kept) ran each patch twice, the
- *   second time trimming against the first run's final distances at every
- *   vertex (perfect upper bounds, ex_enqueue's ex_trim) and dropping a
- *   window that the far vertex of the face it enters beats at 9 points of
- *   its interval (ICH's third rule with perfect bounds): 200 sources, r = 7,
- *   windows hand 1213 -> 1202, camelhead 3926 -> 3924, nefertiti 2417 ->
- *   2417, the same patch distances. The queue's order already gives the
- *   edge ends their final distances when a window is trimmed; what is left
- *   are distinct unfoldings on the lower envelope of their edges (window
- *   against window dominance, MMP's, removed 5 %: session 23). Any exact
- *   method that carries these windows (VTP too) carries about as many: a
- *   faster patch has to come from cheaper windows, or a smaller radius. */
+ *   bench_exact_patch [--edges K] [--sources S] MESH...
+ *
+ * radius = K mean edge lengths (default MFMM_EXACT_START_RADIUS, the
+ * library's base radius); S sources spread over the mesh (default 200).
+ * Findings and their commands: docs/march-measurements.md. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,22 +1,22 @@
 /* One serial solve, timed: median of repeats on a built mesh, in vertices per
- * second (issue 2's figure of merit), and the ceiling it is measured against
- * (issue 13): a plain Dijkstra over the march's own edge graph (every vertex's
- * update list, each neighbour once, edge lengths precomputed), with the same
- * 8-ary heap, vertex order and per-solve reset. ratio = march time / Dijkstra
- * time. With unfolding (the march over spokes) it also times the spoke walk
- * with its edge updates alone, which splits the ratio in two: the spoke
- * records against the graph's edges (records = edges-only walk / Dijkstra)
- * and the triangles' updates (updates = march / edges-only walk).
- * Usage:
- *   bench_solve [--repeats R] [--sources S] [--exact-start R] MESH...
+ * second, against its ceiling: a plain Dijkstra over the march's own edge
+ * graph (every vertex's update list, each neighbour once, edge lengths
+ * precomputed), with the same 8-ary heap, vertex order and per-solve reset.
+ * ratio = march time / Dijkstra time. With unfolding (the march over
+ * spokes) it also times the spoke walk with its edge updates alone, which
+ * splits the ratio in two: the spoke records against the graph's edges
+ * (records = edges-only walk / Dijkstra) and the triangles' updates
+ * (updates = march / edges-only walk). It also prints the built mesh's
+ * bytes per vertex, each array's share.
+ *
+ *   bench_solve [--repeats R] [--sources S] [--exact-start R] [MESH...]
+ *
  * The march starts plain (the paper's start) unless --exact-start R > 0.
- * Each repeat runs every source in turn, as the rows of a job alternate.
- * One source repeated back to back (before session 29) ran small meshes
- * faster than any job sees them: hand 0.029 ms (Dijkstra 0.017) against
- * 0.050 (0.028) in turn, spot 0.175 against 0.199, camelhead equal (likely
- * the branch predictor learning the repeated march: hand's arrays fit in L2
- * either way). From Python over alternating sources: 0.053 ms.
- * With no MESH, the larger meshes of tests/data/meshes and generated spheres. */
+ * Each repeat runs every source in turn, as the rows of a job alternate (one
+ * source repeated back to back runs small meshes faster than any job sees
+ * them). With no MESH, the larger meshes of tests/data/meshes and generated
+ * spheres. bench/micro/ab_solve.py compares two builds of it in alternating
+ * rounds. Findings: docs/march-measurements.md. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -210,7 +210,7 @@ static void bench(const char *name, const double *V, int32_t nv, const int32_t *
         return;
     }
     double t_build = now() - t0;
-    /* issue 13.3: bytes per vertex of the built mesh, each array's share */
+    /* bytes per vertex of the built mesh, each array's share */
     const char *names[32];
     size_t bytes[32], total = 0;
     int n_arrays = mfmm_mesh_memory(mesh, names, bytes, 32);
