@@ -165,9 +165,9 @@ MFMM_INLINE void ex_enqueue(mfmm_exact_ws *ws, int32_t g, int fl, int32_t va, in
 #endif
     /* the least distance: at the foot of I, or at the nearer end. Taken
      * before the trims, which can only raise it: the key is then a lower
-     * bound, as good for the queue's order and the cut at max_d (taking it
-     * again after the quarter of windows that are trimmed cost 4 % of a
-     * patch, for the same windows) */
+     * bound, as good for the queue's order and the cut at max_d, and taking
+     * it again after a trim costs time for the same windows
+     * (docs/performance.md#design-measurements) */
     double dx = ex_gap(ix, s0, s1);
     double key = sigma + (dx > 0.0 ? sqrt(dx * dx + iy2) : iy);
     if (key > ws->max_d)
@@ -205,9 +205,8 @@ static void ex_fan_out(mfmm_exact_ws *ws, int32_t h, int32_t va, int32_t vb, dou
  * against the edge's ends, and queues it in the face across, in that face's
  * frame. known: its ends at a vertex whose distance through this window
  * is already set (bit 0: at s = 0, bit 1: at s = L; see ex_propagate).
- * Inlined where it is called (MFMM_INLINE): in ex_propagate that made a
- * patch 4-6 % faster (bench_exact_patch: hand, spot, camelhead), as a call
- * spilled the window's doubles; ex_link inlined too was no faster. */
+ * Inlined where it is called (MFMM_INLINE): as a call it spilled the
+ * window's doubles (docs/performance.md#design-measurements). */
 MFMM_INLINE void ex_emit_inline(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double ix,
                                 double iy, double sigma, int known)
 {
@@ -316,9 +315,9 @@ void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
     int32_t vc = r->v[m];
     double L = r->len[m], cx = r->cx[m], cy = r->cy[m];
     double b0 = w->b0, b1 = w->b1, px = w->px, py = w->py, sigma = w->sigma;
-    /* (checking the window again here, against the face it crosses with the
-     * distances known by now, drops almost nothing: 1 window in 10^4 on the
-     * bunny, for 15% of the time) */
+    /* (the window is not checked again here, against the face it crosses
+     * with the distances known by now: that drops almost nothing for its
+     * cost, docs/performance.md#design-measurements) */
     ws->n_propagated++;
     /* where the ray from I through C crosses the edge */
     double tc = px + (cx - px) * (-py) / (cy - py);
@@ -333,8 +332,9 @@ void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
         }
     } else if (tc >= b0 - EX_GRAZE * L && tc <= b1 + EX_GRAZE * L) {
         /* C just outside the window: the rays to it may have been in a
-         * window dropped as too narrow, or missed by rounding (a flat mesh
-         * whose straight paths graze vertices was left 3x too long). The path
+         * window dropped as too narrow, or missed by rounding (without this,
+         * on a flat mesh whose straight paths graze vertices, C is left far
+         * too long). The path
          * over the window's nearer end is a real one, within rounding of the
          * straight one. */
         double e = tc < b0 ? b0 : b1;

@@ -37,8 +37,8 @@
  *     is beaten, this keeps the part that is not;
  *   - (ICH's third rule, dropping the window when min D > d(R) + max(|R E0|,
  *     |R E1|), is not applied: with the trims and the queue's order it
- *     dropped 0-11 windows of 2,000-4,000 a patch on the test meshes, and
- *     its test cost 5-9 % of the patch's time.)
+ *     drops almost nothing for the time its test takes;
+ *     docs/performance.md#design-measurements.)
  * Dropping or trimming is safe in any order: every point removed has a
  * shorter path through a vertex, so no shortest path crosses it.
  *

@@ -48,7 +48,7 @@ static int ex_i32_pair_cmp(const void *pa, const void *pb)
  * them: a shortest path may cross from any of them into any other. Their
  * half-edges (across -1) get flip 2 and a place in a cycle per edge
  * (nm_he, nm_next), which ex_fan_out walks. As walls, they would make a
- * path through one bend at a vertex (beetle: up to 0.03, 5 %, too long). 0, or
+ * path through one bend at a vertex, too long. 0, or
  * -1 when out of memory. */
 static int ex_link_nonmanifold(mfmm_exact_tables *t)
 {

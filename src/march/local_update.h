@@ -25,8 +25,8 @@ typedef uchar mfmm_u8;
 #include <stdint.h>
 #define MFMM_GLOBAL
 #if defined(__GNUC__) || defined(__clang__)
-/* the march's per-face steps are called from two places: GCC left them as
- * calls (~30 instructions of spills each, callgrind) */
+/* the march's per-face steps are called from two places, and GCC would
+ * leave them as calls that spill the march's registers */
 #define MFMM_INLINE static inline __attribute__((always_inline))
 /* a march step off the common path (a cost, a virtual stencil): kept out
  * of line so that the common path keeps its values in registers */

@@ -200,8 +200,8 @@ MFMM_INLINE mfmm_i32 mfmm_march_settle(mfmm_march_state *w, mfmm_i32 *settled,
  * along each path: the mean of its ends' F on an edge (trapezoid), and
  * across the triangle the mean of F(C) and F at the middle of AB, as a
  * characteristic from AB to C has it. (F(C) alone over the whole triangle,
- * the paper's F_ij, made a cheap vertex pull T down through costly
- * neighbours: -96 % against a finer mesh.) */
+ * the paper's F_ij, lets a cheap vertex pull T down through costly
+ * neighbours, far below a finer mesh's T: docs/march-measurements.md.) */
 MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, mfmm_i32 f_id, mfmm_i32 c,
                                    mfmm_i32 a, mfmm_i32 b, double *f_a, double *f_b,
                                    double *f_t)
@@ -232,8 +232,8 @@ MFMM_INLINE double mfmm_march_cost(const mfmm_march_state *s, mfmm_i32 f_id, mfm
  * footprint, the faces around the strip's vertices A, B and those up to V
  * (per face: their F; per vertex: F at each of their vertices), read from
  * s->uniform. Elsewhere the corner takes the plain stencil, as with
- * unfolding off (a cost-1 face's virtual edge through cost-100
- * faces made T 50x too low). */
+ * unfolding off (else a cost-1 face's virtual edge through cost-100
+ * faces gives T far too low). */
 MFMM_INLINE int mfmm_march_virt_ok(const mfmm_march_state *s, const mfmm_march_mesh *m,
                                    MFMM_GLOBAL const mfmm_virt *vr, mfmm_i32 a, mfmm_i32 b,
                                    mfmm_i32 iv, double f)
@@ -512,8 +512,8 @@ MFMM_INLINE mfmm_i32 mfmm_march_loop(mfmm_march_state *s, const mfmm_march_mesh 
             mfmm_i32 wc = mm.wedge[j], f_id = MFMM_WEDGE_FACE(wc);
             MFMM_GLOBAL const mfmm_face *fr = mm.faces + f_id;
             /* the next corners, k + 1 and k + 2 mod 3, as the entry holds
-             * them (k is as good as random: a ?: compiled to a branch
-             * mispredicted 2.4 times per settled vertex, cachegrind) */
+             * them (k is as good as random, so a ?: on it compiles to a
+             * branch that mispredicts: docs/march-measurements.md) */
             mfmm_i32 jp = MFMM_WEDGE_NEXT(wc), jq = MFMM_WEDGE_PREV(wc), k = 3 - jp - jq;
             mfmm_i32 p = fr->v[jp], q = fr->v[jq];
             /* at a break in x's fan the pending q goes first, so that the

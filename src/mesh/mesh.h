@@ -78,7 +78,7 @@ struct mfmm_mesh {
     /* The exact solver's read-only tables (exact/exact.h: face frames, fans),
      * built on the first exact solve or exact start and then shared by every
      * solver, thread and job on this mesh, so that a job costs what its rows
-     * reach, not a table build over all faces (0.48 s on a 1M-vertex mesh).
+     * reach, not a table build over all faces.
      * Built under cache_lock; freed with the mesh by exact_tables_free. The
      * one part of a built mesh that changes. */
     pthread_mutex_t cache_lock;

@@ -8,14 +8,9 @@
 #include "order.h"
 
 /* MFMM_VERTEX_ORDER, for A/B runs: 1 Morton cells, rows inside (default),
- * 0 the input order. Variants measured and removed: 4 Morton at full
- * resolution, 2 Hilbert (Skilling 2004; 1M 227 ms, 125k 29.6-30.5 ms), 3
- * breadth-first from the Morton order. Measured (bench_solve, solve ms, one run each,
- * shared machine; input / 4 / 3 / 1): 1M sine 250-279 / 208-222 / 250 /
- * 195-196; 125k sine 19.2-21.5 / 23.6-25.6 / 21.8-22.0 / 22.7-22.8 (a
- * generated grid's row-major order is already good at that size); igea
- * 27.5-29.3 / 26.7-29.1 / 27.2-28.8 / 27.6-28.5; camelhead, nefertiti:
- * equal within noise. */
+ * 0 the input order. Cells keep a march's neighbours near in memory on
+ * large meshes; the variants compared with it (Morton at full resolution,
+ * Hilbert, breadth-first) are in docs/performance.md#design-measurements. */
 #ifndef MFMM_VERTEX_ORDER
 #define MFMM_VERTEX_ORDER 1
 #endif
@@ -80,9 +75,8 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_interna
         if (!isfinite(scale))
             scale = 0.0;
         /* cells of ~64 vertices (a surface has about nv / 4^L cells at
-         * level L) along the curve; inside a cell, rows by position (rows
-         * beat the curve's own order at that scale: 125k sine 22.8 vs 23.8
-         * ms; 1M 196 vs 212 ms) */
+         * level L) along the curve; inside a cell, rows by position, which
+         * beat the curve's own order at that scale */
         int L = 0;
         while (L < 21 && ((double)nv / 64.0) > (double)(1u << L) * (double)(1u << L))
             L++;

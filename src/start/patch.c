@@ -41,7 +41,8 @@ mfmm_status mfmm_exact_patch(mfmm_exact_ws *ws, const mfmm_source *sources, int3
      * and pseudo-source on it was propagated, and d(v) is exact (d is an
      * upper bound, the length of a real path, so d(v) - h <= radius holds
      * for the true distance too). That ring is free and, seeded with the
-     * rest, lowers the march's mean error by 5-15 %. */
+     * rest, lowers the march's mean error
+     * (docs/performance.md#design-measurements). */
     int32_t n = 0;
     for (int32_t i = 0; i < ws->n_touched; i++) {
         int32_t v = ws->touched[i];
@@ -99,7 +100,7 @@ mfmm_status mfmm_exact_patch_check(mfmm_exact_ws *ws, const mfmm_source *src, in
      * sweep in the order the propagation reached the vertices (about the
      * order of their distances): a vertex reached before its best neighbour
      * gets a longer path, a looser bound (a second sweep, or a Dijkstra's
-     * sort, cost 2-5 % of a default row for bounds that need only be real) */
+     * sort, would cost more than bounds that need only be real are worth) */
     for (int32_t i = 0; i < n; i++) {
         int32_t v = ws->touched[i];
         double uv = up[v];

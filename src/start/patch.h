@@ -9,7 +9,7 @@
 /* Exact distances from point sources near them: the "exact start" of a
  * march. Propagation stops once every window and pseudo-source left is
  * farther than radius, so the cost grows with the patch, not the mesh
- * (about 0.2 ms for 150 vertices on the 35k-vertex test meshes).
+ * (docs/performance.md, "The cost of the exact start").
  * Sources as for mfmm_solve_exact (checked: MFMM_ERR_BAD_SOURCE and the
  * like); T = value + distance. The patch: every vertex with T <= radius,
  * and the ring of those beyond it by less than their least height in their

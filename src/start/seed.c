@@ -158,8 +158,8 @@ static int seed_beyond(void *user, const mfmm_start_hit *h)
 {
     beyond_ctx *c = user;
     /* not in the patch, whose exact values it must not undercut (the
-     * straight walk gave up to 0.18 % less than the exact solver at the
-     * patch's outer ring on beetle) */
+     * straight walk can give less than the exact solver at the patch's
+     * outer ring) */
     if (h->length > c->R && !mfmm_exact_in_patch(c->ws, h->vertex))
         mfmm_march_seed(c->st, h->vertex, c->value + h->cost_length);
     return 0;
@@ -191,9 +191,9 @@ mfmm_status mfmm_exact_start_seed(const mfmm_mesh *mesh, mfmm_exact_ws **ws,
     }
     if (src->face >= 0) {
         /* the straight start's vertices beyond the patch: its walk reaches
-         * the mesh's longest edge (straight.c), up to 12 mean edges on the
-         * test meshes, exact where the surface is flat; without them a
-         * face source started worse than the plain start (fertility 1.12x) */
+         * the mesh's longest edge (straight.c), exact where the surface is
+         * flat; without them a face source can start worse than the plain
+         * start (docs/performance.md#design-measurements) */
         beyond_ctx c = {st, *ws, src->value, R};
         mfmm_start_walk(mesh, src, st->cost, st->cost_location, seed_beyond, &c);
     }

@@ -8,8 +8,7 @@
  * the move). At a corner the limit depends on the direction the point comes
  * from; where the corner's angle sum exceeds 2 pi, the start from the corner
  * reaches vertices behind it (through it) that a point beside it does not,
- * and T jumps by the march's own error there (hand: 16 % of sampled corner
- * approaches, up to 0.6 % of the diagonal); the exact start (src/solve)
+ * and T jumps by the march's own error there; the exact start (seed.c)
  * removes that where it applies. */
 #include <math.h>
 #include <string.h>
@@ -170,8 +169,8 @@ static void enter(walk *w, int depth, int32_t g, int32_t ia, int32_t ib, v2 pa, 
 /* Enters every face across the edge (ia, ib) opposite corner k of face f:
  * its neighbour, or, at a non-manifold edge of a start face, each other
  * face on it, copies apart (a straight path from the point goes on into
- * each; a T-junction's split can leave one, and the straight start then
- * missed the far corner of the face it split, 20 % too long); none at a
+ * each; a T-junction's split can leave one, and without this the straight
+ * start misses the far corner of the face it split); none at a
  * boundary. Only from a start face: at every depth, fans of coincident
  * faces multiplied the walks beyond any time limit. */
 static void enter_across(walk *w, int depth, int32_t f, int k, int32_t ia, int32_t ib, v2 pa,
@@ -362,9 +361,9 @@ void mfmm_start_walk(const mfmm_mesh *mesh, const mfmm_source *src, const double
     if (at.kind == MFMM_ON_EDGE && at.across < 0) {
         /* on a non-manifold edge (or a boundary): every face on it, copies
          * and zero-area faces apart, in one order whichever face names the
-         * point (a point on the line a T-junction split a face along, that
-         * edge on a third face too, started one piece, and the other's
-         * corner got its distance round the junction, 28 % too long) */
+         * point (else a point on the line a T-junction split a face along,
+         * that edge on a third face too, starts one piece, and the other's
+         * corner gets its distance round the junction, too long) */
         int32_t ia = fv[(at.zero + 1) % 3], ib = fv[(at.zero + 2) % 3];
         for (int32_t i = mesh->vertex_face_offset[ia]; i < mesh->vertex_face_offset[ia + 1] && !w.stop;
              i++) {

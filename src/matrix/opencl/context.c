@@ -84,8 +84,8 @@ mfmm_status mfmm_opencl_rows(const mfmm_rows_job *job, int32_t start, int32_t *r
 
 /* Device, context and built program. */
 /* Under auto: a CPU device the caller did not name is left to the threads
- * backend, which runs the same rows on the same cores faster (measured:
- * camelhead 2000 rows, wall 0.86-0.93x of OpenCL's; README "Command line"). */
+ * backend, which runs the same rows on the same cores faster
+ * (docs/performance.md, "Backends on a CPU"). */
 static mfmm_status auto_refuses(const ocl *cl, const mfmm_rows_job *job, mfmm_error *err)
 {
     if (!job->full_batches || !cl->cpu || cl->named)
