@@ -4,6 +4,9 @@
  * manifolds", PNAS 95 (1998) 8431-8435, with an exact polyhedral solver
  * beside it.
  *
+ * "The paper" below is Kimmel & Sethian's; "section N" alone is a section
+ * of this header.
+ *
  * The one public header; C99, C ABI. Its sections, essentials first:
  *   1. conventions and ABI policy     6. exact distances
  *   2. status and errors              7. paths
@@ -44,7 +47,9 @@ extern "C" {
  *
  * Threads: an mfmm_mesh is immutable after creation and may be shared by any
  * number of threads; a solver (mfmm_solver, mfmm_exact_solver) is a workspace
- * for one thread at a time; an mfmm_opencl_context may be shared.
+ * for one thread at a time; an mfmm_opencl_context may be shared. An _init
+ * function writes only its argument; a _destroy function may not run while
+ * any other call uses the object it frees.
  *
  * Structs that can grow start with `size_t struct_size`:
  *   - option structs (inputs): fill them with their _init function, which
@@ -91,7 +96,9 @@ typedef enum mfmm_status {
     MFMM_ERR_DEGENERATE_SOURCE,   /* a source lies on a zero-area face */
     MFMM_ERR_BAD_BARYCENTRIC,     /* barycentric coordinates not finite, < 0, or not summing to 1 */
     MFMM_ERR_BAD_ARGUMENT,        /* another argument is invalid (the mfmm_error says which) */
-    MFMM_ERR_WRONG_MESH,          /* the solver was created for another mesh */
+    MFMM_ERR_WRONG_MESH,          /* the solver was created for another mesh (no function
+                                     returns it at present; kept so that the values
+                                     after it stay the same) */
     MFMM_ERR_UNREACHED,           /* a path target has an infinite distance */
     MFMM_ERR_PATH_STALLED,        /* path tracing stopped descending, or ran out of steps */
     MFMM_ERR_NO_OPENCL,           /* no OpenCL platform or device is available */
@@ -123,7 +130,7 @@ typedef struct mfmm_mesh_options mfmm_mesh_options; /* section 10 */
 
 /* Validates a triangle mesh and precomputes what every solve reuses (vertex
  * adjacency, edge lengths, corner angles, a virtual edge for every obtuse
- * corner found by unfolding, section 4.2).
+ * corner found by unfolding, the paper's section 4.2).
  *   vertices: (nv, 3) float64; copied. 1 <= nv <= 715827882.
  *   faces:    (nf, 3) int32, 0-based; copied. 1 <= nf <= 134217727.
  *   options:  NULL for defaults (section 10).
@@ -257,7 +264,9 @@ typedef struct mfmm_solve_options {
  * unfolding on, exact_start_radius MFMM_EXACT_START_AUTO. NULL is a no-op. */
 MFMM_API void mfmm_solve_options_init(mfmm_solve_options *options);
 
-/* Marches from the sources and writes T for every vertex.
+/* Marches from the sources and writes T for every vertex: the paper's
+ * march (section 2), with section 4.1's local update (Eq. 4-5) and, when
+ * unfolding is on, section 4.2's virtual edges.
  *   solver:    from mfmm_solver_create.
  *   sources:   (n_sources,) n_sources >= 1.
  *   options:   NULL for defaults.
@@ -266,7 +275,8 @@ MFMM_API void mfmm_solve_options_init(mfmm_solve_options *options);
  * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_COUNT; MFMM_ERR_BAD_SOURCE,
  * MFMM_ERR_BAD_BARYCENTRIC, MFMM_ERR_DEGENERATE_SOURCE (err->index: the
  * source); MFMM_ERR_BAD_COST (err->index: the entry); MFMM_ERR_BAD_ARGUMENT
- * (max_distance NaN or < 0, a target out of range, exact_start_radius,
+ * (max_distance NaN or < 0; n_targets < 0, or > 0 with targets NULL; a
+ * target out of range, err->index: its position; exact_start_radius;
  * struct_size); MFMM_ERR_OUT_OF_MEMORY.
  * Thread safety: one call at a time per solver. */
 MFMM_API mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources,
@@ -388,7 +398,7 @@ typedef struct mfmm_path_options {
      * crossed (the shortest polyline through the shared edges, by the funnel
      * algorithm), removing the drift that T's first-order error gives the
      * gradient; never longer than the traced path. Not applied with a cost (a
-     * weighted path refracts). 0: the traced path of section 5. */
+     * weighted path refracts). 0: the traced path of the paper's section 5. */
     int32_t straighten;
 } mfmm_path_options;
 
@@ -397,7 +407,7 @@ typedef struct mfmm_path_options {
 MFMM_API void mfmm_path_options_init(mfmm_path_options *options);
 
 /* Traces the shortest path from `target` back to the source along -grad T
- * (paper section 5: Heun's method on T interpolated by a quadratic over each
+ * (the paper's section 5: Heun's method on T interpolated by a quadratic over each
  * face and its neighbours, then straightened).
  *   distances: (nv,) T from mfmm_solve (or mfmm_solve_exact).
  *   target:    a vertex (face == -1) or a point in a face (value ignored), not
@@ -477,7 +487,8 @@ typedef struct mfmm_matrix_options {
     double exact_start_radius;       /* as in mfmm_solve_options, on every backend */
     int32_t n_threads;               /* threads backend; 0 (default): all cores */
     size_t memory_limit;             /* bytes for workspaces and blocks in flight; 0
-                                        (default): a default of the library */
+                                        (default): 16 MiB, and on OpenCL at least one
+                                        row per compute unit */
     void *out;                       /* (n_sources, width) of dtype to fill, or NULL */
     mfmm_rows_callback on_rows;      /* dense rows, block by block, or NULL */
     mfmm_sparse_callback on_sparse;  /* sparse rows: only the finite entries (the
@@ -526,7 +537,8 @@ typedef struct mfmm_matrix_info {
  * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_COUNT (n_sources, n_targets);
  * MFMM_ERR_BAD_SOURCE (err->index: the row); MFMM_ERR_BAD_COST;
  * MFMM_ERR_BAD_ARGUMENT (no output, sparse with dense or on OPENCL, a
- * target, dtype, backend, max_distance, float32 range, struct_size);
+ * target out of range, dtype, backend, max_distance, exact_start_radius,
+ * n_threads < 0, float32 range, struct_size);
  * MFMM_ERR_CANCELLED; MFMM_ERR_NO_OPENCL, MFMM_ERR_OPENCL_BUILD,
  * MFMM_ERR_OPENCL_RUNTIME (backend OPENCL); MFMM_ERR_OUT_OF_MEMORY.
  * Thread-safe (calls on one mesh may run at once; callbacks run on the
@@ -589,12 +601,14 @@ MFMM_API const char *mfmm_opencl_context_device_name(const mfmm_opencl_context *
  *   vertices: out: (nv, 3) float64, allocated by the library (mfmm_free).
  *   faces:    out: (nf, 3) int32, allocated by the library (mfmm_free).
  * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_IO (cannot open or read, not a
- * regular file); MFMM_ERR_PARSE (malformed or another format; err->index: the
- * line); MFMM_ERR_BAD_COUNT; MFMM_ERR_OUT_OF_MEMORY. Thread-safe. */
+ * regular file); MFMM_ERR_PARSE (malformed, another format, an unsupported
+ * extension, no vertices or no faces, more than int32 counts; err->index: the
+ * line, or -1); MFMM_ERR_OUT_OF_MEMORY. Thread-safe. */
 MFMM_API mfmm_status mfmm_load_mesh(const char *path, double **vertices, int32_t *nv,
                                     int32_t **faces, int32_t *nf, mfmm_error *err);
 
-/* Frees memory the library handed out (mfmm_load_mesh); NULL is a no-op. */
+/* Frees memory the library handed out (mfmm_load_mesh); NULL is a no-op.
+ * Thread-safe. */
 MFMM_API void mfmm_free(void *pointer);
 
 /* ============================================ 10. advanced: tuning, memory
@@ -603,7 +617,7 @@ MFMM_API void mfmm_free(void *pointer);
 struct mfmm_mesh_options {
     size_t struct_size;        /* set by mfmm_mesh_options_init */
     /* Most faces one unfolding walk may cross to find the virtual edge of an
-     * obtuse corner (section 4.2); a walk that needs more fails and the corner
+     * obtuse corner (the paper's section 4.2); a walk that needs more fails and the corner
      * keeps its plain stencil. Default 64; >= 1. */
     int32_t max_unfold_steps;
     /* 1 (default): marches at F = 1 with unfolding read per-vertex update
