@@ -27,8 +27,6 @@ int ex_grow(mfmm_exact_ws *ws);
  * the window empty, first moves the window to the least of them. */
 void ex_refill(mfmm_exact_ws *ws);
 
-/* Takes the next entry out of the queue (which must not be empty) into *out. */
-void ex_pop(mfmm_exact_ws *ws, ex_entry *out);
 
 static inline int64_t ex_bucket(const mfmm_exact_ws *ws, double key)
 {
@@ -89,6 +87,38 @@ static inline void ex_queue(mfmm_exact_ws *ws, int32_t e)
     if (ws->heap_n > ws->peak_windows)
         ws->peak_windows = ws->heap_n;
     ex_link(ws, e);
+}
+
+/* Takes the next entry out of the queue (which must not be empty) into *out. */
+static inline void ex_pop(mfmm_exact_ws *ws, ex_entry *out)
+{
+    for (;;) {
+        if (ws->n_in == 0 || ws->cur >= ws->redist + EX_NB)
+            ex_refill(ws);
+        int32_t i = (int32_t)(ws->cur & (EX_NB - 1));
+        int32_t e = ws->bhead[i];
+        if (e < 0) {
+            /* the bucket's windows are done: its vertex events */
+            i += 2 * EX_NB;
+            e = ws->bhead[i];
+            if (e < 0) {
+                ws->cur++;
+                continue;
+            }
+        }
+        ws->bhead[i] = ws->heap[e].next;
+#ifdef __GNUC__
+        /* the next pop's record: a cold line when its bucket filled earlier */
+        if (ws->bhead[i] >= 0)
+            __builtin_prefetch(ws->heap + ws->bhead[i]);
+#endif
+        ws->n_in--;
+        ws->heap_n--;
+        *out = ws->heap[e];
+        ws->heap[e].next = ws->qfree;
+        ws->qfree = e;
+        return;
+    }
 }
 
 #endif
