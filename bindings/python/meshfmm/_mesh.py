@@ -65,7 +65,7 @@ class Mesh:
         True (default): the march builds per-vertex update records (about
         380 bytes per vertex, on the first solve, kept with the mesh).
         False puts memory first: the march walks the faces instead, with the
-        same results bit for bit and a march about 1.25x as long.
+        same results bit for bit and a march 1.25-1.6x as long.
 
     Raises
     ------

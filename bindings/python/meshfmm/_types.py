@@ -56,7 +56,13 @@ class MeshInfo:
     n_duplicate_faces: int  #: faces repeating another's vertices (copies; not walls)
 
     def as_dict(self) -> dict:
-        """The fields as a plain ``dict`` of name -> value."""
+        """The fields as a plain ``dict``.
+
+        Returns
+        -------
+        dict
+            Field name -> value (int or float), in the order above.
+        """
         return dataclasses.asdict(self)
 
 
