@@ -10,8 +10,8 @@ static void help(FILE *out)
 {
     fprintf(out,
             "usage: meshfmm generate SHAPE N -o OUT.obj [--stretch S] [--radii R r]\n\n"
-            "OUT may be - (standard output).\n"
-            "Writes a generated mesh as OBJ (coordinates with 17 significant digits).\n\n"
+            "Writes a generated mesh as OBJ (coordinates with 17 significant digits);\n"
+            "OUT may be - (standard output).\n\n"
             "  grid N      unit square, N x N squares split along alternating diagonals\n"
             "  sine N      z = 0.45 sin(2 pi x) sin(2 pi y) on [0,1]^2, N x N squares\n"
             "              (the paper's Fig. 8a)\n"

@@ -703,7 +703,9 @@ class Mesh:
         n_threads : int
             Threads of the threads backend; 0 for all cores.
         memory_limit : int
-            Bytes the library may use for blocks in flight; 0 for its default.
+            Bytes the library may use for workspaces and blocks in flight; 0
+            for its default, 16 MiB (on OpenCL at least one row per compute
+            unit).
         progress : callable, optional
             Called as ``progress(rows_done, n_rows)`` as blocks of rows
             finish. An exception it raises (or Ctrl-C) stops the job and
