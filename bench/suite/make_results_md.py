@@ -618,7 +618,7 @@ def exact_start_section():
          f"(`bench/suite/bench_exact_start.py`). The default (r = {default}) was chosen on the "
          "*choice* cases (" + ", ".join(es["choice_set"]) + "): the error falls with r on every "
          "case, and r = 7 is the least that brings the bunny to 0.6x (it was 0.63x at r = 6); "
-         "on larger meshes 7 edges cover less of the surface (igea, 134k vertices: 0.62x), so "
+         "on larger meshes 7 edges cover less of the surface (igea, 134k vertices: 0.64x), so "
          "the default, MFMM_EXACT_START_AUTO (column auto), takes 7 sqrt(nv / 40,000) mean edges "
          "above 40,000 vertices for rows without max_distance (column auto r: its value), which "
          "keeps the patch the same share of the surface. Its time per source is "
