@@ -557,7 +557,9 @@ struct mfmm_opencl_options {
     size_t struct_size;      /* set by mfmm_opencl_options_init */
     /* Device: an index over all platforms' devices in order ("0", "1", ...) or
      * a case-insensitive substring of a device name ("pthread", "NVIDIA").
-     * NULL: $MESHFMM_OPENCL_DEVICE, else the first CPU device, else the first. */
+     * NULL: $MESHFMM_OPENCL_DEVICE, else the first device with float64 that
+     * is not a CPU (a GPU or accelerator), else the first such CPU device,
+     * else the first. */
     const char *device;
     /* Folder of the built program binaries (files fmm_rows-<key>.bin, keyed by
      * kernel source, build options, library, platform, device and driver

@@ -53,6 +53,26 @@ static int ci_contains(const char *hay, const char *needle)
     return n == 0;
 }
 
+/* Whether a device can run the program: float64 and a compiler. */
+static int device_usable(const mfmm_cl_api *api, cl_device_id d)
+{
+    cl_device_fp_config fp64 = 0;
+    cl_bool compiler = CL_FALSE;
+    return api->clGetDeviceInfo(d, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof fp64, &fp64, NULL) ==
+               CL_SUCCESS &&
+           fp64 != 0 &&
+           api->clGetDeviceInfo(d, CL_DEVICE_COMPILER_AVAILABLE, sizeof compiler, &compiler,
+                                NULL) == CL_SUCCESS &&
+           compiler;
+}
+
+static int device_is_cpu(const mfmm_cl_api *api, cl_device_id d)
+{
+    cl_device_type t = 0;
+    return api->clGetDeviceInfo(d, CL_DEVICE_TYPE, sizeof t, &t, NULL) == CL_SUCCESS &&
+           (t & CL_DEVICE_TYPE_CPU) != 0;
+}
+
 mfmm_status mfmm_cl_select_device(ocl *cl, const char *want, mfmm_error *err)
 {
     const mfmm_cl_api *api = cl->api;
@@ -108,22 +128,18 @@ mfmm_status mfmm_cl_select_device(ocl *cl, const char *want, mfmm_error *err)
                                  "no OpenCL device name contains '%s' (%s)", want, from);
         }
     } else {
-        for (cl_uint i = 0; i < nd && pick < 0; i++) {
-            cl_device_type t = 0;
-            if (api->clGetDeviceInfo(devs[i], CL_DEVICE_TYPE, sizeof t, &t, NULL) ==
-                    CL_SUCCESS &&
-                (t & CL_DEVICE_TYPE_CPU))
-                pick = (int)i;
-        }
+        /* a usable GPU or accelerator first (on a CPU the threads backend is
+         * faster), then a usable CPU device, then the first */
+        for (int pass = 0; pass < 2 && pick < 0; pass++)
+            for (cl_uint i = 0; i < nd && pick < 0; i++)
+                if (device_is_cpu(api, devs[i]) == pass && device_usable(api, devs[i]))
+                    pick = (int)i;
         if (pick < 0)
             pick = 0;
     }
     cl->device = devs[pick];
     mfmm_cl_device_string(cl, CL_DEVICE_NAME, cl->name, sizeof cl->name);
-    cl_device_type type = 0;
-    cl->cpu = api->clGetDeviceInfo(cl->device, CL_DEVICE_TYPE, sizeof type, &type, NULL) ==
-                  CL_SUCCESS &&
-              (type & CL_DEVICE_TYPE_CPU) != 0;
+    cl->cpu = device_is_cpu(api, cl->device);
     cl->named = want && *want;
     cl_device_fp_config fp64 = 0;
     if (api->clGetDeviceInfo(cl->device, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof fp64, &fp64, NULL) !=

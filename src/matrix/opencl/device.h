@@ -26,7 +26,8 @@ typedef struct ocl {
 const char *mfmm_cl_error_name(cl_int e);
 
 /* `want` (options, else MESHFMM_OPENCL_DEVICE): an index into all devices of
- * all platforms, or a substring of a device's name; default the first CPU
+ * all platforms, or a substring of a device's name; default the first usable
+ * (float64, compiler) device that is not a CPU, else the first usable CPU
  * device, else the first. Fills cl's device fields (cl->api set). */
 mfmm_status mfmm_cl_select_device(ocl *cl, const char *want, mfmm_error *err);
 
