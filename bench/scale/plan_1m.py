@@ -2,7 +2,7 @@
 section "Plan: all pairs on a 1M-vertex mesh"), measured on this machine:
 
     MESHFMM_LIBRARY=build/libmeshfmm.so PYTHONPATH=bindings/python \
-        python bench/scale/plan_1m.py && python bench/suite/make_results_md.py --no-readme
+        python bench/scale/plan_1m.py && python bench/suite/make_results_md.py
 
 Measured: the sine surface of `meshfmm generate sine 1000` (1,002,001
 vertices), mesh build time, per-row time for `--rows` contiguous rows (as one

@@ -5,8 +5,8 @@
 # (scripts/setup.sh --bench: Debian packages, .venv with requirements-dev.txt
 # and the peers of bench/requirements.txt, the build), then writes
 # bench/results/*.json, the plots and figures under docs/images/,
-# bench/RESULTS.md and the summary block of README.md (all generated; never
-# edit them by hand).
+# and bench/RESULTS.md (all generated; never edit them by hand; the README's
+# headline table quotes RESULTS.md by hand).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 
@@ -30,6 +30,6 @@ step "paper figures 8b and 10"
 "$py" bench/figures/figures_cost_head.py
 step "plots"
 "$py" bench/figures/plot_bench.py
-step "bench/RESULTS.md and the README block"
+step "bench/RESULTS.md"
 "$py" bench/suite/make_results_md.py
 step "done"
