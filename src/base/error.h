@@ -18,16 +18,12 @@ mfmm_status mfmm_fail(mfmm_error *err, mfmm_status status, int64_t index, const 
 /* Marks err as success. */
 void mfmm_ok(mfmm_error *err);
 
-/* Checks a public option struct's struct_size (its first field): from
- * sizeof(size_t) to `known` (this library's sizeof) is read; otherwise
+/* Reads a caller's option struct into dst (which holds the defaults, `known`
+ * bytes): a struct_size (its first field) from sizeof(size_t) to `known` is
+ * read, and that prefix copied, so fields beyond an older caller's struct
+ * keep their defaults; dst's struct_size becomes known. Otherwise
  * MFMM_ERR_BAD_ARGUMENT naming `type` (a struct not filled by its _init
  * function, or from a newer header). */
-mfmm_status mfmm_check_struct_size(const void *options, size_t known, const char *type,
-                                   mfmm_error *err);
-
-/* Reads a caller's option struct into dst (which holds the defaults, `known`
- * bytes): checks struct_size and copies that prefix, so fields beyond an
- * older caller's struct keep their defaults; dst's struct_size becomes known. */
 mfmm_status mfmm_read_options(void *dst, const void *options, size_t known, const char *type,
                               mfmm_error *err);
 

@@ -65,26 +65,16 @@ mfmm_status mfmm_fail(mfmm_error *err, mfmm_status status, int64_t index, const 
     return status;
 }
 
-mfmm_status mfmm_check_struct_size(const void *options, size_t known, const char *type,
-                                   mfmm_error *err)
-{
-    size_t given;
-    memcpy(&given, options, sizeof given);
-    if (given >= sizeof given && given <= known)
-        return MFMM_OK;
-    return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
-                     "%s.struct_size is %zu, but this library (meshfmm %s) reads %zu to %zu: "
-                     "fill it with %s_init (a header of another version?)",
-                     type, given, mfmm_version(), sizeof given, known, type);
-}
-
 mfmm_status mfmm_read_options(void *dst, const void *options, size_t known, const char *type,
                               mfmm_error *err)
 {
-    if (mfmm_check_struct_size(options, known, type, err) != MFMM_OK)
-        return MFMM_ERR_BAD_ARGUMENT;
     size_t given;
     memcpy(&given, options, sizeof given);
+    if (given < sizeof given || given > known)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "%s.struct_size is %zu, but this library (meshfmm %s) reads %zu to %zu: "
+                         "fill it with %s_init (a header of another version?)",
+                         type, given, mfmm_version(), sizeof given, known, type);
     memcpy(dst, options, given); /* fields past the caller's struct keep dst's defaults */
     memcpy(dst, &known, sizeof known);
     return MFMM_OK;
@@ -99,10 +89,10 @@ mfmm_status mfmm_check_info_size(const void *info)
 
 mfmm_status mfmm_write_info(void *info, const void *all, size_t known)
 {
+    if (mfmm_check_info_size(info) != MFMM_OK)
+        return MFMM_ERR_BAD_ARGUMENT;
     size_t given;
     memcpy(&given, info, sizeof given);
-    if (given < sizeof given)
-        return MFMM_ERR_BAD_ARGUMENT;
     size_t n = given < known ? given : known;
     memcpy(info, all, n);
     memcpy(info, &n, sizeof n);

@@ -29,7 +29,7 @@ from ctypes import (
     c_void_p,
 )
 from pathlib import Path
-from typing import Any, NamedTuple, Optional, Tuple
+from typing import Any, Optional
 
 import numpy as np
 
@@ -477,29 +477,6 @@ mfmm_distance_matrix = _proto(
 )
 
 
-class MatrixCallInfo(NamedTuple):
-    """What one mfmm_distance_matrix call did (its mfmm_matrix_info)."""
-
-    backend_used: Optional[str]  # "serial", "threads" or "opencl"
-    reason: str                  # why another backend than the one asked for ran; ""
-    vertices_settled: int        # serial and threads backends; 0 from OpenCL
-    start_fallbacks: int
-
-
-def distance_matrix(mesh: Any, sources: Any, n_sources: int, options: mfmm_matrix_options,
-                    err: mfmm_error) -> Tuple[int, MatrixCallInfo]:
-    """Calls mfmm_distance_matrix; returns its status and what the call did
-    (per call: nothing is kept on the mesh)."""
-    info = mfmm_matrix_info()
-    status = mfmm_distance_matrix(mesh, sources, n_sources, ctypes.byref(options),
-                                  ctypes.byref(info), ctypes.byref(err))
-    name = mfmm_backend_name(info.backend_used)
-    return status, MatrixCallInfo(
-        backend_used=name.decode("ascii") if name else None,
-        reason=info.backend_reason.decode("utf-8", "replace"),
-        vertices_settled=int(info.vertices_settled),
-        start_fallbacks=int(info.start_fallbacks),
-    )
 # I/O
 mfmm_opencl_options_init = _proto("mfmm_opencl_options_init", None, [P(mfmm_opencl_options)])
 mfmm_opencl_context_create = _proto(

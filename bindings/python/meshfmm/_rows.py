@@ -110,14 +110,17 @@ def call_library(mesh_ptr: int, src: Optional[np.ndarray], n_rows: int,
     """The one call of mfmm_distance_matrix, and the one place that reads its
     outputs: returns (status, error, the call's MatrixInfo)."""
     err = _lib.mfmm_error()
-    status, call = _lib.distance_matrix(
-        mesh_ptr, None if src is None else _args.addr(src), n_rows, opts, err
+    out = _lib.mfmm_matrix_info()
+    status = _lib.mfmm_distance_matrix(
+        mesh_ptr, None if src is None else _args.addr(src), n_rows, byref(opts), byref(out),
+        byref(err)
     )
+    name = _lib.mfmm_backend_name(out.backend_used)
     info = MatrixInfo(
-        backend=call.backend_used or "",
-        reason=call.reason,
-        vertices_settled=call.vertices_settled,
-        start_fallbacks=call.start_fallbacks,
+        backend=name.decode("ascii") if name else "",
+        reason=out.backend_reason.decode("utf-8", "replace"),
+        vertices_settled=int(out.vertices_settled),
+        start_fallbacks=int(out.start_fallbacks),
     )
     return status, err, info
 
