@@ -189,12 +189,10 @@ static mfmm_status ex_run_once(mfmm_exact_ws *ws, const mfmm_source *sources,
         }
         if (corner >= 0) {
             /* at a corner: a vertex source, offset by the (tiny) distance */
-            const double *X = ws->mesh->xyz;
-            double p[3] = {0.0, 0.0, 0.0};
-            for (int k = 0; k < 3; k++)
-                for (int e = 0; e < 3; e++)
-                    p[e] += w[k] * X[3 * (size_t)fv[k] + e];
-            ex_update(ws, fv[corner], s->value + vdist(p, X + 3 * (size_t)fv[corner]), 1);
+            double p[3];
+            mfmm_bary_to_xyz(ws->mesh, face, w, p);
+            ex_update(ws, fv[corner],
+                      s->value + vdist(p, ws->mesh->xyz + 3 * (size_t)fv[corner]), 1);
             continue;
         }
         ex_start_face(ws, ws->face_in[face], w, s->value);

@@ -159,4 +159,16 @@ static inline int32_t mfmm_mesh_virt_index(const mfmm_mesh *mesh, int32_t corner
     return (int32_t)(mfmm_march_virt_of(&m, fr->virt >> 2, corner) - mesh->virts);
 }
 
+/* The point with barycentric coordinates b (summing to 1) in face f. */
+static inline void mfmm_bary_to_xyz(const mfmm_mesh *m, int32_t f, const double b[3], double x[3])
+{
+    for (int i = 0; i < 3; i++)
+        x[i] = 0.0;
+    for (int k = 0; k < 3; k++) {
+        const double *X = m->xyz + 3 * (size_t)m->face_records[f].v[k];
+        for (int i = 0; i < 3; i++)
+            x[i] += b[k] * X[i];
+    }
+}
+
 #endif /* MFMM_MESH_H */

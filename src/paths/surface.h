@@ -12,15 +12,4 @@
 
 static inline double mfmm_dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-static inline void mfmm_bary_to_xyz(const mfmm_mesh *m, int32_t f, const double b[3], double x[3])
-{
-    for (int i = 0; i < 3; i++)
-        x[i] = 0.0;
-    for (int k = 0; k < 3; k++) {
-        const double *X = m->xyz + 3 * (size_t)m->face_records[f].v[k];
-        for (int i = 0; i < 3; i++)
-            x[i] += b[k] * X[i];
-    }
-}
-
 #endif

@@ -89,9 +89,9 @@ mfmm_status mfmm_exact_patch_check(mfmm_exact_ws *ws, const mfmm_source *src, in
             w[k] = src->bary[k] > 0.0 ? src->bary[k] : 0.0;
             sum += w[k];
         }
-        for (int e = 0; e < 3; e++)
-            p[e] = (w[0] * X[3 * (size_t)fv[0] + e] + w[1] * X[3 * (size_t)fv[1] + e] +
-                    w[2] * X[3 * (size_t)fv[2] + e]) / sum;
+        for (int k = 0; k < 3; k++)
+            w[k] /= sum;
+        mfmm_bary_to_xyz(ws->mesh, src->face, w, p);
         for (int k = 0; k < 3; k++)
             if (ws->in_patch[fv[k]])
                 up[fv[k]] = fmin(up[fv[k]], src->value + vdist(p, X + 3 * (size_t)fv[k]));
