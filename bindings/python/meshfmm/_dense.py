@@ -34,7 +34,7 @@ def dense_matrix(mesh: "Mesh", req: _rows.Request, out: Optional[np.ndarray], *,
     """Rows of ``req`` into `out` (allocated when None), then (D + D^T) / 2
     in place if `symmetric`. `options` are :func:`_rows.options`' keywords.
     Returns the array and the call's MatrixInfo."""
-    nv = mesh.n_vertices
+    nv = mesh._nv
     if symmetric and not req.is_square(nv):
         raise ValueError("symmetric=True needs a square result: sources None or equal to targets")
     shape = (req.n_rows, req.width)
