@@ -17,6 +17,7 @@ int cmd_distance(int argc, char **argv);
 int cmd_generate(int argc, char **argv);
 int cmd_allpairs(int argc, char **argv);
 int cmd_path(int argc, char **argv);
+int cmd_landmarks(int argc, char **argv);
 
 /* Prints "meshfmm: <message>\n" on stderr. */
 void cli_error(const char *fmt, ...)
@@ -56,7 +57,7 @@ enum {
     OPT_NO_UNFOLDING, OPT_EXACT, OPT_TARGET, OPT_TARGET_FACE, OPT_MAX_POINTS, OPT_NO_STRAIGHTEN,
     OPT_JSON, OPT_MAX_UNFOLD_STEPS, OPT_STRETCH, OPT_RADII, OPT_DTYPE, OPT_BACKEND,
     OPT_SOURCES, OPT_THREADS, OPT_MEMORY, OPT_TARGETS, OPT_PLAIN_START, OPT_EXACT_START_RADIUS,
-    OPT_NO_SPOKES
+    OPT_NO_SPOKES, OPT_START
 };
 /* Refuses a value option given a second time, which getopt_long would let
  * win silently (`-o a.npy -o b.npy`): call it with every code getopt_long
@@ -210,7 +211,7 @@ typedef struct cli_npy_writer {
     size_t itemsize; /* 4 or 8 */
 } cli_npy_writer;
 
-/* dtype "<f4" or "<f8". cols < 0 writes a 1-D array of `rows` values;
+/* dtype "<f4", "<f8" or "<i4". cols < 0 writes a 1-D array of `rows` values;
  * otherwise shape (rows, cols). 0 on success, -1 on error. */
 int cli_npy_open(cli_npy_writer *w, const char *path, const char *dtype, int64_t rows,
                  int64_t cols);

@@ -17,6 +17,7 @@ static const cli_command commands[] = {
     {"generate", cmd_generate, "write a generated mesh (sine, sphere, torus, grid, lattice)"},
     {"allpairs", cmd_allpairs, "the distance matrix of many sources, streamed into a .npy file"},
     {"path", cmd_path, "the minimal geodesic from a target to the sources (.csv or .obj)"},
+    {"landmarks", cmd_landmarks, "geodesic farthest-point sampling: K well-spread vertex ids"},
 };
 
 static void print_usage(FILE *out)

@@ -83,7 +83,9 @@ int cli_once(const char *sub, int c, uint32_t *seen)
                 {OPT_SOURCES, "--sources"},
                 {OPT_TARGETS, "--targets"},
                 {OPT_THREADS, "--threads"},
-                {OPT_MEMORY, "--memory"}};
+                {OPT_MEMORY, "--memory"},
+                {OPT_START, "--start"},
+                {'k', "-k/--count"}};
     for (unsigned i = 0; i < sizeof once / sizeof once[0]; i++) {
         if (once[i].code != c)
             continue;

@@ -263,3 +263,62 @@ def test_surface_points_as_targets():
         m.distance(3, at=[SurfacePoint(1, (0.5, 0.6, 0.0))])
     with pytest.raises(ValueError, match="sparse"):
         m.distance_matrix([3], targets=pts, sparse=True, max_distance=1.0)
+
+
+# ---------------------------------------------------------------- the CLI
+def _cli():
+    import os
+    import shutil
+
+    from test_cli import find_cli
+
+    path = find_cli()
+    if path is None:
+        pytest.skip("no meshfmm command line found (set MESHFMM_CLI or build with CMake)")
+    return path
+
+
+def _write_off(path, V, F):
+    with open(path, "w") as f:
+        f.write(f"OFF\n{V.shape[0]} {F.shape[0]} 0\n")
+        np.savetxt(f, V, fmt="%.17g")
+        np.savetxt(f, np.hstack([np.full((F.shape[0], 1), 3), F]), fmt="%d")
+
+
+def test_cli_info_notes_coincident_vertices(spot_split, tmp_path):
+    import json
+    import subprocess
+
+    cli = _cli()
+    V, F, V2, F2, _ = spot_split
+    off = tmp_path / "split.off"
+    _write_off(off, V2, F2)
+    p = subprocess.run([cli, "info", "--json", str(off)], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    got = json.loads(p.stdout)
+    assert got["coincident_vertices"] == V2.shape[0] - V.shape[0]
+    assert got["components"] == 2 and got["welded_components"] == 1
+    assert "coincident vertices" in p.stderr and "weld=True" in p.stderr
+    p = subprocess.run([cli, "info", str(MESHES / "spot.obj")], capture_output=True, text=True)
+    assert p.returncode == 0 and "coincident vertices:   0" in p.stdout and p.stderr == ""
+
+
+def test_cli_landmarks_equal_python(tmp_path):
+    import subprocess
+
+    cli = _cli()
+    out = tmp_path / "L.txt"
+    p = subprocess.run([cli, "landmarks", str(MESHES / "spot.obj"), "-k", "30", "--start", "12",
+                        "-o", str(out)], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    want, dist = mesh("spot.obj").farthest_point_sampling(30, 12, return_distances=True)
+    assert np.array_equal(np.loadtxt(out, dtype=np.int64), want)
+    assert f"within {dist.max():.6g}" in p.stderr
+    npy = tmp_path / "L.npy"
+    p = subprocess.run([cli, "landmarks", str(MESHES / "spot.obj"), "-k", "30", "--start", "12",
+                        "-o", str(npy)], capture_output=True, text=True)
+    assert p.returncode == 0 and np.array_equal(np.load(npy), want)
+    assert np.load(npy).dtype == np.int32
+    p = subprocess.run([cli, "landmarks", str(MESHES / "spot.obj"), "-o", str(out)],
+                       capture_output=True, text=True)
+    assert p.returncode == 2 and "-k" in p.stderr
