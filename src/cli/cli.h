@@ -57,7 +57,7 @@ enum {
     OPT_NO_UNFOLDING, OPT_EXACT, OPT_TARGET, OPT_TARGET_FACE, OPT_MAX_POINTS, OPT_NO_STRAIGHTEN,
     OPT_JSON, OPT_MAX_UNFOLD_STEPS, OPT_STRETCH, OPT_RADII, OPT_DTYPE, OPT_BACKEND,
     OPT_SOURCES, OPT_THREADS, OPT_MEMORY, OPT_TARGETS, OPT_PLAIN_START, OPT_EXACT_START_RADIUS,
-    OPT_NO_SPOKES, OPT_START
+    OPT_NO_SPOKES, OPT_START, OPT_NO_SIZE_CHECK
 };
 /* Refuses a value option given a second time, which getopt_long would let
  * win silently (`-o a.npy -o b.npy`): call it with every code getopt_long
@@ -74,6 +74,12 @@ int cli_getopt_error(const char *sub, int c, char **argv);
 int cli_take_face_point(const char *face, int argc, char **argv, mfmm_source *s);
 
 /* ---- inputs and outputs (util.c) ---- */
+
+/* Bytes free to an unprivileged writer on the file system that holds
+ * `path` (the folder of a file to be written): 0, or -1 when unknown. */
+int cli_free_bytes(const char *path, double *out);
+/* A byte count as "3.65 TiB", "812 MiB", ... into buf. */
+const char *cli_format_bytes(double bytes, char *buf, size_t size);
 
 /* SIGINT and SIGTERM set a flag (cli_interrupted() reads it) instead of
  * killing the process, so that temporary files get removed; the CLI only,

@@ -19,7 +19,11 @@ static void help(FILE *out)
             "  torus N     N x N quads split in two; tube centre radius R, tube radius r\n"
             "              (--radii, default 1 0.4)\n"
             "  lattice N   equilateral triangles, N rows of N cells, x stretched by S\n"
-            "              (--stretch, default 3: 120-degree corners)\n");
+            "              (--stretch, default 3: 120-degree corners)\n\n"
+            "  -o, --output OUT.obj   the file to write (- for standard output)\n"
+            "  --stretch S            lattice: x stretched by S (default 3)\n"
+            "  --radii R r            torus: tube centre radius and tube radius\n"
+            "  -h, --help             this text\n");
 }
 
 static int write_obj(const char *path, const mfmm_gen_mesh *m, const char *comment)

@@ -16,7 +16,8 @@ static void help(FILE *out)
             "position of another: texture seams, unmerged corners) with the components\n"
             "once they are welded; when there are any, a note on standard error.\n\n"
             "  --json                 one JSON object instead of text\n"
-            "  --max-unfold-steps N   faces one unfolding walk may cross (default 64)\n");
+            "  --max-unfold-steps N   faces one unfolding walk may cross (default 64)\n"
+            "  -h, --help             this text\n");
 }
 
 /* Prints a path as a JSON string (escaping quotes, backslashes, controls). */

@@ -13,6 +13,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <sys/statvfs.h>
+
 #include "cli.h"
 #include "io/io.h"
 
@@ -95,6 +97,41 @@ int cli_once(const char *sub, int c, uint32_t *seen)
         return CLI_OK;
     }
     return CLI_OK;
+}
+
+int cli_free_bytes(const char *path, double *out)
+{
+    size_t n = strlen(path);
+    char *dir = malloc(n + 2);
+    if (!dir)
+        return -1;
+    memcpy(dir, path, n + 1);
+    char *slash = strrchr(dir, '/');
+    if (!slash)
+        strcpy(dir, ".");
+    else if (slash == dir)
+        dir[1] = '\0';
+    else
+        *slash = '\0';
+    struct statvfs fs;
+    int rc = statvfs(dir, &fs);
+    free(dir);
+    if (rc != 0)
+        return -1;
+    *out = (double)fs.f_bavail * (double)fs.f_frsize;
+    return 0;
+}
+
+const char *cli_format_bytes(double bytes, char *buf, size_t size)
+{
+    static const char *unit[] = {"bytes", "KiB", "MiB", "GiB", "TiB", "PiB"};
+    int u = 0;
+    while (bytes >= 1024.0 && u < 5) {
+        bytes /= 1024.0;
+        u++;
+    }
+    snprintf(buf, size, u ? "%.3g %s" : "%.0f %s", bytes, unit[u]);
+    return buf;
 }
 
 int cli_getopt_error(const char *sub, int c, char **argv)

@@ -322,3 +322,111 @@ def test_cli_landmarks_equal_python(tmp_path):
     p = subprocess.run([cli, "landmarks", str(MESHES / "spot.obj"), "-o", str(out)],
                        capture_output=True, text=True)
     assert p.returncode == 2 and "-k" in p.stderr
+
+
+# ------------------------------------------------------- guards and messages
+def test_dense_result_refused_past_a_memory_limit(tmp_path):
+    """Under an address-space limit a dense matrix that cannot fit is
+    refused before any work, with both sizes; small jobs still run, and
+    size_check=False skips the check (numpy's own allocation then fails)."""
+    import subprocess
+    import sys
+    import textwrap
+
+    script = textwrap.dedent(f"""
+        import os, resource, meshfmm
+        m = meshfmm.Mesh(*meshfmm.load_mesh({str(MESHES / "camelhead.off")!r}))
+        size = int(open("/proc/self/statm").read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+        resource.setrlimit(resource.RLIMIT_AS, (size + 300 * 2**20, resource.RLIM_INFINITY))
+        assert m.distance_matrix([0, 1], backend="serial").shape == (2, m.n_vertices)
+        try:
+            m.distance_matrix(backend="serial")
+        except MemoryError as e:
+            print("REFUSED", e)
+        try:
+            m.distance_matrix(backend="serial", size_check=False)
+        except MemoryError as e:
+            print("NUMPY", e)
+    """)
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                       timeout=120)
+    assert p.returncode == 0, p.stderr
+    refused = [ln for ln in p.stdout.splitlines() if ln.startswith("REFUSED")]
+    assert refused and "518 MB (11381 x 11381 float32)" in refused[0]
+    assert "size_check=False" in refused[0] and "available" in refused[0]
+    numpy_line = [ln for ln in p.stdout.splitlines() if ln.startswith("NUMPY")]
+    assert numpy_line and "size_check" not in numpy_line[0]
+
+
+def test_progress_bar_on_stderr(capfd):
+    m = mesh("hand_lowres.obj")
+    D, info = m.distance_matrix(np.arange(300), progress=True, return_info=True)
+    err = capfd.readouterr().err
+    assert "distance matrix [" in err and "300/300 (100%)" in err
+    assert err.endswith("\n") and f"backend {info.backend}" in err
+    assert "falling back" not in err
+    m.distance(0, method="exact", progress=True)
+    assert "exact solve" in capfd.readouterr().err
+    m.distance_matrix([0, 1])
+    assert capfd.readouterr().err == ""  # quiet by default
+    with pytest.raises(TypeError):
+        m.distance_matrix([0], progress="yes")
+
+
+def test_every_cli_help_lists_every_option():
+    import re
+    import subprocess
+
+    from conftest import REPO
+
+    cli = _cli()
+    for src in sorted((REPO / "src" / "cli").glob("cmd_*.c")):
+        sub = src.stem[4:]
+        text = src.read_text()
+        table = text[text.index("longopts[] = {"):]
+        table = table[: table.index("{NULL, 0, NULL, 0}")]
+        names = set(re.findall(r'\{"([a-z-]+)",', table))
+        if sub == "allpairs":
+            names.discard("source")  # a trap for --source, not an option (--sources is)
+        if "CLI_SHARED_LONG_OPTIONS" in table:
+            names |= {"help", "output", "source", "face-source", "cost", "cost-per-face",
+                      "plain-start", "exact-start-radius"}
+        helptext = subprocess.run([cli, sub, "--help"], capture_output=True, text=True).stdout
+        missing = [n for n in names if not re.search(rf"--{n}\b", helptext)]
+        assert not missing, f"meshfmm {sub} --help lacks {missing}"
+
+
+def test_pip_allpairs_help_lists_the_zarr_options():
+    import subprocess
+    import sys
+
+    p = subprocess.run([sys.executable, "-m", "meshfmm", "allpairs", "--help"],
+                       capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    for word in (".zarr", "--workers", "--resume", "--scheduler", "--no-size-check", ".npz"):
+        assert word in p.stdout, word
+
+
+def test_cli_refuses_a_matrix_larger_than_the_disk(tmp_path):
+    import signal
+    import subprocess
+    import time
+
+    cli = _cli()
+    grid = tmp_path / "grid.obj"
+    subprocess.run([cli, "generate", "grid", "1000", "-o", str(grid)], check=True)
+    out = tmp_path / "D.npy"
+    p = subprocess.run([cli, "allpairs", str(grid), "--dtype", "float64", "-o", str(out)],
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 1
+    assert "would take 7.31 TiB (1002001 x 1002001 float64)" in p.stderr
+    assert "free" in p.stderr and "--no-size-check" in p.stderr
+    assert not out.exists() and list(tmp_path.iterdir()) == [grid]
+    # the override starts the job (stopped by SIGINT, which removes its file)
+    proc = subprocess.Popen([cli, "allpairs", str(grid), "--dtype", "float64", "-o", str(out),
+                             "--no-size-check"], stderr=subprocess.PIPE, text=True)
+    time.sleep(4)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "would take" not in err
+    assert list(tmp_path.iterdir()) == [grid]

@@ -64,6 +64,33 @@ def _allpairs_zarr(args: List[str]) -> int:
     return cli_allpairs_zarr(args)
 
 
+def _allpairs_help() -> int:
+    """`meshfmm allpairs --help`: the C command line's help (.npy, .npz),
+    then the options of the .zarr output this Python command adds."""
+    import subprocess
+
+    exe = cli_path()
+    if exe is not None:
+        sys.stdout.flush()
+        subprocess.run([exe, "allpairs", "--help"], check=False)
+    else:
+        print("meshfmm allpairs: the command-line binary (.npy and .npz outputs) is not "
+              "installed with this package")
+    print("\nOutput to OUT.zarr (this Python command: a Dask cluster writing a Zarr v3 array,"
+          "\nresumable; needs dask[distributed] and zarr>=3):\n")
+    try:
+        from ._zarr_cli import zarr_parser
+
+        text = zarr_parser().format_help()
+    except ImportError as e:
+        text = (f"  (its options cannot be listed: {e}); --scheduler, --workers, --resume,\n"
+                "  --overwrite, --dtype, --sources, --targets, --max-distance, --cost,\n"
+                "  --backend, --exact-start-radius, --plain-start, --block-rows,\n"
+                "  --compression, --no-progress, --no-spokes\n")
+    sys.stdout.write(text)
+    return 0
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     """Runs the ``meshfmm`` command.
 
@@ -83,6 +110,8 @@ def main(argv: Optional[List[str]] = None) -> int:
         Zarr job lacks Dask or Zarr, else the Zarr job's status.
     """
     args = list(sys.argv[1:] if argv is None else argv)
+    if args and args[0] == "allpairs" and any(a in ("-h", "--help") for a in args[1:]):
+        return _allpairs_help()
     if args and args[0] == "allpairs":
         out = _output(args[1:])
         if out is not None and out.rstrip("/").lower().endswith(".zarr"):

@@ -20,7 +20,7 @@ from typing import Any, Callable, Dict, Iterator, List, Optional, Tuple, Union
 
 import numpy as np
 
-from . import _args, _dense, _isolines, _lib, _rows, _sparse
+from . import _args, _dense, _guards, _isolines, _lib, _rows, _sparse
 from ._interrupt import sigint_as_flag
 from ._points import Points, combine
 from ._types import (GeodesicPath, Isoline, MatrixInfo, MeshInfo, MeshWarning, SourceLike,
@@ -464,6 +464,7 @@ class Mesh:
         method: str = "fmm",
         exact_start: Any = True,
         at: Any = None,
+        progress: bool = False,
     ) -> np.ndarray:
         """Distance from the nearest source to every vertex, or to given
         points.
@@ -508,6 +509,9 @@ class Mesh:
             linear interpolant of the face's corners, sum of ``b_k * d_k``
             over the corners with ``b_k > 0`` (+inf when one of them is
             unreached). The march stops once those corners are settled.
+        progress : bool
+            True: with ``method="exact"`` (which can run minutes on millions
+            of vertices), the time so far on standard error while it runs.
 
         Returns
         -------
@@ -541,23 +545,30 @@ class Mesh:
             stop = pts.columns(self._F)[0]
             targets = stop if targets is None else np.concatenate(
                 [_args.index_array(targets, "target"), stop])
-        d = self._distance(sources, cost, max_distance, targets=targets, unfolding=unfolding,
-                           cost_location=cost_location, method=method,
-                           exact_start=exact_start)
+        bar = None
+        if _args.flag(progress, "progress") and method == "exact":
+            bar = _guards.ProgressBar("exact solve")
+        try:
+            d = self._distance(sources, cost, max_distance, targets=targets,
+                               unfolding=unfolding, cost_location=cost_location, method=method,
+                               exact_start=exact_start, bar=bar)
+        finally:
+            if bar is not None:
+                bar.close()
         if pts is not None:
             return pts.values(d, self._F)
         return d if self._weld is None else self._weld.per_vertex(d)
 
     def _distance(self, sources: Any, cost: Any, max_distance: Optional[float], *,
                   targets: Any, unfolding: Any, cost_location: Optional[str], method: str,
-                  exact_start: Any) -> np.ndarray:
+                  exact_start: Any, bar: Any = None) -> np.ndarray:
         """:meth:`distance` in the C mesh's vertex ids (welded ones)."""
         unfolding = _args.flag(unfolding, "unfolding")
         if method == "exact":
             if cost is not None or targets is not None or not unfolding or exact_start is not True:
                 raise ValueError("method='exact' computes geodesic distance: it takes no cost, "
                                  "targets, unfolding or exact_start")
-            return self._distance_exact(sources, max_distance)
+            return self._distance_exact(sources, max_distance, bar)
         if method != "fmm":
             raise ValueError(f"method must be 'fmm' or 'exact', not {method!r}")
         if _args.is_int(sources):  # the common case, kept cheap (bench/suite/bench_python.py)
@@ -603,7 +614,8 @@ class Mesh:
             raise _lib.make_error(status, err)
         return out
 
-    def _distance_exact(self, sources: SourceLike, max_distance: Optional[float]) -> np.ndarray:
+    def _distance_exact(self, sources: SourceLike, max_distance: Optional[float],
+                        bar: Any = None) -> np.ndarray:
         src = _args.source_records(sources)
         opts = _lib.mfmm_exact_options()
         _lib.mfmm_exact_options_init(byref(opts))
@@ -614,7 +626,12 @@ class Mesh:
         info = _lib.mfmm_exact_info()
         # Ctrl-C stops a long solve: the library asks every few milliseconds
         interrupted: List[int] = []
-        interrupt = type(opts.interrupt)(lambda user: 1 if interrupted else 0)
+        def ask(user: Any) -> int:
+            if bar is not None:
+                bar.tick()
+            return 1 if interrupted else 0
+
+        interrupt = type(opts.interrupt)(ask)
         opts.interrupt = interrupt
         solver = None
         mesh_ptr = self._enter()
@@ -1006,11 +1023,12 @@ class Mesh:
         exact_start: Any = True,
         n_threads: int = 0,
         memory_limit: int = 0,
-        progress: Optional[Callable[[int, int], Any]] = None,
+        progress: Any = None,
         targets: Any = None,
         sparse: bool = False,
         symmetric: bool = False,
         return_info: bool = False,
+        size_check: bool = True,
     ) -> Any:
         """Distances from many vertex sources, one row per source.
 
@@ -1041,15 +1059,21 @@ class Mesh:
             Bytes the library may use for workspaces and blocks in flight; 0
             for its default, 16 MiB (on OpenCL at least one row per compute
             unit).
-        progress : callable, optional
-            Called as ``progress(rows_done, n_rows)`` as blocks of rows
-            finish. An exception it raises (or Ctrl-C) stops the job and
-            propagates.
-        targets : array_like of int, shape (T,), optional
+        progress : bool or callable, optional
+            True: a progress bar on standard error (rows done, time, time
+            left), ending with the backend that ran and, under "auto", why.
+            A callable is called as ``progress(rows_done, n_rows)`` as
+            blocks of rows finish; an exception it raises (or Ctrl-C) stops
+            the job and propagates.
+        targets : array_like of int or SurfacePoint, shape (T,), optional
             Vertex ids in any order, duplicates allowed: the result is S x T,
             column j the distance to ``targets[j]``, and each row's march
             stops once its targets are settled (landmark matrices cost far
-            less than full rows). None: every vertex. Every backend.
+            less than full rows). None: every vertex. Every backend. Points
+            inside faces (:class:`SurfacePoint`, mixed with ids or not) get
+            the value the path tracer reads there, as ``distance(at=...)``:
+            the rows go to their faces' corners (float64) and are combined;
+            dense only.
         sparse : bool
             Return a ``scipy.sparse.csr_matrix`` of the finite entries only
             (with ``max_distance=r``: the pairs within r; the diagonal holds
@@ -1061,6 +1085,11 @@ class Mesh:
             (D + D^T) / 2, symmetrised in place without a copy. Dense only.
         return_info : bool
             Also return the call's :class:`MatrixInfo`.
+        size_check : bool
+            True (default): before allocating a dense result (``out`` None),
+            compare its size with the memory available (the system's, a
+            cgroup's limit, RLIMIT_AS) and refuse with both numbers rather
+            than start a job that cannot finish. False allocates anyway.
 
         Returns
         -------
@@ -1081,6 +1110,9 @@ class Mesh:
             result, ...).
         KeyboardInterrupt
             Ctrl-C, after the library stopped at the next block of rows.
+        MemoryError
+            The dense result would not fit the memory available
+            (``size_check``).
         """
         pts = None
         if targets is not None and _has_surface_point(targets):
@@ -1093,15 +1125,22 @@ class Mesh:
             else:
                 targets = w.to_welded if targets is None else w.vertices(targets, "target")
             cost, cost_location = w.cost(cost, cost_location)
+        progress, bar = _guards.progress_callback(progress, "distance matrix")
         kw = dict(max_distance=max_distance, cost=cost, cost_location=cost_location,
                   unfolding=unfolding, exact_start=exact_start, n_threads=n_threads,
-                  memory_limit=memory_limit, progress=progress)
-        if pts is not None:
-            result, info = self._matrix_at_points(pts, sources, backend, dtype, out,
-                                                  sparse=sparse, symmetric=symmetric, **kw)
-        else:
-            result, info = self._matrix(sources, backend, dtype, out, targets=targets,
-                                        sparse=sparse, symmetric=symmetric, **kw)
+                  memory_limit=memory_limit, progress=progress,
+                  size_check=_args.flag(size_check, "size_check"))
+        info = None
+        try:
+            if pts is not None:
+                result, info = self._matrix_at_points(pts, sources, backend, dtype, out,
+                                                      sparse=sparse, symmetric=symmetric, **kw)
+            else:
+                result, info = self._matrix(sources, backend, dtype, out, targets=targets,
+                                            sparse=sparse, symmetric=symmetric, **kw)
+        finally:
+            if bar is not None:
+                bar.close(info)
         return (result, info) if _args.flag(return_info, "return_info") else result
 
     def _matrix_at_points(self, pts: Points, sources: Any, backend: Any, dtype: Any,
@@ -1133,6 +1172,8 @@ class Mesh:
         sparse = _args.flag(sparse, "sparse")
         symmetric = _args.flag(symmetric, "symmetric")
         req.check_targets(self._nv)
+        if sparse:
+            kw.pop("size_check")  # memory follows the entries
         path = _sparse.sparse_matrix if sparse else _dense.dense_matrix
         return path(self, req, out, symmetric=symmetric, progress=progress,
                     unfolding=unfolding, **kw)
@@ -1184,18 +1225,24 @@ class Mesh:
         n_rows = src.shape[0]
         if n_rows == 0:
             raise ValueError("at least one source is needed")
-        progress = kwargs.pop("progress", None)
+        progress, bar = _guards.progress_callback(kwargs.pop("progress", None), "distance rows")
         with_info = _args.flag(kwargs.pop("return_info", False), "return_info")
-        for first in range(0, n_rows, block_rows):
-            part = src[first : first + block_rows]
+        info = None
+        try:
+            for first in range(0, n_rows, block_rows):
+                part = src[first : first + block_rows]
 
-            def prog(done: int, _total: int, first: int = first) -> Any:
-                if progress is not None:
-                    return progress(first + done, n_rows)
-                return None
+                def prog(done: int, _total: int, first: int = first) -> Any:
+                    if progress is not None:
+                        return progress(first + done, n_rows)
+                    return None
 
-            block, info = self.distance_matrix(part, progress=prog, return_info=True, **kwargs)
-            yield (first, block, info) if with_info else (first, block)
+                block, info = self.distance_matrix(part, progress=prog, return_info=True,
+                                                   **kwargs)
+                yield (first, block, info) if with_info else (first, block)
+        finally:
+            if bar is not None:
+                bar.close(info)
 
 
 def _reverse_path(p: GeodesicPath, V: np.ndarray, F: np.ndarray) -> GeodesicPath:
