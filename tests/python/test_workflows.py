@@ -430,3 +430,62 @@ def test_cli_refuses_a_matrix_larger_than_the_disk(tmp_path):
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130 and "would take" not in err
     assert list(tmp_path.iterdir()) == [grid]
+
+
+def test_weld_drops_collapsed_faces_and_keeps_face_ids():
+    """A sliver whose two corners coincide is dropped by welding: face ids
+    after it still name the faces given, points in it are refused."""
+    n = 6
+    xs, ys = np.meshgrid(np.linspace(0, 1, n), np.linspace(0, 1, n))
+    V = np.column_stack([xs.ravel(), ys.ravel(), np.zeros(n * n)])
+    F = []
+    for j in range(n - 1):
+        for i in range(n - 1):
+            a, b, c, d = j * n + i, j * n + i + 1, (j + 1) * n + i, (j + 1) * n + i + 1
+            F += [[a, b, d], [a, d, c]]
+    F = np.array(F)
+    # vertex 36 repeats vertex 7; face 0 becomes a sliver (0, 1, 36 = 7)... and
+    # every face after it keeps its id
+    V2 = np.vstack([V, V[7]])
+    F2 = np.vstack([[[7, 8, 36]], F])
+    with pytest.warns(MeshWarning):
+        meshfmm.Mesh(V2, F2)
+    w = meshfmm.Mesh(V2, F2, weld=True)
+    plain = meshfmm.Mesh(V, F)
+    assert w.info.n_faces == F.shape[0] and w.n_faces == F.shape[0] + 1
+    assert np.array_equal(w.distance(36), plain.distance(7)[np.r_[np.arange(36), 7]])
+    with pytest.raises(ValueError, match="dropped"):
+        w.distance(SurfacePoint(0, (0.2, 0.3, 0.5)))
+    p = w.path(SurfacePoint(5, (0.2, 0.3, 0.5)), 36)
+    q = plain.path(SurfacePoint(4, (0.2, 0.3, 0.5)), 7)
+    assert np.array_equal(p.points, q.points) and np.array_equal(p.faces, q.faces + 1)
+    cost = np.linspace(1, 2, F2.shape[0])
+    assert np.array_equal(w.distance(0, cost, cost_location="face"),
+                          plain.distance(0, cost[1:], cost_location="face")[np.r_[np.arange(36), 7]])
+    d = w.distance(0)
+    lines = w.isolines(d, [0.5])[0]
+    lines_plain = plain.isolines(plain.distance(0), [0.5])[0]
+    assert [np.array_equal(a.faces, b.faces + 1) for a, b in zip(lines, lines_plain)] == [True]
+    lab = w.voronoi_labels([0, 36])
+    assert lab[36] == 1 and lab[7] == 1 and lab[0] == 0
+
+
+def test_readme_python_example_runs(tmp_path):
+    """The README's Python block, as written, from a folder holding spot.obj."""
+    import os
+    import re
+    import shutil
+
+    from conftest import REPO
+
+    text = (REPO / "README.md").read_text()
+    block = re.search(r"## Python.*?```python\n(.*?)```", text, re.S).group(1)
+    shutil.copy(MESHES / "spot.obj", tmp_path / "spot.obj")
+    here = os.getcwd()
+    os.chdir(tmp_path)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            exec(compile(block, "README.md", "exec"), {})
+    finally:
+        os.chdir(here)

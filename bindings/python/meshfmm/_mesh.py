@@ -1098,7 +1098,7 @@ class Mesh:
             (sparse). ``out`` itself when given.
         info : MatrixInfo
             Only with ``return_info=True``: the backend that ran, why "auto"
-            fell back, the vertices settled and the exact start's fallbacks.
+            chose it, the vertices settled and the exact start's fallbacks.
 
         Raises
         ------

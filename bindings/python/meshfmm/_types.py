@@ -124,7 +124,8 @@ class MatrixInfo:
     reason : str
         Why ``backend="auto"`` ran threads instead of OpenCL (the OpenCL
         error, a CPU device, too few rows to keep the device busy, sparse
-        output); ``""`` when it did not fall back.
+        output; a CPU device left to the threads is the expected case);
+        ``""`` when the backend asked for ran.
     vertices_settled : int
         Vertices the marches settled, summed over the rows: the work done
         (0 from OpenCL, which does not count it).
