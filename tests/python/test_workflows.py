@@ -267,9 +267,6 @@ def test_surface_points_as_targets():
 
 # ---------------------------------------------------------------- the CLI
 def _cli():
-    import os
-    import shutil
-
     from test_cli import find_cli
 
     path = find_cli()

@@ -16,7 +16,7 @@ import os
 import threading
 import warnings
 from ctypes import byref
-from typing import Any, Callable, Dict, Iterator, List, Optional, Tuple, Union
+from typing import Any, Dict, Iterator, List, Optional, Tuple, Union
 
 import numpy as np
 
