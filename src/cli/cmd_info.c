@@ -134,8 +134,9 @@ int cmd_info(int argc, char **argv)
         fprintf(stderr,
                 "meshfmm info: note: %d coincident vertices (at the position of another: texture "
                 "seams or unmerged corners) cut the surface into %d component(s), %d once "
-                "welded; distances and paths do not cross the cuts. Weld them first (in "
-                "Python: meshfmm.Mesh(V, F, weld=True)).\n",
+                "welded; distances and paths do not cross the cuts. Weld them first: "
+                "meshfmm weld MESH -o WELDED.obj --map MAP.txt (in Python: "
+                "meshfmm.Mesh(V, F, weld=True)).\n",
                 (int)m.n_coincident_vertices, (int)m.n_components, (int)m.n_welded_components);
     if (fflush(stdout) != 0) {
         cli_error("cannot write to standard output");

@@ -87,6 +87,7 @@ int cli_once(const char *sub, int c, uint32_t *seen)
                 {OPT_THREADS, "--threads"},
                 {OPT_MEMORY, "--memory"},
                 {OPT_START, "--start"},
+                {OPT_MAP, "--map"},
                 {'k', "-k/--count"}};
     for (unsigned i = 0; i < sizeof once / sizeof once[0]; i++) {
         if (once[i].code != c)
@@ -440,4 +441,22 @@ void cli_note_sources_in_no_face(const char *sub, int64_t count, int32_t first)
         fprintf(stderr, "meshfmm %s: note: %lld source vertices are in no face (the first: "
                         "%ld): each reaches only itself (0 there, +inf elsewhere)\n", sub,
                 (long long)count, (long)first);
+}
+
+int cli_write_obj(const char *path, const double *V, int32_t nv, const int32_t *F, int32_t nf,
+                  const char *comment)
+{
+    cli_output out;
+    if (cli_output_open(&out, path))
+        return -1;
+    FILE *f = out.f;
+    int bad = fprintf(f, "# %s\n", comment) < 0;
+    for (int32_t i = 0; i < nv && !bad && !cli_interrupted(); i++)
+        for (int k = 0; k < 3 && !bad; k++)
+            bad = fputs(k ? " " : "v ", f) < 0 || cli_put_double(f, V[3 * i + k]) < 0 ||
+                  (k == 2 && fputc('\n', f) == EOF);
+    for (int32_t i = 0; i < nf && !bad && !cli_interrupted(); i++)
+        bad = fprintf(f, "f %ld %ld %ld\n", (long)F[3 * i] + 1, (long)F[3 * i + 1] + 1,
+                      (long)F[3 * i + 2] + 1) < 0;
+    return cli_output_close(&out, bad);
 }

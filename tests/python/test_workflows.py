@@ -486,3 +486,27 @@ def test_readme_python_example_runs(tmp_path):
             exec(compile(block, "README.md", "exec"), {})
     finally:
         os.chdir(here)
+
+
+def test_cli_weld_writes_the_welded_mesh_and_map(spot_split, tmp_path):
+    import subprocess
+
+    cli = _cli()
+    V, F, V2, F2, orig = spot_split
+    off = tmp_path / "split.off"
+    _write_off(off, V2, F2)
+    out, mp = tmp_path / "welded.obj", tmp_path / "map.npy"
+    p = subprocess.run([cli, "weld", str(off), "-o", str(out), "--map", str(mp)],
+                       capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    assert f"{V2.shape[0]} vertices, {V.shape[0]} once welded" in p.stderr
+    Vw, Fw = meshfmm.load_mesh(out)
+    assert np.array_equal(Vw, V) and np.array_equal(Fw, F)  # the original spot back
+    python_map = meshfmm.Mesh(V2, F2, weld=True).weld_map
+    assert np.array_equal(np.load(mp), python_map) and np.load(mp).dtype == np.int32
+    info = subprocess.run([cli, "info", str(out)], capture_output=True, text=True)
+    assert "coincident vertices:   0" in info.stdout and info.stderr == ""
+    txt = tmp_path / "map.txt"
+    p = subprocess.run([cli, "weld", str(off), "-o", str(out), "--map", str(txt)],
+                       capture_output=True, text=True)
+    assert p.returncode == 0 and np.array_equal(np.loadtxt(txt, dtype=np.int64), orig)
