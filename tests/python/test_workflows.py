@@ -510,3 +510,41 @@ def test_cli_weld_writes_the_welded_mesh_and_map(spot_split, tmp_path):
     p = subprocess.run([cli, "weld", str(off), "-o", str(out), "--map", str(txt)],
                        capture_output=True, text=True)
     assert p.returncode == 0 and np.array_equal(np.loadtxt(txt, dtype=np.int64), orig)
+
+
+@pytest.mark.parametrize("where", ["vertex", "face"])
+def test_fps_with_a_cost_equals_brute_force(where):
+    m = mesh("hand_lowres.obj")
+    n = m.n_vertices if where == "vertex" else m.n_faces
+    cost = 1.0 + 0.5 * np.sin(np.arange(n))
+    pts, dist = m.farthest_point_sampling(25, 3, cost=cost, cost_location=where,
+                                          return_distances=True)
+    dmin = np.full(m.n_vertices, np.inf)
+    chosen = [3]
+    for i in range(25):
+        dmin = np.minimum(dmin, m.distance(chosen[-1], cost, cost_location=where))
+        if i < 24:
+            cand = dmin.copy()
+            cand[chosen] = -1
+            chosen.append(int(np.argmax(cand)))
+    dmin[chosen] = 0
+    assert np.array_equal(pts, chosen) and np.array_equal(dist, dmin)
+
+
+def test_fps_beyond_the_auto_radius_size_equals_brute_force():
+    """Above MFMM_EXACT_START_AUTO_VERTICES a full solve's exact start grows
+    with the mesh; the bounded marches keep that radius."""
+    n = 215  # 46,656 vertices
+    xs, ys = np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1))
+    z = 0.1 * np.sin(3 * xs) * np.cos(2 * ys)
+    V = np.column_stack([xs.ravel(), ys.ravel(), z.ravel()])
+    idx = np.arange((n + 1) ** 2).reshape(n + 1, n + 1)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel()
+    F = np.concatenate([np.column_stack([a, b, d]), np.column_stack([a, d, c])])
+    m = meshfmm.Mesh(V, F)
+    assert m.n_vertices > 40000
+    pts, radii, dist = m.farthest_point_sampling(6, 1000, return_radii=True,
+                                                 return_distances=True)
+    ref_pts, ref_radii, ref_dist = brute_fps(m, 6, 1000)
+    assert np.array_equal(pts, ref_pts) and np.array_equal(radii, ref_radii)
+    assert np.array_equal(dist, ref_dist)
