@@ -170,7 +170,7 @@ int cmd_weld(int argc, char **argv)
         goto done;
     if (map_path && write_map(map_path, map, nv))
         goto done;
-    fprintf(stderr, "meshfmm weld: %ld vertices, %ld once welded (%ld coincident); %ld faces, "
+    fprintf(stderr, "meshfmm weld: %ld vertices, %ld once welded (%ld removed); %ld faces, "
             "%ld dropped (zero area once welded)\n", (long)nv, (long)nw, (long)(nv - nw),
             (long)nf, (long)(nf - kept));
     rc = CLI_OK;
