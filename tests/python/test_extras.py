@@ -121,3 +121,18 @@ def test_extras_match_pyproject():
         assert sorted(set(extras[extra])) == sorted({dist.get(m, m) for m in modules}), extra
     union = {d for e in _extras.EXTRAS for d in extras[e]}
     assert sorted(extras["all"]) == sorted(union)
+
+
+def test_python_m_meshfmm_distributed_without_zarr(tmp_path):
+    """`python -m meshfmm.distributed` (the job's own command line): one
+    line and status 2, no traceback."""
+    import subprocess
+
+    code = ("import sys, runpy; sys.modules['zarr'] = None; "
+            "sys.argv = ['meshfmm.distributed', 'm.obj', '-o', sys.argv[1]]; "
+            "runpy.run_module('meshfmm.distributed', run_name='__main__')")
+    proc = subprocess.run([sys.executable, "-c", code, str(tmp_path / "D.zarr")],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2
+    assert "python -m meshfmm.distributed needs zarr" in proc.stderr
+    assert "meshfmm[dask]" in proc.stderr and "Traceback" not in proc.stderr

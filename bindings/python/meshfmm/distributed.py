@@ -653,6 +653,11 @@ def symmetrize(store: Any, out: Any, storage_options: Optional[dict] = None,
 
 
 if __name__ == "__main__":  # pragma: no cover
+    try:
+        _extras.require("python -m meshfmm.distributed", "dask")
+    except ImportError as e:
+        sys.stderr.write(f"{e}\n")
+        sys.exit(2)
     from ._zarr_cli import cli_allpairs_zarr
 
     sys.exit(cli_allpairs_zarr(sys.argv[1:]))
