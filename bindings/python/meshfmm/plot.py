@@ -115,6 +115,8 @@ def isoline_segments(vertices: Any, faces: Any, values: Any,
 def _levels(isolines: Union[None, int, Sequence[float]], lo: float, hi: float) -> np.ndarray:
     if isolines is None or isolines is False:
         return np.empty(0)
+    if isolines is True:
+        isolines = 10
     if isinstance(isolines, (int, np.integer)) and not isinstance(isolines, bool):
         if isolines < 0:
             raise ValueError(f"isolines must be >= 0 or a list of values, not {isolines}")
@@ -173,8 +175,8 @@ def render(mesh: Any, distances: Any, path_png: Union[str, "os.PathLike[str]"], 
         The PNG to write.
     isolines : int or sequence of float or None
         A number of levels evenly spaced between 0 (or the smallest value)
-        and the largest finite value, or the levels themselves; 0 or None
-        for none.
+        and the largest finite value, or the levels themselves; 0, None or
+        False for none (True: 10).
     paths : sequence, optional
         Polylines on the surface: :class:`~meshfmm.GeodesicPath` objects
         (drawn above the faces they run through) or (k, 3) arrays of points
