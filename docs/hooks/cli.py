@@ -2,8 +2,9 @@
 
 Runs the built command line (``$MESHFMM_CLI``, else ``build/meshfmm``):
 ``meshfmm --help``, then ``meshfmm COMMAND --help`` for every command that
-help lists, and ``python -m meshfmm.distributed --help`` (the Dask + Zarr
-job behind ``meshfmm allpairs ... -o OUT.zarr``) when that module exists.
+help lists, ``python -m meshfmm.distributed --help`` (the Dask + Zarr
+job behind ``meshfmm allpairs ... -o OUT.zarr``) when that module exists, and
+``python -m meshfmm render --help`` (meshfmm.plot) when that one exists.
 The page holds only a marker (``<!-- cli -->``) that this hook replaces, so
 the page says what the binary says. Without a built binary the build fails:
 build first (see the message).
@@ -90,6 +91,16 @@ def render() -> str:
                "The Dask + Zarr job: what `meshfmm allpairs MESH -o OUT.zarr` runs when the "
                "`meshfmm` command comes from the Python package (`pip install .`).", ""]
         md += _block(_run([sys.executable, "-m", "meshfmm.distributed", "--help"], env=env))
+    probe = subprocess.run([sys.executable, "-c",
+                            "import importlib.util as u, sys; "
+                            "sys.exit(0 if u.find_spec('meshfmm.plot') else 3)"],
+                           capture_output=True, text=True, env=env)
+    if probe.returncode == 0:
+        md += ["## meshfmm render", "",
+               "A picture of the distance field (`meshfmm.plot.render`): a command of the "
+               "Python package's `meshfmm` (it needs matplotlib, the `[plot]` extra), not of "
+               "the C command line.", ""]
+        md += _block(_run([sys.executable, "-m", "meshfmm", "render", "--help"], env=env))
     return "\n".join(md)
 
 

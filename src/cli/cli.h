@@ -17,6 +17,8 @@ int cmd_distance(int argc, char **argv);
 int cmd_generate(int argc, char **argv);
 int cmd_allpairs(int argc, char **argv);
 int cmd_path(int argc, char **argv);
+int cmd_landmarks(int argc, char **argv);
+int cmd_weld(int argc, char **argv);
 
 /* Prints "meshfmm: <message>\n" on stderr. */
 void cli_error(const char *fmt, ...)
@@ -56,7 +58,7 @@ enum {
     OPT_NO_UNFOLDING, OPT_EXACT, OPT_TARGET, OPT_TARGET_FACE, OPT_MAX_POINTS, OPT_NO_STRAIGHTEN,
     OPT_JSON, OPT_MAX_UNFOLD_STEPS, OPT_STRETCH, OPT_RADII, OPT_DTYPE, OPT_BACKEND,
     OPT_SOURCES, OPT_THREADS, OPT_MEMORY, OPT_TARGETS, OPT_PLAIN_START, OPT_EXACT_START_RADIUS,
-    OPT_NO_SPOKES
+    OPT_NO_SPOKES, OPT_START, OPT_NO_SIZE_CHECK, OPT_MAP
 };
 /* Refuses a value option given a second time, which getopt_long would let
  * win silently (`-o a.npy -o b.npy`): call it with every code getopt_long
@@ -73,6 +75,17 @@ int cli_getopt_error(const char *sub, int c, char **argv);
 int cli_take_face_point(const char *face, int argc, char **argv, mfmm_source *s);
 
 /* ---- inputs and outputs (util.c) ---- */
+
+/* Bytes free to an unprivileged writer on the file system that holds
+ * `path` (the folder of a file to be written): 0, or -1 when unknown. */
+int cli_free_bytes(const char *path, double *out);
+/* Writes an OBJ file (a comment line, then v and f lines; coordinates
+ * with 17 significant digits) through a cli_output. 0, or -1 with the
+ * error printed. */
+int cli_write_obj(const char *path, const double *V, int32_t nv, const int32_t *F, int32_t nf,
+                  const char *comment);
+/* A byte count as "3.65 TiB", "812 MiB", ... into buf. */
+const char *cli_format_bytes(double bytes, char *buf, size_t size);
 
 /* SIGINT and SIGTERM set a flag (cli_interrupted() reads it) instead of
  * killing the process, so that temporary files get removed; the CLI only,
@@ -210,7 +223,7 @@ typedef struct cli_npy_writer {
     size_t itemsize; /* 4 or 8 */
 } cli_npy_writer;
 
-/* dtype "<f4" or "<f8". cols < 0 writes a 1-D array of `rows` values;
+/* dtype "<f4", "<f8" or "<i4". cols < 0 writes a 1-D array of `rows` values;
  * otherwise shape (rows, cols). 0 on success, -1 on error. */
 int cli_npy_open(cli_npy_writer *w, const char *path, const char *dtype, int64_t rows,
                  int64_t cols);

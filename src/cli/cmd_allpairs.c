@@ -19,7 +19,8 @@ static void help(FILE *out)
             "                        [--targets FILE]\n"
             "                        [--cost FILE [--cost-per-face]] [--max-distance X]\n"
             "                        [--exact-start-radius R | --plain-start]\n"
-            "                        [--threads N] [--memory MB] [--no-spokes] [--quiet]\n\n"
+            "                        [--threads N] [--memory MB] [--no-spokes] [--quiet]\n"
+            "                        [--no-size-check]\n\n"
             "The geodesic distance matrix: one row per source (default every vertex), one\n"
             "column per vertex, streamed into a .npy file block by block (the matrix is\n"
             "never held in memory). The file appears under its name only when complete.\n\n"
@@ -29,6 +30,8 @@ static void help(FILE *out)
             "                      matrix of the pairs within it, scipy.sparse.load_npz's\n"
             "                      CSR format (explicit zeros on the diagonal); memory\n"
             "                      follows the entries, never rows x columns\n"
+            "                      (OUT.zarr, a resumable Dask + Zarr job, is the command\n"
+            "                      pip installs: `python -m meshfmm allpairs --help`)\n"
             "  --dtype T           float32 (default) or float64; arithmetic is float64\n"
             "  --backend B         auto (default: OpenCL on a device that is not a CPU\n"
             "                      or that MESHFMM_OPENCL_DEVICE names, else threads),\n"
@@ -53,7 +56,11 @@ static void help(FILE *out)
             "                      per vertex, built once for the march); the same\n"
             "                      matrix, each row's march 1.25-1.6x as long\n"
             "  --quiet             nothing on stderr but errors (no progress, no notes, no\n"
-            "                      summary line)\n\n"
+            "                      summary line)\n"
+            "  --no-size-check     write a dense .npy even when it exceeds the free space\n"
+            "                      of its file system (by default the size is compared\n"
+            "                      with it first and the job refused with both numbers)\n"
+            "  -h, --help          this text\n\n"
             "Environment: MESHFMM_OPENCL_DEVICE (device index or name substring),\n"
             "MESHFMM_CACHE_DIR (OpenCL program cache, default ~/.cache/meshfmm).\n"
             "SIGINT, SIGTERM or SIGHUP stop the run, remove the temporary file and exit\n"
@@ -204,7 +211,7 @@ int cmd_allpairs(int argc, char **argv)
     mfmm_backend backend = MFMM_BACKEND_AUTO;
     mfmm_mesh_options mo;
     mfmm_mesh_options_init(&mo);
-    int quiet = 0, start_given = 0, threads_given = 0;
+    int quiet = 0, start_given = 0, threads_given = 0, size_check = 1;
     static const struct option longopts[] = {
         {"help", no_argument, NULL, 'h'},
         {"output", required_argument, NULL, 'o'},
@@ -221,6 +228,7 @@ int cmd_allpairs(int argc, char **argv)
         {"plain-start", no_argument, NULL, OPT_PLAIN_START},
         {"exact-start-radius", required_argument, NULL, OPT_EXACT_START_RADIUS},
         {"no-spokes", no_argument, NULL, OPT_NO_SPOKES},
+        {"no-size-check", no_argument, NULL, OPT_NO_SIZE_CHECK},
         /* not an option of allpairs: named so that getopt does not take it
          * for an abbreviation of --sources */
         {"source", required_argument, NULL, OPT_SOURCE},
@@ -285,6 +293,9 @@ int cmd_allpairs(int argc, char **argv)
             break;
         case OPT_NO_SPOKES:
             mo.spokes = 0;
+            break;
+        case OPT_NO_SIZE_CHECK:
+            size_check = 0;
             break;
         case OPT_EXACT_START_RADIUS:
             if (cli_start_option("allpairs", 2, &start_given) != CLI_OK ||
@@ -400,6 +411,22 @@ int cmd_allpairs(int argc, char **argv)
     int64_t n_cols = tgt ? n_tgt : nv;
     if (cli_interrupted())
         goto done;
+    double free_bytes;
+    if (!sparse && size_check && cli_free_bytes(out_path, &free_bytes) == 0) {
+        /* the .npy and its temporary file are one file: it needs its size */
+        double need = (double)n_src * (double)n_cols * (o.dtype == MFMM_FLOAT64 ? 8.0 : 4.0) +
+                      128.0;
+        if (need > free_bytes) {
+            char a[32], b[32];
+            cli_error("%s would take %s (%lld x %lld %s) but its file system has %s free; "
+                      "write fewer rows (--sources), the pairs within a radius "
+                      "(--max-distance R -o OUT.npz), or give --no-size-check to start anyway",
+                      out_path, cli_format_bytes(need, a, sizeof a), (long long)n_src,
+                      (long long)n_cols, o.dtype == MFMM_FLOAT64 ? "float64" : "float32",
+                      cli_format_bytes(free_bytes, b, sizeof b));
+            goto done;
+        }
+    }
     if (sparse) {
         if (cli_npz_open(&s.z, out_path, o.dtype == MFMM_FLOAT64, n_src, n_cols))
             goto done;
@@ -424,9 +451,6 @@ int cmd_allpairs(int argc, char **argv)
     mfmm_matrix_info info = {.struct_size = sizeof info};
     mfmm_status st = mfmm_distance_matrix(mesh, src, (int32_t)n_src, &o, &info, &err);
     mfmm_backend used = info.backend_used;
-    if (info.backend_reason[0] && !tgt && !sparse && !quiet)
-        fprintf(stderr, "meshfmm allpairs: OpenCL not used (%s); falling back to threads\n",
-                info.backend_reason);
     if (cli_interrupted()) {
         if (sparse)
             cli_npz_abort(&s.z);
@@ -458,10 +482,15 @@ int cmd_allpairs(int argc, char **argv)
             rc = CLI_EXIT_INTERRUPTED;
         goto done;
     }
+    /* one line: the backend that ran and, under auto, why (a CPU device
+     * left to the threads is the expected case, not a failure) */
     if (!quiet)
-        fprintf(stderr, "meshfmm allpairs: %lld x %lld %s%s matrix, backend %s, %.2f s, wrote %s\n",
-            (long long)n_src, (long long)n_cols, sparse ? "sparse " : "", o.dtype == MFMM_FLOAT64 ? "float64" : "float32",
-            mfmm_backend_name(used), now() - s.t0, out_path);
+        fprintf(stderr, "meshfmm allpairs: %lld x %lld %s%s matrix, backend %s%s%s%s, %.2f s, "
+                        "wrote %s\n",
+                (long long)n_src, (long long)n_cols, sparse ? "sparse " : "",
+                o.dtype == MFMM_FLOAT64 ? "float64" : "float32", mfmm_backend_name(used),
+                info.backend_reason[0] ? " (auto: " : "", info.backend_reason,
+                info.backend_reason[0] ? ")" : "", now() - s.t0, out_path);
     rc = CLI_OK;
 done:
     if (rc == CLI_FAIL && cli_interrupted())

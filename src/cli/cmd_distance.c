@@ -26,7 +26,8 @@ static void help(FILE *out)
             "                          per vertex (default) or per face (--cost-per-face)\n"
             "  -o, --output OUT        .npy (float64, shape (nv,)) or .txt (one value per\n"
             "                          line, %%.17g, inf for unreached vertices); - writes\n"
-            "                          the text to standard output\n\n"
+            "                          the text to standard output\n"
+            "  -h, --help              this text\n\n"
             "Options take their value as --source 3 or --source=3. The output is written\n"
             "to a temporary file beside OUT and renamed when complete; it may not be one\n"
             "of the inputs.\n");

@@ -19,24 +19,11 @@ static void help(FILE *out)
             "  torus N     N x N quads split in two; tube centre radius R, tube radius r\n"
             "              (--radii, default 1 0.4)\n"
             "  lattice N   equilateral triangles, N rows of N cells, x stretched by S\n"
-            "              (--stretch, default 3: 120-degree corners)\n");
-}
-
-static int write_obj(const char *path, const mfmm_gen_mesh *m, const char *comment)
-{
-    cli_output out;
-    if (cli_output_open(&out, path))
-        return -1;
-    FILE *f = out.f;
-    int bad = fprintf(f, "# %s\n", comment) < 0;
-    for (int32_t i = 0; i < m->nv && !bad && !cli_interrupted(); i++)
-        for (int k = 0; k < 3 && !bad; k++)
-            bad = fputs(k ? " " : "v ", f) < 0 || cli_put_double(f, m->V[3 * i + k]) < 0 ||
-                  (k == 2 && fputc('\n', f) == EOF);
-    for (int32_t i = 0; i < m->nf && !bad && !cli_interrupted(); i++)
-        bad = fprintf(f, "f %ld %ld %ld\n", (long)m->F[3 * i] + 1, (long)m->F[3 * i + 1] + 1,
-                      (long)m->F[3 * i + 2] + 1) < 0;
-    return cli_output_close(&out, bad);
+            "              (--stretch, default 3: 120-degree corners)\n\n"
+            "  -o, --output OUT.obj   the file to write (- for standard output)\n"
+            "  --stretch S            lattice: x stretched by S (default 3)\n"
+            "  --radii R r            torus: tube centre radius and tube radius\n"
+            "  -h, --help             this text\n");
 }
 
 int cmd_generate(int argc, char **argv)
@@ -127,7 +114,7 @@ int cmd_generate(int argc, char **argv)
     snprintf(comment, sizeof comment, "meshfmm generate %s %d: %d vertices, %d faces", shape,
              (int)n, (int)m.nv, (int)m.nf);
     cli_signals_install();
-    int rc = write_obj(out_path, &m, comment) ? CLI_FAIL : CLI_OK;
+    int rc = cli_write_obj(out_path, m.V, m.nv, m.F, m.nf, comment) ? CLI_FAIL : CLI_OK;
     if (rc != CLI_OK && cli_interrupted())
         rc = CLI_EXIT_INTERRUPTED;
     mfmm_gen_free(&m);

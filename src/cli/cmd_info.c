@@ -11,10 +11,13 @@ static void help(FILE *out)
             "Reads MESH (.obj, .off, .ply, .stl) and prints its counts: vertices, faces, edges,\n"
             "boundary and non-manifold edges, components, unreferenced vertices,\n"
             "degenerate faces, obtuse corners, virtual edges found by unfolding and\n"
-            "unfolding failures, edge lengths, the bounding-box diagonal, and the bytes\n"
-            "the built mesh holds (mfmm_mesh_memory).\n\n"
+            "unfolding failures, edge lengths, the bounding-box diagonal, the bytes\n"
+            "the built mesh holds (mfmm_mesh_memory), and coincident vertices (at the\n"
+            "position of another: texture seams, unmerged corners) with the components\n"
+            "once they are welded; when there are any, a note on standard error.\n\n"
             "  --json                 one JSON object instead of text\n"
-            "  --max-unfold-steps N   faces one unfolding walk may cross (default 64)\n");
+            "  --max-unfold-steps N   faces one unfolding walk may cross (default 64)\n"
+            "  -h, --help             this text\n");
 }
 
 /* Prints a path as a JSON string (escaping quotes, backslashes, controls). */
@@ -94,13 +97,15 @@ int cmd_info(int argc, char **argv)
                "\"degenerate_faces\": %d, \"duplicate_faces\": %d, \"obtuse_corners\": %d, \"virtual_edges\": %d, "
                "\"unfold_failures\": %d, \"min_edge_length\": %.17g, "
                "\"max_edge_length\": %.17g, \"mean_edge_length\": %.17g, "
-               "\"bbox_diagonal\": %.17g, \"mesh_bytes\": %.0f}\n",
+               "\"bbox_diagonal\": %.17g, \"mesh_bytes\": %.0f, \"coincident_vertices\": %d, "
+               "\"welded_components\": %d}\n",
                (int)m.n_vertices, (int)m.n_faces, (int)m.n_edges, (int)m.n_boundary_edges,
                (int)m.n_nonmanifold_edges, (int)m.n_components, (int)m.n_unreferenced_vertices,
                (int)m.n_degenerate_faces, (int)m.n_duplicate_faces, (int)m.n_obtuse_corners,
                (int)m.n_virtual_edges,
                (int)m.n_unfold_failures, m.min_edge_length, m.max_edge_length,
-               m.mean_edge_length, m.bbox_diagonal, (double)mesh_bytes);
+               m.mean_edge_length, m.bbox_diagonal, (double)mesh_bytes,
+               (int)m.n_coincident_vertices, (int)m.n_welded_components);
     } else {
         printf("file:                  %s\n", path);
         printf("vertices:              %d\n", (int)m.n_vertices);
@@ -110,6 +115,8 @@ int cmd_info(int argc, char **argv)
         printf("non-manifold edges:    %d\n", (int)m.n_nonmanifold_edges);
         printf("components:            %d\n", (int)m.n_components);
         printf("unreferenced vertices: %d\n", (int)m.n_unreferenced_vertices);
+        printf("coincident vertices:   %d\n", (int)m.n_coincident_vertices);
+        printf("components if welded:  %d\n", (int)m.n_welded_components);
         printf("degenerate faces:      %d\n", (int)m.n_degenerate_faces);
         printf("duplicate faces:       %d\n", (int)m.n_duplicate_faces);
         printf("obtuse corners:        %d\n", (int)m.n_obtuse_corners);
@@ -123,6 +130,14 @@ int cmd_info(int argc, char **argv)
                "                       its spokes and exact tables, about 710 more)\n",
                (double)mesh_bytes / 1e6, (double)mesh_bytes / (m.n_vertices > 0 ? m.n_vertices : 1));
     }
+    if (m.n_coincident_vertices > 0)
+        fprintf(stderr,
+                "meshfmm info: note: %d coincident vertices (at the position of another: texture "
+                "seams or unmerged corners) cut the surface into %d component(s), %d once "
+                "welded; distances and paths do not cross the cuts. Weld them first: "
+                "meshfmm weld MESH -o WELDED.obj --map MAP.txt (in Python: "
+                "meshfmm.Mesh(V, F, weld=True)).\n",
+                (int)m.n_coincident_vertices, (int)m.n_components, (int)m.n_welded_components);
     if (fflush(stdout) != 0) {
         cli_error("cannot write to standard output");
         return CLI_FAIL;

@@ -32,7 +32,8 @@ static void help(FILE *out)
             "  -o, --output OUT        .csv (face,b0,b1,b2,x,y,z per point, with a header) or\n"
             "                          .obj (v lines and one polyline 'l' element); - writes\n"
             "                          the .csv to standard output (the length then goes to\n"
-            "                          standard error)\n\n"
+            "                          standard error)\n"
+            "  -h, --help              this text\n\n"
             "Options take their value as --target 3 or --target=3. The output is written to\n"
             "a temporary file beside OUT and renamed when complete; it may not be an input.\n");
 }

@@ -35,6 +35,8 @@ int cli_npy_open(cli_npy_writer *w, const char *path, const char *dtype, int64_t
         w->itemsize = 4;
     else if (strcmp(dtype, "<f8") == 0)
         w->itemsize = 8;
+    else if (strcmp(dtype, "<i4") == 0)
+        w->itemsize = 4;
     else {
         cli_error("npy: unsupported dtype '%s'", dtype);
         return -1;

@@ -13,6 +13,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <sys/statvfs.h>
+
 #include "cli.h"
 #include "io/io.h"
 
@@ -83,7 +85,10 @@ int cli_once(const char *sub, int c, uint32_t *seen)
                 {OPT_SOURCES, "--sources"},
                 {OPT_TARGETS, "--targets"},
                 {OPT_THREADS, "--threads"},
-                {OPT_MEMORY, "--memory"}};
+                {OPT_MEMORY, "--memory"},
+                {OPT_START, "--start"},
+                {OPT_MAP, "--map"},
+                {'k', "-k/--count"}};
     for (unsigned i = 0; i < sizeof once / sizeof once[0]; i++) {
         if (once[i].code != c)
             continue;
@@ -93,6 +98,41 @@ int cli_once(const char *sub, int c, uint32_t *seen)
         return CLI_OK;
     }
     return CLI_OK;
+}
+
+int cli_free_bytes(const char *path, double *out)
+{
+    size_t n = strlen(path);
+    char *dir = malloc(n + 2);
+    if (!dir)
+        return -1;
+    memcpy(dir, path, n + 1);
+    char *slash = strrchr(dir, '/');
+    if (!slash)
+        strcpy(dir, ".");
+    else if (slash == dir)
+        dir[1] = '\0';
+    else
+        *slash = '\0';
+    struct statvfs fs;
+    int rc = statvfs(dir, &fs);
+    free(dir);
+    if (rc != 0)
+        return -1;
+    *out = (double)fs.f_bavail * (double)fs.f_frsize;
+    return 0;
+}
+
+const char *cli_format_bytes(double bytes, char *buf, size_t size)
+{
+    static const char *unit[] = {"bytes", "KiB", "MiB", "GiB", "TiB", "PiB"};
+    int u = 0;
+    while (bytes >= 1024.0 && u < 5) {
+        bytes /= 1024.0;
+        u++;
+    }
+    snprintf(buf, size, u ? "%.3g %s" : "%.0f %s", bytes, unit[u]);
+    return buf;
 }
 
 int cli_getopt_error(const char *sub, int c, char **argv)
@@ -401,4 +441,22 @@ void cli_note_sources_in_no_face(const char *sub, int64_t count, int32_t first)
         fprintf(stderr, "meshfmm %s: note: %lld source vertices are in no face (the first: "
                         "%ld): each reaches only itself (0 there, +inf elsewhere)\n", sub,
                 (long long)count, (long)first);
+}
+
+int cli_write_obj(const char *path, const double *V, int32_t nv, const int32_t *F, int32_t nf,
+                  const char *comment)
+{
+    cli_output out;
+    if (cli_output_open(&out, path))
+        return -1;
+    FILE *f = out.f;
+    int bad = fprintf(f, "# %s\n", comment) < 0;
+    for (int32_t i = 0; i < nv && !bad && !cli_interrupted(); i++)
+        for (int k = 0; k < 3 && !bad; k++)
+            bad = fputs(k ? " " : "v ", f) < 0 || cli_put_double(f, V[3 * i + k]) < 0 ||
+                  (k == 2 && fputc('\n', f) == EOF);
+    for (int32_t i = 0; i < nf && !bad && !cli_interrupted(); i++)
+        bad = fprintf(f, "f %ld %ld %ld\n", (long)F[3 * i] + 1, (long)F[3 * i + 1] + 1,
+                      (long)F[3 * i + 2] + 1) < 0;
+    return cli_output_close(&out, bad);
 }

@@ -245,6 +245,67 @@ static int32_t uf_find(int32_t *parent, int32_t x)
     return x;
 }
 
+/* A position's hash: its coordinates' bits (-0.0 read as 0.0). */
+static uint64_t position_hash(const double *p)
+{
+    uint64_t h = 1469598103934665603u;
+    for (int k = 0; k < 3; k++) {
+        double x = p[k] + 0.0;
+        uint64_t bits;
+        memcpy(&bits, &x, sizeof bits);
+        h = (h ^ bits) * 1099511628211u;
+        h ^= h >> 29;
+    }
+    return h;
+}
+
+/* Referenced vertices at the position of another (texture seams, unmerged
+ * STL corners): their count, and the components the surface would have
+ * with each such group welded into one vertex. `parent` is the
+ * union-find of the face components (build_components), reused. */
+static mfmm_status coincident_vertices(mfmm_mesh *m, int32_t *parent)
+{
+    size_t cap = 16;
+    while (cap < 2 * (size_t)m->nv)
+        cap *= 2;
+    int32_t *table = malloc(cap * sizeof *table);
+    if (!table)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < cap; i++)
+        table[i] = -1;
+    int32_t n_coincident = 0;
+    for (int32_t v = 0; v < m->nv; v++) {
+        if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1])
+            continue; /* unreferenced: counted apart */
+        const double *p = m->xyz + 3 * (size_t)v;
+        size_t i = (size_t)position_hash(p) & (cap - 1);
+        for (;;) {
+            int32_t w = table[i];
+            if (w < 0) {
+                table[i] = v;
+                break;
+            }
+            const double *q = m->xyz + 3 * (size_t)w;
+            if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) {
+                n_coincident++;
+                int32_t a = uf_find(parent, v), b = uf_find(parent, w);
+                if (a != b)
+                    parent[a] = b;
+                break;
+            }
+            i = (i + 1) & (cap - 1);
+        }
+    }
+    free(table);
+    int32_t n_welded = 0;
+    for (int32_t v = 0; v < m->nv; v++)
+        if (m->vertex_face_offset[v] != m->vertex_face_offset[v + 1] && uf_find(parent, v) == v)
+            n_welded++;
+    m->info.n_coincident_vertices = n_coincident;
+    m->info.n_welded_components = n_welded;
+    return MFMM_OK;
+}
+
 /* Connected components (through faces) of referenced vertices: their count
  * (the ids are not kept). */
 static mfmm_status build_components(mfmm_mesh *m)
@@ -279,11 +340,12 @@ static mfmm_status build_components(mfmm_mesh *m)
             component[r] = n_comp++;
         component[v] = component[r];
     }
-    free(parent);
     free(component);
     m->info.n_components = n_comp;
     m->info.n_unreferenced_vertices = n_unref;
-    return MFMM_OK;
+    mfmm_status st = coincident_vertices(m, parent);
+    free(parent);
+    return st;
 }
 
 static void sub3(double *o, const double *a, const double *b)

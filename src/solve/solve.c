@@ -166,6 +166,11 @@ static void solver_reset_pending(mfmm_solver *solver)
     solver->n_pending = 0;
 }
 
+const mfmm_mesh *mfmm_solver_mesh(const mfmm_solver *solver)
+{
+    return solver->mesh;
+}
+
 void mfmm_solver_fix_cost(mfmm_solver *solver, const double *cost, int cost_location)
 {
     solver->fixed_cost = NULL;

@@ -23,6 +23,9 @@ int32_t mfmm_solve_local(mfmm_solver *solver, const mfmm_source *sources, int32_
                          const mfmm_solve_options *options, const double **T,
                          const int32_t **touched, int32_t *n_touched);
 
+/* The mesh a solver was made for. */
+const mfmm_mesh *mfmm_solver_mesh(const mfmm_solver *solver);
+
 /* The vertices of the last solve's exact start that the march computed
  * instead (mfmm_solve_info.start_fallbacks). */
 int64_t mfmm_solver_start_fallbacks(const mfmm_solver *solver);

@@ -77,6 +77,16 @@ static void test_mesh_info(void **state)
         assert_int_equal(mfmm_mesh_get_info(mesh, (mfmm_mesh_info *)(void *)b.bytes), MFMM_OK);
         guarded_check(&b, sizes[i] < sizeof full ? sizes[i] : sizeof full, &full);
     }
+    /* a caller compiled before the coincident-vertex counts: up to bbox_diagonal */
+    {
+        size_t old = offsetof(mfmm_mesh_info, n_coincident_vertices);
+        guarded o;
+        guarded_init(&o, old);
+        assert_int_equal(mfmm_mesh_get_info(mesh, (mfmm_mesh_info *)(void *)o.bytes), MFMM_OK);
+        guarded_check(&o, old, &full);
+    }
+    assert_int_equal(full.n_coincident_vertices, 0);
+    assert_int_equal(full.n_welded_components, full.n_components);
     guarded b;
     guarded_init(&b, 4);
     assert_int_equal(mfmm_mesh_get_info(mesh, (mfmm_mesh_info *)(void *)b.bytes),

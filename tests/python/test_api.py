@@ -603,9 +603,10 @@ def test_max_unfold_steps_reaches_the_core(meshes_dir):
 def test_options_rebuild_an_equal_mesh():
     V, F = grid(4)
     m = meshfmm.Mesh(V, F, max_unfold_steps=8, spokes=False)
-    assert m.options == {"max_unfold_steps": 8, "spokes": False}
+    assert m.options == {"max_unfold_steps": 8, "spokes": False, "weld": False}
     m.options["spokes"] = True  # a copy: the mesh's options stay
     assert m.options["spokes"] is False
     again = meshfmm.Mesh(m.vertices, m.faces, **m.options)
     assert np.array_equal(again.distance(0), m.distance(0))
-    assert meshfmm.Mesh(V, F).options == {"max_unfold_steps": None, "spokes": True}
+    assert meshfmm.Mesh(V, F).options == {"max_unfold_steps": None, "spokes": True,
+                                             "weld": False}

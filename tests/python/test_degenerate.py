@@ -80,6 +80,7 @@ def test_a_point_on_the_line_a_face_was_split_along_starts_both_pieces():
         assert np.allclose(d, euclid, rtol=1e-12, atol=0), kwargs
 
 
+@pytest.mark.filterwarnings("ignore::meshfmm.MeshWarning")  # coincident on purpose
 def test_windows_tied_at_coincident_vertices_do_not_go_round_for_ever():
     # a flat grid with two vertices at one point: windows kept at ties with
     # paths through them (which start windows of their own) went round the

@@ -102,12 +102,15 @@ def test_mesh_distance_method_exact_refuses_what_it_cannot_do():
 def test_cli_distance_exact(tmp_path, reference_dir):
     """`meshfmm distance --exact` equals the stored igl.exact_geodesic row;
     with --cost it is refused with a sentence and status 2."""
-    import os
     import subprocess
 
-    cli = os.environ.get("MESHFMM_CLI")
+    import meshfmm.__main__
+
+    # the package's own binary, else $MESHFMM_CLI (a development build)
+    cli = meshfmm.__main__.cli_path()
     if not cli:
-        pytest.skip("MESHFMM_CLI is not set (scripts/test.sh sets it to build/meshfmm)")
+        pytest.skip("no meshfmm command line in the package and MESHFMM_CLI is not set "
+                    "(scripts/test.sh sets it to build/meshfmm)")
     ref = np.load(reference_dir / "spot.npz")
     out = tmp_path / "d.npy"
     r = subprocess.run([cli, "distance", str(MESHES / "spot.obj"), f"--source={ref['sources'][1]}",

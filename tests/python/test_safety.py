@@ -169,7 +169,7 @@ def test_spokes_off_gives_the_same_rows_and_survives_copies():
                                   on.distance_matrix(src, dtype="float64"))
     np.testing.assert_array_equal(off.distance(3), on.distance(3))
     c = pickle.loads(pickle.dumps(off))
-    assert c._options() == {"max_unfold_steps": None, "spokes": False}
+    assert c._options() == {"max_unfold_steps": None, "spokes": False, "weld": False}
     np.testing.assert_array_equal(c.distance(5), on.distance(5))
 
 

@@ -18,7 +18,7 @@ from . import _lib
 from ._lib import MeshError, OpenCLError
 from ._memmap import open_memmap
 from ._mesh import Mesh, load_mesh
-from ._types import GeodesicPath, MatrixInfo, MeshInfo, SurfacePoint
+from ._types import GeodesicPath, Isoline, MatrixInfo, MeshInfo, MeshWarning, SurfacePoint
 
 #: Version of the loaded libmeshfmm ("MAJOR.MINOR.PATCH").
 __version__: str = _lib.version()
@@ -32,6 +32,8 @@ __all__ = [
     "SurfacePoint",
     "GeodesicPath",
     "MatrixInfo",
+    "Isoline",
+    "MeshWarning",
     "MeshError",
     "OpenCLError",
     "load_mesh",

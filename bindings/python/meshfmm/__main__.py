@@ -4,8 +4,9 @@ console script that ``pip install .`` installs.
 The commands are the C command line's (src/cli), built into the wheel as
 ``meshfmm/_bin/meshfmm``: this wrapper replaces itself with that binary
 (os.execv), so arguments, output, signals (Ctrl-C) and exit codes are the
-binary's own. Only ``allpairs ... -o OUT.zarr`` (Dask + Zarr) is Python's,
-dispatched in :func:`main` before the exec.
+binary's own. Only ``allpairs ... -o OUT.zarr`` (Dask + Zarr) and ``render``
+(a picture, :mod:`meshfmm.plot`) are Python's, dispatched in :func:`main`
+before the exec.
 """
 
 from __future__ import annotations
@@ -53,23 +54,50 @@ def _output(args: List[str]) -> Optional[str]:
 def _allpairs_zarr(args: List[str]) -> int:
     """`meshfmm allpairs MESH -o OUT.zarr`: the Dask + Zarr job of
     meshfmm.distributed, run by its command line (meshfmm._zarr_cli)."""
+    from . import _extras
+
     try:
+        _extras.require("meshfmm allpairs -o OUT.zarr", "dask")
         from ._zarr_cli import cli_allpairs_zarr
-        import distributed  # noqa: F401
-        import zarr  # noqa: F401
     except ImportError as e:
-        sys.stderr.write(f"meshfmm allpairs: output to .zarr needs Dask and Zarr "
-                         f"(pip install 'dask[distributed]' 'zarr>=3'): {e}\n")
+        sys.stderr.write(f"{e}\n")
         return 2
     return cli_allpairs_zarr(args)
+
+
+def _allpairs_help() -> int:
+    """`meshfmm allpairs --help`: the C command line's help (.npy, .npz),
+    then the options of the .zarr output this Python command adds."""
+    import subprocess
+
+    exe = cli_path()
+    if exe is not None:
+        sys.stdout.flush()
+        subprocess.run([exe, "allpairs", "--help"], check=False)
+    else:
+        print("meshfmm allpairs: the command-line binary (.npy and .npz outputs) is not "
+              "installed with this package")
+    print("\nOutput to OUT.zarr (this Python command: a Dask cluster writing a Zarr v3 array,"
+          "\nresumable; needs dask[distributed] and zarr>=3):\n")
+    try:
+        from ._zarr_cli import zarr_parser
+
+        text = zarr_parser().format_help()
+    except ImportError as e:
+        text = (f"  (its options cannot be listed: {e}); --scheduler, --workers, --resume,\n"
+                "  --overwrite, --dtype, --sources, --targets, --max-distance, --cost,\n"
+                "  --backend, --exact-start-radius, --plain-start, --block-rows,\n"
+                "  --compression, --no-progress, --no-spokes\n")
+    sys.stdout.write(text)
+    return 0
 
 
 def main(argv: Optional[List[str]] = None) -> int:
     """Runs the ``meshfmm`` command.
 
-    ``allpairs ... -o OUT.zarr`` runs the Dask + Zarr job in Python; every
-    other command replaces this process with the C command line
-    (``os.execv``), so it does not return.
+    ``render`` and ``allpairs ... -o OUT.zarr`` (the Dask + Zarr job) run
+    in Python; every other command replaces this process with the C
+    command line (``os.execv``), so it does not return.
 
     Parameters
     ----------
@@ -79,10 +107,16 @@ def main(argv: Optional[List[str]] = None) -> int:
     Returns
     -------
     int
-        The exit status: 2 when the C command line is not installed or the
-        Zarr job lacks Dask or Zarr, else the Zarr job's status.
+        The exit status: 2 when the C command line is not installed, or the
+        Zarr job or ``render`` lacks its extra, else the Python command's.
     """
     args = list(sys.argv[1:] if argv is None else argv)
+    if args and args[0] == "allpairs" and any(a in ("-h", "--help") for a in args[1:]):
+        return _allpairs_help()
+    if args and args[0] == "render":
+        from .plot import cli_render
+
+        return cli_render(args[1:])
     if args and args[0] == "allpairs":
         out = _output(args[1:])
         if out is not None and out.rstrip("/").lower().endswith(".zarr"):

@@ -126,6 +126,10 @@ def source_records(sources: Any, what: str = "source") -> np.ndarray:
     """Any accepted form of sources (a vertex id, a SurfacePoint, a sequence
     mixing those, an integer array of vertex ids) -> a C-contiguous array of
     mfmm_source records (``_lib.SOURCE_DTYPE``)."""
+    if isinstance(sources, np.ndarray) and sources.dtype == _lib.SOURCE_DTYPE:
+        if sources.size == 0:
+            raise ValueError(f"at least one {what} is needed")
+        return np.ascontiguousarray(sources.reshape(-1))  # records already
     if isinstance(sources, SurfacePoint):
         sources = [sources]
     elif is_int(sources):

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any, Callable, Optional, Tuple
 
 import numpy as np
 
-from . import _rows
+from . import _guards, _rows
 from ._types import MatrixInfo
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -30,15 +30,20 @@ def check_out(out: Any, shape: Tuple[int, int], dt: np.dtype) -> None:
 
 def dense_matrix(mesh: "Mesh", req: _rows.Request, out: Optional[np.ndarray], *,
                  symmetric: bool, progress: Optional[Callable[[int, int], Any]],
-                 **options: Any) -> Tuple[np.ndarray, MatrixInfo]:
-    """Rows of ``req`` into `out` (allocated when None), then (D + D^T) / 2
-    in place if `symmetric`. `options` are :func:`_rows.options`' keywords.
-    Returns the array and the call's MatrixInfo."""
-    nv = mesh.n_vertices
+                 size_check: bool = True, **options: Any) -> Tuple[np.ndarray, MatrixInfo]:
+    """Rows of ``req`` into `out` (allocated when None, after comparing its
+    size with the memory available unless not `size_check`), then
+    (D + D^T) / 2 in place if `symmetric`. `options` are
+    :func:`_rows.options`' keywords. Returns the array and the call's
+    MatrixInfo."""
+    nv = mesh._nv
     if symmetric and not req.is_square(nv):
         raise ValueError("symmetric=True needs a square result: sources None or equal to targets")
     shape = (req.n_rows, req.width)
     if out is None:
+        if size_check:
+            _guards.check_memory(shape[0] * shape[1] * req.dtype.itemsize,
+                                 f"{shape[0]} x {shape[1]} {req.dtype}")
         out = np.empty(shape, dtype=req.dtype)
     else:
         check_out(out, shape, req.dtype)

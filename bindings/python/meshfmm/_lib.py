@@ -168,6 +168,8 @@ class mfmm_mesh_info(_Sized):
         ("max_edge_length", c_double),
         ("mean_edge_length", c_double),
         ("bbox_diagonal", c_double),
+        ("n_coincident_vertices", c_int32),
+        ("n_welded_components", c_int32),
     ]
 
 
@@ -436,6 +438,19 @@ mfmm_solve = _proto(
     [c_void_p, c_void_p, c_int32, P(mfmm_solve_options), c_void_p, P(mfmm_error)],
 )
 mfmm_solver_get_info = _proto("mfmm_solver_get_info", c_enum, [c_void_p, P(mfmm_solve_info)])
+mfmm_farthest_points = _proto(
+    "mfmm_farthest_points",
+    c_enum,
+    # solver, start, k, options, points (int32_t *), radii (double *), distances (double *), err
+    [c_void_p, c_int32, c_int32, P(mfmm_solve_options), c_void_p, c_void_p, c_void_p,
+     P(mfmm_error)],
+)
+mfmm_voronoi_labels = _proto(
+    "mfmm_voronoi_labels",
+    c_enum,
+    # mesh, distances (double *), sources (mfmm_source *), n_sources, labels (int32_t *), err
+    [c_void_p, c_void_p, c_void_p, c_int32, c_void_p, P(mfmm_error)],
+)
 # exact
 mfmm_exact_solver_create = _proto("mfmm_exact_solver_create", c_enum, [c_void_p, P(c_void_p)])
 mfmm_exact_solver_destroy = _proto("mfmm_exact_solver_destroy", None, [c_void_p])

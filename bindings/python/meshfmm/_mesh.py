@@ -14,16 +14,21 @@ import math
 import numbers
 import os
 import threading
+import warnings
 from ctypes import byref
-from typing import Any, Callable, Dict, Iterator, List, Optional, Tuple, Union
+from typing import Any, Dict, Iterator, List, Optional, Tuple, Union
 
 import numpy as np
 
-from . import _args, _dense, _lib, _rows, _sparse
+from . import _args, _dense, _guards, _isolines, _lib, _rows, _sparse
 from ._interrupt import sigint_as_flag
-from ._types import GeodesicPath, MatrixInfo, MeshInfo, SourceLike, SurfacePoint
+from ._points import Points, combine
+from ._types import (GeodesicPath, Isoline, MatrixInfo, MeshInfo, MeshWarning, SourceLike,
+                     SurfacePoint)
+from ._weld import Weld
 
-__all__ = ["Mesh", "MeshInfo", "SurfacePoint", "GeodesicPath", "MatrixInfo", "load_mesh"]
+__all__ = ["Mesh", "MeshInfo", "SurfacePoint", "GeodesicPath", "MatrixInfo", "Isoline",
+           "MeshWarning", "load_mesh"]
 
 
 class Mesh:
@@ -66,6 +71,22 @@ class Mesh:
         380 bytes per vertex, on the first solve, kept with the mesh).
         False puts memory first: the march walks the faces instead, with the
         same results bit for bit and a march 1.25-1.6x as long.
+    weld : bool
+        False (default): every vertex is its own, and vertices at the same
+        position (texture seams, unmerged STL corners) cut the surface; a
+        :class:`MeshWarning` says so. True: vertices of exactly equal
+        position are welded into one (faces whose corners weld together are
+        dropped); the methods still take and return the vertex and face ids
+        given (``vertices``, ``faces``, ``n_vertices`` are the input's), and
+        every per-vertex result holds, for each input vertex, the value of
+        its welded vertex. :attr:`info` and :meth:`memory` describe the
+        welded surface; :attr:`weld_map` maps input vertices to it.
+
+    Warns
+    -----
+    MeshWarning
+        With ``weld=False``, when vertices coincide: it names their count,
+        the components with and without welding, and ``weld=True``.
 
     Raises
     ------
@@ -78,7 +99,7 @@ class Mesh:
     """
 
     def __init__(self, V: Any, F: Any = None, *, max_unfold_steps: Optional[int] = None,
-                 spokes: bool = True) -> None:
+                 spokes: bool = True, weld: bool = False) -> None:
         self._ptr: Optional[int] = None
         if F is None:
             # Mesh(obj): anything with .vertices and .faces (a trimesh.Trimesh,
@@ -91,6 +112,7 @@ class Mesh:
             V, F = V.vertices, V.faces
         self._max_unfold_steps = max_unfold_steps
         self._spokes = _args.flag(spokes, "spokes")
+        self._weld_opt = _args.flag(weld, "weld")
         self._lock = threading.Lock()
         # _leave notifies it when the last call in flight ends (close waits on it)
         self._idle = threading.Condition(self._lock)
@@ -101,7 +123,17 @@ class Mesh:
         self._solvers: List[int] = []
         self._exact_solvers: List[int] = []
 
-        self._V, self._F = _args.mesh_arrays(V, F)
+        # _V_in, _F_in: as given (the public arrays); _V, _F: what the C mesh
+        # is built from (welded when weld=True)
+        self._V_in, self._F_in = _args.mesh_arrays(V, F)
+        self._weld: Optional[Weld] = None
+        if self._weld_opt and Weld.applicable(self._V_in, self._F_in):
+            self._weld = Weld(self._V_in, self._F_in)
+            self._V, self._F = self._weld.V, self._weld.F
+            self._V.setflags(write=False)
+            self._F.setflags(write=False)
+        else:
+            self._V, self._F = self._V_in, self._F_in
         nv, nf = self._V.shape[0], self._F.shape[0]
 
         opts = _lib.mfmm_mesh_options()
@@ -122,6 +154,14 @@ class Mesh:
         _lib.check(_lib.mfmm_mesh_get_info(self._ptr, byref(info)))
         self._info = MeshInfo(**{name: getattr(info, name) for name, _ in info._fields_
                                  if name != "struct_size"})
+        if self._info.n_coincident_vertices and self._weld is None:
+            i = self._info
+            warnings.warn(
+                f"{i.n_coincident_vertices} coincident vertices (at the position of another "
+                "vertex: texture seams or unmerged STL corners) cut the surface, which falls "
+                f"into {i.n_components} component(s) ({i.n_welded_components} once welded); "
+                "distances and paths do not cross the cuts. Mesh(V, F, weld=True) welds them.",
+                MeshWarning, stacklevel=2)
         self._opts_template = _lib.mfmm_solve_options()
         _lib.mfmm_solve_options_init(byref(self._opts_template))
 
@@ -154,30 +194,31 @@ class Mesh:
 
     # ---- copies and pickling: by vertices, faces and options, never the C pointer
     def _options(self) -> dict:
-        return {"max_unfold_steps": self._max_unfold_steps, "spokes": self._spokes}
+        return {"max_unfold_steps": self._max_unfold_steps, "spokes": self._spokes,
+                "weld": self._weld_opt}
 
     @property
     def options(self) -> Dict[str, Any]:
         """The constructor's keyword options, ``max_unfold_steps`` (None: the
-        default) and ``spokes``: ``Mesh(V, F, **mesh.options)`` builds an
-        equal mesh (a new dict each time)."""
+        default), ``spokes`` and ``weld``: ``Mesh(V, F, **mesh.options)``
+        builds an equal mesh (a new dict each time)."""
         return self._options()
 
     def __reduce__(self) -> Tuple[Any, ...]:
         if self.closed:
             raise ValueError("cannot pickle or copy a closed mesh")
-        return (_rebuild_mesh, (type(self), self._V, self._F, self._options()))
+        return (_rebuild_mesh, (type(self), self._V_in, self._F_in, self._options()))
 
     def __copy__(self) -> "Mesh":
         # a new C mesh (the vertex and face arrays are read-only, so shared)
         if self.closed:
             raise ValueError("cannot copy a closed mesh")
-        return _rebuild_mesh(type(self), self._V, self._F, self._options())
+        return _rebuild_mesh(type(self), self._V_in, self._F_in, self._options())
 
     def __deepcopy__(self, memo: dict) -> "Mesh":
         if self.closed:
             raise ValueError("cannot copy a closed mesh")
-        return _rebuild_mesh(type(self), self._V.copy(), self._F.copy(), self._options())
+        return _rebuild_mesh(type(self), self._V_in.copy(), self._F_in.copy(), self._options())
 
     # ---- lifetime
     def close(self, timeout: Optional[float] = None) -> None:
@@ -340,23 +381,30 @@ class Mesh:
     # ---- properties
     @property
     def n_vertices(self) -> int:
-        """Number of vertices (unreferenced ones included)."""
-        return self._nv
+        """Number of vertices (unreferenced ones included), as given."""
+        return int(self._V_in.shape[0])
 
     @property
     def n_faces(self) -> int:
-        """Number of faces."""
-        return self._nf
+        """Number of faces, as given."""
+        return int(self._F_in.shape[0])
 
     @property
     def vertices(self) -> np.ndarray:
-        """The vertices, float64 (n_vertices, 3), read-only."""
-        return self._V
+        """The vertices as given, float64 (n_vertices, 3), read-only."""
+        return self._V_in
 
     @property
     def faces(self) -> np.ndarray:
-        """The faces, int32 (n_faces, 3), read-only."""
-        return self._F
+        """The faces as given, int32 (n_faces, 3), read-only."""
+        return self._F_in
+
+    @property
+    def weld_map(self) -> Optional[np.ndarray]:
+        """With ``weld=True``: int32 (n_vertices,), the welded vertex of
+        each input vertex (welded vertices are numbered by their lowest
+        input id, in input order); None without welding."""
+        return None if self._weld is None else self._weld.to_welded.copy()
 
     @property
     def info(self) -> MeshInfo:
@@ -400,7 +448,7 @@ class Mesh:
         elif self._closing:
             state = "closed, freed when its calls in flight end"
         else:
-            state = f"{self._nv} vertices, {self._nf} faces"
+            state = f"{self.n_vertices} vertices, {self.n_faces} faces"
         return f"<meshfmm.Mesh {state}>"
 
     # ---- distances
@@ -415,8 +463,11 @@ class Mesh:
         cost_location: Optional[str] = None,
         method: str = "fmm",
         exact_start: Any = True,
+        at: Any = None,
+        progress: bool = False,
     ) -> np.ndarray:
-        """Distance from the nearest source to every vertex.
+        """Distance from the nearest source to every vertex, or to given
+        points.
 
         Parameters
         ----------
@@ -451,12 +502,22 @@ class Mesh:
             mean error of the paper's start). A number: that radius in mean
             edge lengths. False (or 0): the paper's plain start. With a
             cost, it applies where the cost is uniform around the source.
+        at : int, SurfacePoint, or sequence of those, optional
+            Points to return the distances of instead of every vertex's: a
+            vertex id gives its vertex's distance; a point in a face the
+            value the path tracer reads there (:meth:`geodesic_path`), the
+            linear interpolant of the face's corners, sum of ``b_k * d_k``
+            over the corners with ``b_k > 0`` (+inf when one of them is
+            unreached). The march stops once those corners are settled.
+        progress : bool
+            True: with ``method="exact"`` (which can run minutes on millions
+            of vertices), the time so far on standard error while it runs.
 
         Returns
         -------
-        numpy.ndarray, float64, shape (n_vertices,)
-            The distances; unreached vertices (other components, beyond
-            max_distance) are +inf.
+        numpy.ndarray, float64, shape (n_vertices,) or (P,)
+            The distances (at the P points of ``at`` when given); unreached
+            vertices (other components, beyond max_distance) are +inf.
 
         Raises
         ------
@@ -469,12 +530,45 @@ class Mesh:
         KeyboardInterrupt
             Ctrl-C during ``method="exact"``.
         """
+        pts = None
+        if at is not None:
+            pts = Points.parse(at, "at", self.n_vertices, self.n_faces)
+        if self._weld is not None:
+            w = self._weld
+            sources = w.sources(sources)
+            cost, cost_location = w.cost(cost, cost_location)
+            if targets is not None:
+                targets = w.vertices(targets, "target")
+            if pts is not None:
+                pts = pts.welded(w, "at")
+        if pts is not None and method != "exact":
+            stop = pts.columns(self._F)[0]
+            targets = stop if targets is None else np.concatenate(
+                [_args.index_array(targets, "target"), stop])
+        bar = None
+        if _args.flag(progress, "progress") and method == "exact":
+            bar = _guards.ProgressBar("exact solve")
+        try:
+            d = self._distance(sources, cost, max_distance, targets=targets,
+                               unfolding=unfolding, cost_location=cost_location, method=method,
+                               exact_start=exact_start, bar=bar)
+        finally:
+            if bar is not None:
+                bar.close()
+        if pts is not None:
+            return pts.values(d, self._F)
+        return d if self._weld is None else self._weld.per_vertex(d)
+
+    def _distance(self, sources: Any, cost: Any, max_distance: Optional[float], *,
+                  targets: Any, unfolding: Any, cost_location: Optional[str], method: str,
+                  exact_start: Any, bar: Any = None) -> np.ndarray:
+        """:meth:`distance` in the C mesh's vertex ids (welded ones)."""
         unfolding = _args.flag(unfolding, "unfolding")
         if method == "exact":
             if cost is not None or targets is not None or not unfolding or exact_start is not True:
                 raise ValueError("method='exact' computes geodesic distance: it takes no cost, "
                                  "targets, unfolding or exact_start")
-            return self._distance_exact(sources, max_distance)
+            return self._distance_exact(sources, max_distance, bar)
         if method != "fmm":
             raise ValueError(f"method must be 'fmm' or 'exact', not {method!r}")
         if _args.is_int(sources):  # the common case, kept cheap (bench/suite/bench_python.py)
@@ -520,7 +614,8 @@ class Mesh:
             raise _lib.make_error(status, err)
         return out
 
-    def _distance_exact(self, sources: SourceLike, max_distance: Optional[float]) -> np.ndarray:
+    def _distance_exact(self, sources: SourceLike, max_distance: Optional[float],
+                        bar: Any = None) -> np.ndarray:
         src = _args.source_records(sources)
         opts = _lib.mfmm_exact_options()
         _lib.mfmm_exact_options_init(byref(opts))
@@ -531,7 +626,12 @@ class Mesh:
         info = _lib.mfmm_exact_info()
         # Ctrl-C stops a long solve: the library asks every few milliseconds
         interrupted: List[int] = []
-        interrupt = type(opts.interrupt)(lambda user: 1 if interrupted else 0)
+        def ask(user: Any) -> int:
+            if bar is not None:
+                bar.tick()
+            return 1 if interrupted else 0
+
+        interrupt = type(opts.interrupt)(ask)
         opts.interrupt = interrupt
         solver = None
         mesh_ptr = self._enter()
@@ -608,6 +708,13 @@ class Mesh:
             where T stops decreasing above 0: a face source, a source value
             > 0). It never returns a path that ends elsewhere.
         """
+        if self._weld is not None:
+            w = self._weld
+            distances = w.distances_in(distances)
+            target = w.point(target, "target")
+            if sources is not None:
+                sources = w.sources(sources)
+            cost, cost_location = w.cost(cost, cost_location)
         d = np.ascontiguousarray(distances, dtype=np.float64)
         if d.shape != (self._nv,):
             raise ValueError(f"distances must have shape ({self._nv},), got {d.shape}")
@@ -648,13 +755,258 @@ class Mesh:
             self._leave()
         _lib.check(status, err)
         pts = buf[: n.value]
+        faces = np.ascontiguousarray(pts["face"])
+        if self._weld is not None:
+            faces = self._weld.faces_out(faces)
         return GeodesicPath(
             points=np.ascontiguousarray(pts["xyz"]),
-            faces=np.ascontiguousarray(pts["face"]),
+            faces=faces,
             barycentric=np.ascontiguousarray(pts["bary"]),
             length=float(length.value),
             weighted_length=float(weighted.value),
         )
+
+    # ---- workflow tools
+    def path(
+        self,
+        source: Union[int, SurfacePoint],
+        target: Union[int, SurfacePoint],
+        *,
+        method: str = "fmm",
+        cost: Any = None,
+        cost_location: Optional[str] = None,
+        exact_start: Any = True,
+        max_points: Optional[int] = None,
+        straighten: bool = True,
+    ) -> GeodesicPath:
+        """The shortest path from ``source`` to ``target`` in one call.
+
+        Solves from the source (:meth:`distance`), traces back from the
+        target (:meth:`geodesic_path` with ``sources=[source]``) and returns
+        the polyline reversed: point 0 is the source, the last point the
+        target. Equal, point for point, to the reversed two-call path.
+
+        Parameters
+        ----------
+        source, target : int or SurfacePoint
+            Vertex ids or points inside faces.
+        method : {"fmm", "exact"}
+            The distances the path descends (:meth:`distance`).
+        cost, cost_location, exact_start
+            As in :meth:`distance`.
+        max_points, straighten
+            As in :meth:`geodesic_path`.
+
+        Returns
+        -------
+        GeodesicPath
+            From the source (point 0) to the target; ``faces[i]`` (i > 0)
+            is the face the segment from point i-1 runs through and
+            ``barycentric[i]`` point i's coordinates in it.
+
+        Raises
+        ------
+        ValueError
+            A bad source or target, or a target the source does not reach.
+        RuntimeError
+            Tracing stalls (as :meth:`geodesic_path`).
+        """
+        d = self.distance(source, cost, method=method, cost_location=cost_location,
+                          exact_start=exact_start)
+        back = self.geodesic_path(d, target, sources=[source], cost=cost,
+                                  cost_location=cost_location, max_points=max_points,
+                                  straighten=straighten)
+        return _reverse_path(back, self._V_in, self._F_in)
+
+    def farthest_point_sampling(
+        self,
+        k: int,
+        start: int = 0,
+        *,
+        cost: Any = None,
+        cost_location: Optional[str] = None,
+        unfolding: bool = True,
+        exact_start: Any = True,
+        return_radii: bool = False,
+        return_distances: bool = False,
+    ) -> Any:
+        """Geodesic farthest-point sampling (landmarks): k vertices, the
+        first ``start``, each next the vertex farthest from those chosen
+        (ties to the lowest vertex id).
+
+        One solver and a running minimum (``mfmm_farthest_points``): each
+        march stops at the current farthest distance, past which it cannot
+        lower the minimum, so later points cost a fraction of a full solve;
+        the points equal those of a loop of full :meth:`distance` solves.
+        Vertices in no face are never chosen; a component not yet reached
+        is farther than any reached vertex, so each component gets a point
+        before any gets a second.
+
+        Parameters
+        ----------
+        k : int
+            Points to choose, 1 <= k <= the vertices in faces.
+        start : int
+            The first point, a vertex in a face.
+        cost, cost_location, unfolding, exact_start
+            As in :meth:`distance`.
+        return_radii : bool
+            Also return float64 (k,): each point's distance to the points
+            before it when chosen (+inf for the first): the covering radius
+            of the points before, non-increasing.
+        return_distances : bool
+            Also return float64 (n_vertices,): each vertex's distance to its
+            nearest point.
+
+        Returns
+        -------
+        points : numpy.ndarray, int32 (k,)
+            Vertex ids, in the order chosen (with ``weld=True``: the lowest
+            input id of each welded vertex).
+        radii, distances : numpy.ndarray
+            Only when asked for, in that order.
+
+        Raises
+        ------
+        ValueError
+            k out of range, a start out of range or in no face, a bad cost.
+        """
+        k = _args.index(k, "k")
+        start = _args.index(start, "start")
+        if not (0 <= start < self.n_vertices):
+            raise ValueError(f"start vertex {start} is out of range (the mesh has "
+                             f"{self.n_vertices} vertices)")
+        return_radii = _args.flag(return_radii, "return_radii")
+        return_distances = _args.flag(return_distances, "return_distances")
+        if self._weld is not None:
+            start = int(self._weld.to_welded[start])
+            cost, cost_location = self._weld.cost(cost, cost_location)
+        opts = _lib.mfmm_solve_options.from_buffer_copy(self._opts_template)
+        c, loc = _args.cost_array(cost, cost_location, self._nv, self._nf)
+        if c is not None:
+            opts.cost = _args.addr(c)
+            opts.cost_location = loc
+        opts.unfolding = 1 if _args.flag(unfolding, "unfolding") else 0
+        radius = _args.exact_start_radius(exact_start)
+        if radius is not None:
+            opts.exact_start_radius = radius
+        if k < 1:
+            raise ValueError(f"k must be >= 1, got {k}")
+        points = np.empty(k, dtype=np.int32)
+        radii = np.empty(k, dtype=np.float64)
+        dist = np.empty(self._nv, dtype=np.float64) if return_distances else None
+        err = _lib.mfmm_error()
+        solver = None
+        mesh_ptr = self._enter()
+        try:
+            solver = self._take_solver(mesh_ptr)
+            status = _lib.mfmm_farthest_points(
+                solver, start, k, byref(opts), _args.addr(points), _args.addr(radii),
+                None if dist is None else _args.addr(dist), byref(err))
+        finally:
+            if solver is not None:
+                self._solvers.append(solver)
+            self._leave()
+        _lib.check(status, err)
+        if self._weld is not None:
+            points = self._weld.rep[points].astype(np.int32)
+            if dist is not None:
+                dist = self._weld.per_vertex(dist)
+        out: List[Any] = [points]
+        if return_radii:
+            out.append(radii)
+        if return_distances:
+            out.append(dist)
+        return out[0] if len(out) == 1 else tuple(out)
+
+    def voronoi_labels(self, sources: SourceLike, distances: Any = None,
+                       **kwargs: Any) -> np.ndarray:
+        """Geodesic Voronoi labels: which source each vertex's distance comes
+        from.
+
+        One pass over the vertices' edges after the solve
+        (``mfmm_voronoi_labels``): a source's own vertex takes that source;
+        any other vertex the label of its lower neighbour u minimizing
+        ``d(u) + |uv|``. Inside a cell this is the argmin over the
+        single-source fields; within about an edge of a cell's border, where
+        two sources' distances differ by less than the march's error,
+        either may be given (ties of exactly equal distance: the lower
+        source index where a source decides).
+
+        Parameters
+        ----------
+        sources : int, SurfacePoint, or sequence of those
+            The sources, as for :meth:`distance`; labels index this list.
+        distances : array_like of float, shape (n_vertices,), optional
+            The distances from these sources (:meth:`distance` with the same
+            sources); None solves them.
+        **kwargs
+            :meth:`distance`'s options for that solve (cost, method, ...).
+
+        Returns
+        -------
+        numpy.ndarray, int32 (n_vertices,)
+            The index in ``sources`` of each vertex's nearest source; -1
+            where the distance is +inf.
+        """
+        src = _args.source_records(sources)
+        if distances is None:
+            d = self.distance(src, **kwargs)
+        elif kwargs:
+            raise ValueError("options are for the solve: give them without distances")
+        else:
+            d = distances
+        if self._weld is not None:
+            src = self._weld.sources(src)
+            d = self._weld.distances_in(d)
+        d = np.ascontiguousarray(d, dtype=np.float64)
+        if d.shape != (self._nv,):
+            raise ValueError(f"distances must have shape ({self.n_vertices},), got {d.shape}")
+        labels = np.empty(self._nv, dtype=np.int32)
+        err = _lib.mfmm_error()
+        with self._in_call() as mesh_ptr:
+            status = _lib.mfmm_voronoi_labels(mesh_ptr, _args.addr(d), _args.addr(src),
+                                              src.shape[0], _args.addr(labels), byref(err))
+        _lib.check(status, err)
+        return labels if self._weld is None else self._weld.per_vertex(labels)
+
+    def isolines(self, distances: Any, values: Any) -> List[List[Isoline]]:
+        """Isolines of a per-vertex field at given values, as polylines.
+
+        Where the linear interpolant of ``distances`` over each face equals a
+        value: one pass over the faces per value, segments joined through
+        their shared edges. A corner counts as above a level when its value
+        is >= it; faces with an infinite corner hold no segment.
+
+        Parameters
+        ----------
+        distances : array_like of float, shape (n_vertices,)
+            The field (any per-vertex values, e.g. from :meth:`distance`).
+        values : float or sequence of float
+            The levels.
+
+        Returns
+        -------
+        list of list of Isoline
+            For each value, its polylines (an empty list where none).
+        """
+        d = np.ascontiguousarray(distances, dtype=np.float64)
+        if d.shape != (self.n_vertices,):
+            raise ValueError(f"distances must have shape ({self.n_vertices},), got {d.shape}")
+        if np.isnan(d).any():
+            raise ValueError("distances hold NaN")
+        vals = np.atleast_1d(np.asarray(values, dtype=np.float64))
+        if vals.ndim != 1 or not np.isfinite(vals).all():
+            raise ValueError("values must be finite numbers")
+        if self._weld is not None:
+            d = self._weld.distances_in(d)
+        out = []
+        for c in vals:
+            lines = _isolines.isolines(self._V, self._F, d, float(c))
+            if self._weld is not None:
+                lines = _isolines.fix_faces(lines, self._weld.faces_out)
+            out.append(lines)
+        return out
 
     # ---- many sources
     def distance_matrix(
@@ -671,11 +1023,12 @@ class Mesh:
         exact_start: Any = True,
         n_threads: int = 0,
         memory_limit: int = 0,
-        progress: Optional[Callable[[int, int], Any]] = None,
+        progress: Any = None,
         targets: Any = None,
         sparse: bool = False,
         symmetric: bool = False,
         return_info: bool = False,
+        size_check: bool = True,
     ) -> Any:
         """Distances from many vertex sources, one row per source.
 
@@ -706,15 +1059,21 @@ class Mesh:
             Bytes the library may use for workspaces and blocks in flight; 0
             for its default, 16 MiB (on OpenCL at least one row per compute
             unit).
-        progress : callable, optional
-            Called as ``progress(rows_done, n_rows)`` as blocks of rows
-            finish. An exception it raises (or Ctrl-C) stops the job and
-            propagates.
-        targets : array_like of int, shape (T,), optional
+        progress : bool or callable, optional
+            True: a progress bar on standard error (rows done, time, time
+            left), ending with the backend that ran and, under "auto", why.
+            A callable is called as ``progress(rows_done, n_rows)`` as
+            blocks of rows finish; an exception it raises (or Ctrl-C) stops
+            the job and propagates.
+        targets : array_like of int or SurfacePoint, shape (T,), optional
             Vertex ids in any order, duplicates allowed: the result is S x T,
             column j the distance to ``targets[j]``, and each row's march
             stops once its targets are settled (landmark matrices cost far
-            less than full rows). None: every vertex. Every backend.
+            less than full rows). None: every vertex. Every backend. Points
+            inside faces (:class:`SurfacePoint`, mixed with ids or not) get
+            the value the path tracer reads there, as ``distance(at=...)``:
+            the rows go to their faces' corners (float64) and are combined;
+            dense only.
         sparse : bool
             Return a ``scipy.sparse.csr_matrix`` of the finite entries only
             (with ``max_distance=r``: the pairs within r; the diagonal holds
@@ -726,6 +1085,11 @@ class Mesh:
             (D + D^T) / 2, symmetrised in place without a copy. Dense only.
         return_info : bool
             Also return the call's :class:`MatrixInfo`.
+        size_check : bool
+            True (default): before allocating a dense result (``out`` None),
+            compare its size with the memory available (the system's, a
+            cgroup's limit, RLIMIT_AS) and refuse with both numbers rather
+            than start a job that cannot finish. False allocates anyway.
 
         Returns
         -------
@@ -734,7 +1098,7 @@ class Mesh:
             (sparse). ``out`` itself when given.
         info : MatrixInfo
             Only with ``return_info=True``: the backend that ran, why "auto"
-            fell back, the vertices settled and the exact start's fallbacks.
+            chose it, the vertices settled and the exact start's fallbacks.
 
         Raises
         ------
@@ -746,19 +1110,73 @@ class Mesh:
             result, ...).
         KeyboardInterrupt
             Ctrl-C, after the library stopped at the next block of rows.
+        MemoryError
+            The dense result would not fit the memory available
+            (``size_check``).
         """
+        pts = None
+        if targets is not None and _has_surface_point(targets):
+            pts = Points.parse(targets, "target", self.n_vertices, self.n_faces)
+        if self._weld is not None:
+            w = self._weld
+            sources = w.to_welded if sources is None else w.vertices(sources, "source")
+            if pts is not None:
+                pts = pts.welded(w, "target")
+            else:
+                targets = w.to_welded if targets is None else w.vertices(targets, "target")
+            cost, cost_location = w.cost(cost, cost_location)
+        progress, bar = _guards.progress_callback(progress, "distance matrix")
+        kw = dict(max_distance=max_distance, cost=cost, cost_location=cost_location,
+                  unfolding=unfolding, exact_start=exact_start, n_threads=n_threads,
+                  memory_limit=memory_limit, progress=progress,
+                  size_check=_args.flag(size_check, "size_check"))
+        info = None
+        try:
+            if pts is not None:
+                result, info = self._matrix_at_points(pts, sources, backend, dtype, out,
+                                                      sparse=sparse, symmetric=symmetric, **kw)
+            else:
+                result, info = self._matrix(sources, backend, dtype, out, targets=targets,
+                                            sparse=sparse, symmetric=symmetric, **kw)
+        finally:
+            if bar is not None:
+                bar.close(info)
+        return (result, info) if _args.flag(return_info, "return_info") else result
+
+    def _matrix_at_points(self, pts: Points, sources: Any, backend: Any, dtype: Any,
+                          out: Optional[np.ndarray], *, sparse: Any, symmetric: Any,
+                          **kw: Any) -> Tuple[np.ndarray, MatrixInfo]:
+        """Columns at surface points: the rows to the corners they need
+        (float64), combined as the tracer interpolates."""
+        if _args.flag(sparse, "sparse") or _args.flag(symmetric, "symmetric"):
+            raise ValueError("targets with points in faces give a dense S x T result: "
+                             "sparse and symmetric do not apply")
+        dt, _ = _args.matrix_dtype(dtype)
+        U, cols, wts = pts.columns(self._F)
+        DU, info = self._matrix(sources, backend, "float64", None, targets=U, sparse=False,
+                                symmetric=False, **kw)
+        shape = (DU.shape[0], cols.shape[0])
+        if out is None:
+            out = np.empty(shape, dtype=dt)
+        else:
+            _dense.check_out(out, shape, dt)
+        combine(DU, cols, wts, out=out)
+        return out, info
+
+    def _matrix(self, sources: Any, backend: Any, dtype: Any, out: Optional[np.ndarray], *,
+                targets: Any, sparse: Any, symmetric: Any, progress: Any,
+                **kw: Any) -> Tuple[Any, MatrixInfo]:
+        """:meth:`distance_matrix` in the C mesh's vertex ids."""
         req = _rows.Request(self, sources, backend, dtype, targets)
-        unfolding = _args.flag(unfolding, "unfolding")
+        unfolding = _args.flag(kw.pop("unfolding"), "unfolding")
         sparse = _args.flag(sparse, "sparse")
         symmetric = _args.flag(symmetric, "symmetric")
-        return_info = _args.flag(return_info, "return_info")
         req.check_targets(self._nv)
+        if sparse:
+            kw.pop("size_check")  # memory follows the entries
         path = _sparse.sparse_matrix if sparse else _dense.dense_matrix
-        result, info = path(self, req, out, symmetric=symmetric, progress=progress,
-                            cost=cost, cost_location=cost_location, max_distance=max_distance,
-                            unfolding=unfolding, exact_start=exact_start, n_threads=n_threads,
-                            memory_limit=memory_limit)
-        return (result, info) if return_info else result
+        return path(self, req, out, symmetric=symmetric, progress=progress,
+                    unfolding=unfolding, **kw)
 
     def iter_distance_rows(
         self, sources: Any = None, block_rows: int = 256, **kwargs: Any
@@ -802,23 +1220,65 @@ class Mesh:
             raise ValueError("iter_distance_rows yields dense blocks: no sparse, symmetric or out")
         if block_rows < 1:
             raise ValueError("block_rows must be >= 1")
-        src = (np.arange(self._nv, dtype=np.int32) if sources is None
+        src = (np.arange(self.n_vertices, dtype=np.int32) if sources is None
                else _args.index_array(sources, "source"))
         n_rows = src.shape[0]
         if n_rows == 0:
             raise ValueError("at least one source is needed")
-        progress = kwargs.pop("progress", None)
+        progress, bar = _guards.progress_callback(kwargs.pop("progress", None), "distance rows")
         with_info = _args.flag(kwargs.pop("return_info", False), "return_info")
-        for first in range(0, n_rows, block_rows):
-            part = src[first : first + block_rows]
+        info = None
+        try:
+            for first in range(0, n_rows, block_rows):
+                part = src[first : first + block_rows]
 
-            def prog(done: int, _total: int, first: int = first) -> Any:
-                if progress is not None:
-                    return progress(first + done, n_rows)
-                return None
+                def prog(done: int, _total: int, first: int = first) -> Any:
+                    if progress is not None:
+                        return progress(first + done, n_rows)
+                    return None
 
-            block, info = self.distance_matrix(part, progress=prog, return_info=True, **kwargs)
-            yield (first, block, info) if with_info else (first, block)
+                block, info = self.distance_matrix(part, progress=prog, return_info=True,
+                                                   **kwargs)
+                yield (first, block, info) if with_info else (first, block)
+        finally:
+            if bar is not None:
+                bar.close(info)
+
+
+def _reverse_path(p: GeodesicPath, V: np.ndarray, F: np.ndarray) -> GeodesicPath:
+    """A path run backwards, keeping GeodesicPath's convention (faces[i],
+    i > 0, the face of the segment from point i-1; barycentric[i] in
+    faces[i]): a point whose face changes gets its coordinates in the new
+    face, from its position."""
+    k = len(p)
+    pts = p.points[::-1].copy()
+    if k < 2:
+        return p
+    old_f = p.faces
+    faces = np.empty(k, dtype=np.int32)
+    faces[0] = old_f[k - 1]
+    faces[1:] = old_f[k - 1 : 0 : -1]
+    bary = p.barycentric[::-1].copy()
+    old_of_new = np.arange(k - 1, -1, -1)
+    for j in range(k):
+        if faces[j] != old_f[old_of_new[j]]:
+            A, B, C = V[F[faces[j]]]
+            M = np.stack([B - A, C - A], axis=1)
+            lam, *_ = np.linalg.lstsq(M, pts[j] - A, rcond=None)
+            b = np.array([1.0 - lam[0] - lam[1], lam[0], lam[1]])
+            b = np.clip(b, 0.0, None)
+            bary[j] = b / b.sum()
+    return GeodesicPath(points=pts, faces=faces, barycentric=bary, length=p.length,
+                        weighted_length=p.weighted_length)
+
+
+def _has_surface_point(x: Any) -> bool:
+    """Whether a targets argument holds a SurfacePoint."""
+    if isinstance(x, SurfacePoint):
+        return True
+    if isinstance(x, (np.ndarray, str, bytes)) or not hasattr(x, "__iter__"):
+        return False
+    return any(isinstance(t, SurfacePoint) for t in x)
 
 
 def _free(ptr: Optional[int], solvers: List[int], exact: List[int]) -> None:

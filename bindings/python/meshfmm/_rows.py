@@ -29,7 +29,7 @@ class Request:
 
     def __init__(self, mesh: "Mesh", sources: Any, backend: Any, dtype: Any,
                  targets: Any) -> None:
-        nv = mesh.n_vertices
+        nv = mesh._nv  # the C mesh's (welded) count
         if sources is None:
             self.src: Optional[np.ndarray] = None
             self.n_rows = nv
@@ -74,7 +74,7 @@ def options(mesh: "Mesh", req: Request, out: np.ndarray, *, sparse: bool, cost: 
     _lib.mfmm_matrix_options_init(byref(opts))
     opts.backend = req.backend
     opts.dtype = req.c_dtype
-    c, loc = _args.cost_array(cost, cost_location, mesh.n_vertices, mesh.n_faces)
+    c, loc = _args.cost_array(cost, cost_location, mesh._nv, mesh._nf)
     # The library writes rows into `out` while it still reads the sources
     # and the cost: an input that shares memory with `out` (a view of it)
     # would be overwritten mid-job, so such inputs are copied first.

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any, Callable, List, Optional, Tuple
 
 import numpy as np
 
-from . import _rows
+from . import _extras, _rows
 from ._types import MatrixInfo
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -40,6 +40,7 @@ def sparse_matrix(mesh: "Mesh", req: _rows.Request, out: Optional[np.ndarray], *
     max_distance; no `out`, not symmetric). `options` are
     :func:`_rows.options`' keywords. Returns the matrix and the call's
     MatrixInfo."""
+    _extras.require("distance_matrix(sparse=True)", "sparse")
     if symmetric:
         raise ValueError("symmetric=True is for dense results")
     if out is not None:

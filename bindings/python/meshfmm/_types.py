@@ -8,7 +8,14 @@ from typing import NamedTuple, Sequence, Union
 
 import numpy as np
 
-__all__ = ["SurfacePoint", "MeshInfo", "GeodesicPath", "MatrixInfo", "SourceLike"]
+__all__ = ["SurfacePoint", "MeshInfo", "GeodesicPath", "MatrixInfo", "Isoline", "MeshWarning",
+           "SourceLike"]
+
+
+class MeshWarning(UserWarning):
+    """A mesh is accepted but likely not what was meant: coincident vertices
+    (texture seams, unmerged STL corners) cut its surface. The message
+    names the counts and ``Mesh(V, F, weld=True)``, which welds them."""
 
 
 class SurfacePoint(NamedTuple):
@@ -54,6 +61,10 @@ class MeshInfo:
     mean_edge_length: float  #: mean edge length
     bbox_diagonal: float  #: length of the bounding-box diagonal
     n_duplicate_faces: int  #: faces repeating another's vertices (copies; not walls)
+    #: referenced vertices at exactly another's position (seams): welding removes them
+    n_coincident_vertices: int = 0
+    #: components with coincident vertices welded (far below n_components: cut at seams)
+    n_welded_components: int = 0
 
     def as_dict(self) -> dict:
         """The fields as a plain ``dict``.
@@ -113,7 +124,8 @@ class MatrixInfo:
     reason : str
         Why ``backend="auto"`` ran threads instead of OpenCL (the OpenCL
         error, a CPU device, too few rows to keep the device busy, sparse
-        output); ``""`` when it did not fall back.
+        output; a CPU device left to the threads is the expected case);
+        ``""`` when the backend asked for ran.
     vertices_settled : int
         Vertices the marches settled, summed over the rows: the work done
         (0 from OpenCL, which does not count it).
@@ -127,3 +139,39 @@ class MatrixInfo:
     reason: str
     vertices_settled: int
     start_fallbacks: int
+
+
+@dataclasses.dataclass(frozen=True)
+class Isoline:
+    """One polyline of a level set, as returned by :meth:`Mesh.isolines`:
+    where the linear interpolant of a per-vertex field over the faces
+    equals ``value``.
+
+    ``faces[i]`` (i > 0) is the face the segment from point i-1 runs
+    through (``faces[0] == faces[1]``) and ``barycentric[i]`` the point's
+    coordinates in ``faces[i]``; every point lies on an edge. A closed
+    polyline repeats its first point at its end.
+
+    Attributes
+    ----------
+    value : float
+        The level.
+    points : numpy.ndarray, float64 (k, 3)
+        Positions.
+    faces : numpy.ndarray, int32 (k,)
+        Faces, as above.
+    barycentric : numpy.ndarray, float64 (k, 3)
+        Each point's coordinates in its face.
+    closed : bool
+        Whether the polyline is a loop (else it ends at a boundary, an
+        unreached face or a non-manifold edge).
+    """
+
+    value: float
+    points: np.ndarray
+    faces: np.ndarray
+    barycentric: np.ndarray
+    closed: bool
+
+    def __len__(self) -> int:
+        return int(self.faces.shape[0])

@@ -46,6 +46,12 @@ def cli_allpairs_zarr(argv: Sequence[str]) -> int:
     entries deleted); ``--overwrite`` is needed to write into a location
     that exists and is not a meshfmm store (its Zarr entries are replaced,
     other files kept). Errors are one line on stderr and exit status 2."""
+    a = zarr_parser().parse_args(list(argv))
+    return _run(a)
+
+
+def zarr_parser() -> argparse.ArgumentParser:
+    """The argument parser of ``meshfmm allpairs MESH -o OUT.zarr``."""
     ap = argparse.ArgumentParser(prog="meshfmm allpairs",
                                  description="All-pairs geodesic distances on a Dask cluster, "
                                              "written into a Zarr v3 array.")
@@ -82,7 +88,10 @@ def cli_allpairs_zarr(argv: Sequence[str]) -> int:
     ap.add_argument("--no-spokes", action="store_true",
                     help="memory first: no per-vertex update records on the workers "
                          "(~380 bytes per vertex each; same matrix, marches 1.25-1.6x as long)")
-    a = ap.parse_args(list(argv))
+    return ap
+
+
+def _run(a: argparse.Namespace) -> int:
     try:
         _store.refuse_inputs(a.output, [a.mesh, a.sources, a.targets, a.cost])
         mesh = Mesh(*load_mesh(a.mesh), spokes=not a.no_spokes)

@@ -52,7 +52,7 @@ from typing import Any, Callable, Dict, List, Optional, Tuple, Union
 import numpy as np
 
 from . import __version__
-from . import _args, _lib, _zarr_tasks
+from . import _args, _extras, _lib, _zarr_tasks
 from . import _zarr_store as _store
 from ._mesh import Mesh
 from ._zarr_store import JOB_ATTR, OWNER_ATTR, RUN_ATTR, StoreError, StoreOwnerError
@@ -373,7 +373,11 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
     ValueError, TypeError
         Bad arguments, checked before the store is touched (one row is
         computed with the job's options first).
+    ImportError
+        Zarr, Dask or Dask's distributed scheduler is not installed (the
+        ``[dask]`` extra), checked before anything is computed.
     """
+    _extras.require("meshfmm.distributed.distance_matrix", "dask")
     import zarr
     from zarr.codecs import BloscCodec, BloscShuffle, Crc32cCodec
 
@@ -615,7 +619,10 @@ def symmetrize(store: Any, out: Any, storage_options: Optional[dict] = None,
         empty without `overwrite`.
     ValueError
         The matrix is not square.
+    ImportError
+        Zarr or Dask is not installed (the ``[dask]`` extra).
     """
+    _extras.require("meshfmm.distributed.symmetrize", "dask")
     import dask.array as da
     import zarr
 
@@ -646,6 +653,11 @@ def symmetrize(store: Any, out: Any, storage_options: Optional[dict] = None,
 
 
 if __name__ == "__main__":  # pragma: no cover
+    try:
+        _extras.require("python -m meshfmm.distributed", "dask")
+    except ImportError as e:
+        sys.stderr.write(f"{e}\n")
+        sys.exit(2)
     from ._zarr_cli import cli_allpairs_zarr
 
     sys.exit(cli_allpairs_zarr(sys.argv[1:]))

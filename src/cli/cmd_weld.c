@@ -1,0 +1,187 @@
+/* meshfmm weld MESH -o OUT.obj [--map MAP.txt|.npy] */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+static void help(FILE *out)
+{
+    fprintf(out,
+            "usage: meshfmm weld MESH -o OUT.obj [--map MAP]\n\n"
+            "Welds the vertices of MESH that lie at exactly the same position (texture\n"
+            "seams, unmerged corners: `meshfmm info` counts them) into one and writes\n"
+            "the welded mesh as OBJ. Welded vertices are numbered by their first\n"
+            "occurrence, in input order (as Python's Mesh(V, F, weld=True)); faces keep\n"
+            "their order and corner order, and a face two of whose corners weld\n"
+            "together (zero area) is dropped. Prints the counts on standard error.\n\n"
+            "  -o, --output OUT.obj    the welded mesh (- for standard output)\n"
+            "  --map MAP               the welded id of each input vertex: .txt (one per\n"
+            "                          line) or .npy (int32), to carry ids across\n"
+            "  -h, --help              this text\n\n"
+            "Outputs are written to a temporary file beside them and renamed when\n"
+            "complete; they may not be the mesh.\n");
+}
+
+static uint64_t hash3(const double *p)
+{
+    uint64_t h = 1469598103934665603u;
+    for (int k = 0; k < 3; k++) {
+        double x = p[k] + 0.0; /* -0.0 as 0.0 */
+        uint64_t bits;
+        memcpy(&bits, &x, sizeof bits);
+        h = (h ^ bits) * 1099511628211u;
+        h ^= h >> 29;
+    }
+    return h;
+}
+
+/* map[v]: the welded id of input vertex v (first occurrence order); the
+ * count of welded vertices, or -1 when out of memory. */
+static int32_t weld_map(const double *V, int32_t nv, int32_t *map)
+{
+    size_t cap = 16;
+    while (cap < 2 * (size_t)nv)
+        cap *= 2;
+    int32_t *table = malloc(cap * sizeof *table);
+    if (!table)
+        return -1;
+    for (size_t i = 0; i < cap; i++)
+        table[i] = -1;
+    int32_t n = 0;
+    for (int32_t v = 0; v < nv; v++) {
+        const double *p = V + 3 * (size_t)v;
+        size_t i = (size_t)hash3(p) & (cap - 1);
+        for (;;) {
+            int32_t w = table[i];
+            if (w < 0) {
+                table[i] = v;
+                map[v] = n++;
+                break;
+            }
+            const double *q = V + 3 * (size_t)w;
+            if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) {
+                map[v] = map[w];
+                break;
+            }
+            i = (i + 1) & (cap - 1);
+        }
+    }
+    free(table);
+    return n;
+}
+
+static int write_map(const char *path, const int32_t *map, int32_t nv)
+{
+    if (cli_has_ext(path, "npy")) {
+        cli_npy_writer w;
+        if (cli_npy_open(&w, path, "<i4", nv, -1))
+            return -1;
+        if (cli_npy_append(&w, map, nv)) {
+            cli_npy_abort(&w);
+            return -1;
+        }
+        return cli_npy_close(&w);
+    }
+    cli_output out;
+    if (cli_output_open(&out, path))
+        return -1;
+    int bad = 0;
+    for (int32_t i = 0; i < nv && !bad; i++)
+        bad = fprintf(out.f, "%ld\n", (long)map[i]) < 0;
+    return cli_output_close(&out, bad);
+}
+
+int cmd_weld(int argc, char **argv)
+{
+    static const struct option longopts[] = {
+        {"help", no_argument, NULL, 'h'},
+        {"output", required_argument, NULL, 'o'},
+        {"map", required_argument, NULL, OPT_MAP},
+        {NULL, 0, NULL, 0}};
+    const char *mesh_path = NULL, *out_path = NULL, *map_path = NULL;
+    int c, rc;
+    opterr = 0;
+    uint32_t seen = 0;
+    while ((c = getopt_long(argc, argv, ":ho:", longopts, NULL)) != -1) {
+        if ((rc = cli_once("weld", c, &seen)) != CLI_OK)
+            return rc;
+        if (c == 'h') {
+            help(stdout);
+            return CLI_OK;
+        } else if (c == 'o') {
+            out_path = optarg;
+        } else if (c == OPT_MAP) {
+            map_path = optarg;
+        } else {
+            return cli_getopt_error("weld", c, argv);
+        }
+    }
+    for (int i = optind; i < argc; i++) {
+        if (mesh_path)
+            return cli_usage_error("weld", "one mesh at a time ('%s' is extra)", argv[i]);
+        mesh_path = argv[i];
+    }
+    if (!mesh_path)
+        return cli_usage_error("weld", "no mesh file given");
+    if (!out_path || (!cli_has_ext(out_path, "obj") && strcmp(out_path, "-") != 0))
+        return cli_usage_error("weld", "-o OUT.obj is required");
+    if (map_path && !cli_has_ext(map_path, "txt") && !cli_has_ext(map_path, "npy"))
+        return cli_usage_error("weld", "--map must end in .txt or .npy");
+    if (map_path && strcmp(map_path, "-") == 0)
+        return cli_usage_error("weld", "--map needs a file");
+    const char *inputs[1] = {mesh_path};
+    if ((rc = cli_check_output_not_input("weld", out_path, inputs, 1)) != CLI_OK ||
+        (map_path && (rc = cli_check_output_not_input("weld", map_path, inputs, 1)) != CLI_OK))
+        return rc;
+    cli_signals_install();
+
+    rc = CLI_FAIL;
+    double *V = NULL, *W = NULL;
+    int32_t *F = NULL, *map = NULL, nv = 0, nf = 0;
+    mfmm_error err;
+    if (mfmm_load_mesh(mesh_path, &V, &nv, &F, &nf, &err) != MFMM_OK) {
+        cli_error("%s", err.message);
+        goto done;
+    }
+    map = malloc((size_t)nv * sizeof *map);
+    W = malloc(3 * (size_t)nv * sizeof *W);
+    int32_t nw = map && W ? weld_map(V, nv, map) : -1;
+    if (nw < 0) {
+        cli_error("out of memory");
+        goto done;
+    }
+    for (int32_t v = 0; v < nv; v++)
+        memcpy(W + 3 * (size_t)map[v], V + 3 * (size_t)v, 3 * sizeof *W);
+    int32_t kept = 0;
+    for (int32_t f = 0; f < nf; f++) {
+        int32_t a = map[F[3 * f]], b = map[F[3 * f + 1]], d = map[F[3 * f + 2]];
+        if (a == b || b == d || a == d)
+            continue;
+        F[3 * kept] = a;
+        F[3 * kept + 1] = b;
+        F[3 * kept + 2] = d;
+        kept++;
+    }
+    char comment[160];
+    snprintf(comment, sizeof comment, "meshfmm weld: %ld vertices welded into %ld, %ld faces "
+             "(%ld dropped)", (long)nv, (long)nw, (long)kept, (long)(nf - kept));
+    if (cli_write_obj(out_path, W, nw, F, kept, comment))
+        goto done;
+    if (map_path && write_map(map_path, map, nv))
+        goto done;
+    fprintf(stderr, "meshfmm weld: %ld vertices, %ld once welded (%ld removed); %ld faces, "
+            "%ld dropped (zero area once welded)\n", (long)nv, (long)nw, (long)(nv - nw),
+            (long)nf, (long)(nf - kept));
+    rc = CLI_OK;
+done:
+    if (rc != CLI_OK && cli_interrupted()) {
+        fprintf(stderr, "meshfmm weld: interrupted; no output written\n");
+        rc = CLI_EXIT_INTERRUPTED;
+    }
+    mfmm_free(V);
+    mfmm_free(F);
+    free(W);
+    free(map);
+    return rc;
+}
