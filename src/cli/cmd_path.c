@@ -14,7 +14,7 @@ static void help(FILE *out)
             "usage: meshfmm path MESH --source I [--source J ...] [--face-source F W0 W1 W2 ...]\n"
             "                    (--target J | --target-face F W0 W1 W2)\n"
             "                    [--cost FILE [--cost-per-face]] [--max-points N] [--no-straighten]\n"
-            "                    [--exact-start-radius R | --plain-start]\n"
+            "                    [--exact-start-radius R | --plain-start] [--weld]\n"
             "                    -o OUT\n\n"
             "The minimal geodesic from the target back to the nearest source: distances by\n"
             "Fast Marching, then backtracking along -grad T (Heun's method). Prints the\n"
@@ -29,6 +29,7 @@ static void help(FILE *out)
             CLI_START_HELP_NO_LIMIT
             "  --no-straighten         keep the traced path of section 5 (by default it is\n"
             "                          straightened inside the strip of faces it crossed)\n"
+            CLI_WELD_HELP
             "  -o, --output OUT        .csv (face,b0,b1,b2,x,y,z per point, with a header) or\n"
             "                          .obj (v lines and one polyline 'l' element); - writes\n"
             "                          the .csv to standard output (the length then goes to\n"
@@ -87,8 +88,7 @@ int cmd_path(int argc, char **argv)
     cli_sources_and_cost o;
     double *dist = NULL;
     mfmm_surface_point *pts = NULL;
-    mfmm_mesh *mesh = NULL;
-    uint8_t *in_no_face = NULL;
+    cli_mesh m = {0};
     if (cli_sources_and_cost_init(&o, "path", help, argc))
         return CLI_FAIL;
     int c;
@@ -141,20 +141,19 @@ int cmd_path(int argc, char **argv)
     rc = CLI_FAIL;
     cli_signals_install();
 
-    mesh = cli_load_mesh(o.mesh_path, NULL, &in_no_face);
     mfmm_solve_options opt;
     mfmm_solve_options_init(&opt);
-    if (!mesh || cli_sources_and_cost_load(&o, mesh, 0, &opt))
+    if (cli_sources_and_cost_load(&o, &m, 1, 0, &opt) || cli_mesh_point(&m, "target", &target))
         goto done;
     pts = malloc((size_t)max_points * sizeof *pts);
     if (!pts) {
         cli_error("out of memory");
         goto done;
     }
-    dist = cli_solve_distances(mesh, &o, &opt);
+    dist = cli_solve_distances(m.mesh, &o, &opt);
     if (!dist)
         goto done;
-    cli_sources_and_cost_note_in_no_face(&o, in_no_face);
+    cli_sources_and_cost_note_in_no_face(&o, &m);
     mfmm_path_options po;
     mfmm_path_options_init(&po);
     double wlen = 0.0, len = 0.0;
@@ -167,10 +166,13 @@ int cmd_path(int argc, char **argv)
     po.cost = opt.cost;
     po.cost_location = opt.cost_location;
     po.weighted_length = &wlen;
-    if (mfmm_trace_path(mesh, dist, &target, &po, pts, max_points, &n, &len, &err) != MFMM_OK) {
+    if (mfmm_trace_path(m.mesh, dist, &target, &po, pts, max_points, &n, &len, &err) !=
+        MFMM_OK) {
         cli_error("%s", err.message);
         goto done;
     }
+    for (int32_t i = 0; i < n; i++)
+        pts[i].face = cli_mesh_input_face(&m, pts[i].face);
     if (cli_interrupted() || write_path(o.out_path, pts, n, obj))
         goto done;
     /* The length goes to stdout, or to stderr when stdout holds the path. */
@@ -192,9 +194,8 @@ done:
         fprintf(stderr, "meshfmm path: interrupted; no output written\n");
         rc = CLI_EXIT_INTERRUPTED;
     }
-    mfmm_mesh_destroy(mesh);
+    cli_mesh_free(&m);
     free(pts);
-    free(in_no_face);
     free(dist);
     cli_sources_and_cost_free(&o);
     return rc;

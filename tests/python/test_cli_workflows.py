@@ -1,0 +1,166 @@
+"""The workflow commands against the Python API and the unsplit mesh:
+--weld on distance, allpairs and landmarks (a mesh split at a seam gives the
+unsplit mesh's values, in the split file's ids)."""
+
+from __future__ import annotations
+
+import io
+import os
+import subprocess
+import sys
+import warnings
+
+import numpy as np
+import pytest
+
+import meshfmm
+from conftest import MESHES, load, mesh
+from meshfmm import SurfacePoint
+from test_api import grid
+from test_workflows import split_at_x
+
+
+def _cli():
+    from test_cli import find_cli
+
+    path = find_cli()
+    if path is None:
+        pytest.skip("no meshfmm command line found (set MESHFMM_CLI or build with CMake)")
+    return path
+
+
+def run(*args, ok=True):
+    p = subprocess.run([str(a) for a in args], capture_output=True, text=True, timeout=300)
+    if ok:
+        assert p.returncode == 0, p.stderr
+    return p
+
+
+def py(*args, ok=True):
+    return run(sys.executable, "-m", "meshfmm", *args, ok=ok)
+
+
+def write_off(path, V, F):
+    with open(path, "w") as f:
+        f.write(f"OFF\n{V.shape[0]} {F.shape[0]} 0\n")
+        np.savetxt(f, V, fmt="%.17g")
+        np.savetxt(f, np.hstack([np.full((F.shape[0], 1), 3), F]), fmt="%d")
+
+
+def plain(V, F):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", meshfmm.MeshWarning)
+        return meshfmm.Mesh(V, F)
+
+
+def read_path_csv(text):
+    a = np.loadtxt(io.StringIO(text), delimiter=",", skiprows=1, ndmin=2)
+    return a[:, 0].astype(np.int64), a[:, 1:4], a[:, 4:7]
+
+
+@pytest.fixture(scope="module")
+def spot_split(tmp_path_factory):
+    """spot.obj cut at x = 0 (the copies of the cut's vertices appended),
+    written as OFF: welded, it is spot again, numbered as spot."""
+    V, F = load("spot.obj")
+    V2, F2, orig = split_at_x(V, F)
+    off = tmp_path_factory.mktemp("split") / "split.off"
+    write_off(off, V2, F2)
+    return V, F, V2, F2, orig, off
+
+
+@pytest.fixture(scope="module")
+def grid_split(tmp_path_factory):
+    V, F = grid(10)
+    V2, F2, orig = split_at_x(V, F, 0.45)
+    off = tmp_path_factory.mktemp("gsplit") / "grid.off"
+    write_off(off, V2, F2)
+    return V, F, V2, F2, orig, off
+
+
+# ------------------------------------------------------------------ --weld
+def test_distance_weld_gives_the_unsplit_values(spot_split, tmp_path):
+    cli = _cli()
+    V, F, V2, F2, orig, off = spot_split
+    base = mesh("spot.obj")
+    copy = V.shape[0] + 3              # a copy of vertex orig[copy]
+    s = int(orig[copy])
+    out = tmp_path / "d.npy"
+    # unwelded, the cut is a wall: the other side is unreached
+    run(cli, "distance", off, "--source", copy, "-o", out)
+    assert np.isinf(np.load(out)).any()
+    run(cli, "distance", off, "--weld", "--source", copy, "-o", out)
+    d = np.load(out)
+    assert d.shape == (V2.shape[0],) and np.array_equal(d, base.distance(s)[orig])
+    # the same from the Python package's weld=True
+    assert np.array_equal(d, meshfmm.Mesh(V2, F2, weld=True).distance(copy))
+    # exact, a face source (the file's face ids), a per-vertex cost of the file's size
+    run(cli, "distance", off, "--weld", "--source", copy, "--exact", "-o", out)
+    assert np.array_equal(np.load(out), base.distance(s, method="exact")[orig])
+    fs = SurfacePoint(4000, (0.2, 0.3, 0.5))
+    run(cli, "distance", off, "--weld", "--face-source", 4000, 0.2, 0.3, 0.5, "-o", out)
+    assert np.array_equal(np.load(out), base.distance(fs)[orig])
+    cost = np.linspace(1, 2, V2.shape[0])
+    np.save(tmp_path / "cost.npy", cost)
+    run(cli, "distance", off, "--weld", "--source", copy, "--cost", tmp_path / "cost.npy",
+        "-o", out)
+    assert np.array_equal(np.load(out), base.distance(s, cost[:V.shape[0]])[orig])
+    fcost = np.linspace(1, 3, F2.shape[0])
+    np.savetxt(tmp_path / "fcost.txt", fcost)
+    run(cli, "distance", off, "--weld", "--source", copy, "--cost", tmp_path / "fcost.txt",
+        "--cost-per-face", "-o", out)
+    assert np.array_equal(np.load(out), base.distance(s, fcost, cost_location="face")[orig])
+    # ids are the file's: its last vertex is in range, one past it is not
+    p = run(cli, "distance", off, "--weld", "--source", V2.shape[0], "-o", out, ok=False)
+    assert p.returncode == 1 and f"outside [0, {V2.shape[0]})" in p.stderr
+
+
+def test_allpairs_weld_gives_the_unsplit_matrix(grid_split, tmp_path):
+    """Every row and column in the file's ids, dense and sparse, with
+    --sources and --targets in the file's ids too."""
+    cli = _cli()
+    V, F, V2, F2, orig, off = grid_split
+    base = meshfmm.Mesh(V, F)
+    n2 = V2.shape[0]
+    assert n2 > V.shape[0]
+    full = base.distance_matrix(backend="serial", dtype="float64")
+    out = tmp_path / "D.npy"
+    run(cli, "allpairs", off, "--weld", "--dtype", "float64", "--backend", "serial", "-o", out,
+        "--quiet")
+    D = np.load(out)
+    assert D.shape == (n2, n2) and np.array_equal(D, full[np.ix_(orig, orig)])
+    run(cli, "allpairs", off, "--weld", "--backend", "threads", "-o", out, "--quiet")
+    assert np.array_equal(np.load(out), full.astype(np.float32)[np.ix_(orig, orig)])
+    src, tgt = tmp_path / "s.txt", tmp_path / "t.npy"
+    rows, cols = [n2 - 1, 0, 17], [n2 - 2, 3, n2 - 1, 3]
+    src.write_text(" ".join(map(str, rows)))
+    np.save(tgt, np.array(cols, dtype=np.int32))
+    run(cli, "allpairs", off, "--weld", "--dtype", "float64", "--sources", src, "--targets",
+        tgt, "-o", out, "--quiet")
+    assert np.array_equal(np.load(out), full[np.ix_(orig[rows], orig[cols])])
+    scipy_sparse = pytest.importorskip("scipy.sparse")
+    r = 0.3
+    npz = tmp_path / "S.npz"
+    run(cli, "allpairs", off, "--weld", "--dtype", "float64", "--max-distance", r, "-o", npz,
+        "--quiet")
+    S = scipy_sparse.load_npz(npz)
+    assert S.shape == (n2, n2) and S.has_sorted_indices
+    want = full[np.ix_(orig, orig)]
+    assert np.array_equal(S.toarray()[want <= r], want[want <= r])
+    within = want <= r
+    assert S.nnz == within.sum()
+    # an unwelded allpairs of the split file differs (the cut is a wall)
+    run(cli, "allpairs", off, "--dtype", "float64", "-o", out, "--quiet")
+    assert np.isinf(np.load(out)).any()
+
+
+def test_landmarks_weld(spot_split, tmp_path):
+    cli = _cli()
+    V, F, V2, F2, orig, off = spot_split
+    base = mesh("spot.obj")
+    copy = V.shape[0] + 3
+    out = tmp_path / "L.txt"
+    p = run(cli, "landmarks", off, "--weld", "-k", 12, "--start", copy, "-o", out)
+    want, dist = base.farthest_point_sampling(12, int(orig[copy]), return_distances=True)
+    assert np.array_equal(np.loadtxt(out, dtype=np.int64), want)  # the lowest file ids
+    assert f"within {dist.max():.6g}" in p.stderr and "unreached" not in p.stderr
