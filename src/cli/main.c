@@ -16,7 +16,7 @@ static const cli_command commands[] = {
     {"distance", cmd_distance, "geodesic distances from sources to every vertex"},
     {"generate", cmd_generate, "write a generated mesh (sine, sphere, torus, grid, lattice)"},
     {"allpairs", cmd_allpairs, "the distance matrix of many sources, streamed into a .npy file"},
-    {"path", cmd_path, "the minimal geodesic from a target to the sources (.csv or .obj)"},
+    {"path", cmd_path, "the minimal geodesic from the nearest source to a target"},
     {"landmarks", cmd_landmarks, "geodesic farthest-point sampling: K well-spread vertex ids"},
     {"weld", cmd_weld, "weld vertices at the same position (seams) and write the mesh"},
 };

@@ -1,6 +1,7 @@
 """The workflow commands against the Python API and the unsplit mesh:
---weld on distance, allpairs and landmarks (a mesh split at a seam gives the
-unsplit mesh's values, in the split file's ids)."""
+--weld on distance, path, allpairs and landmarks (a mesh split at a seam
+gives the unsplit mesh's values, in the split file's ids), and paths
+written from the source as Mesh.path writes them."""
 
 from __future__ import annotations
 
@@ -115,6 +116,27 @@ def test_distance_weld_gives_the_unsplit_values(spot_split, tmp_path):
     assert p.returncode == 1 and f"outside [0, {V2.shape[0]})" in p.stderr
 
 
+def test_path_weld_gives_the_unsplit_path(spot_split, tmp_path):
+    cli = _cli()
+    V, F, V2, F2, orig, off = spot_split
+    base = mesh("spot.obj")
+    copy, t = V.shape[0] + 3, V.shape[0] + 40
+    p = run(cli, "path", off, "--weld", "--source", copy, "--target", t, "-o", "-")
+    faces, bary, xyz = read_path_csv(p.stdout)
+    want = base.path(int(orig[copy]), int(orig[t]))
+    assert np.array_equal(xyz, want.points) and np.array_equal(faces, want.faces)
+    assert np.allclose(bary, want.barycentric, rtol=0, atol=1e-12)
+    assert float(p.stderr.split()[0]) == pytest.approx(want.length, rel=1e-15)
+    # the split mesh unwelded: the target is beyond the cut
+    far = int(np.flatnonzero(np.isinf(plain(V2, F2).distance(copy)))[0])
+    p = run(cli, "path", off, "--source", copy, "--target", far, "-o", tmp_path / "p.csv",
+            ok=False)
+    assert p.returncode == 1 and "reached" in p.stderr
+    p = run(cli, "path", off, "--weld", "--source", copy, "--target", far, "-o", "-")
+    assert np.array_equal(read_path_csv(p.stdout)[2],
+                          base.path(int(orig[copy]), int(orig[far])).points)
+
+
 def test_allpairs_weld_gives_the_unsplit_matrix(grid_split, tmp_path):
     """Every row and column in the file's ids, dense and sparse, with
     --sources and --targets in the file's ids too."""
@@ -164,3 +186,47 @@ def test_landmarks_weld(spot_split, tmp_path):
     want, dist = base.farthest_point_sampling(12, int(orig[copy]), return_distances=True)
     assert np.array_equal(np.loadtxt(out, dtype=np.int64), want)  # the lowest file ids
     assert f"within {dist.max():.6g}" in p.stderr and "unreached" not in p.stderr
+
+
+# ------------------------------------------------------------------- path
+@pytest.mark.parametrize("source,target", [
+    ((77,), (1500,)),
+    (("face", 100, 0.3, 0.3, 0.4), ("face", 2000, 0.6, 0.2, 0.2)),
+    ((55,), ("face", 4000, 0.1, 0.1, 0.8)),
+])
+def test_path_runs_from_the_source_to_the_target(source, target, tmp_path):
+    """`meshfmm path` writes Python's Mesh.path(source, target): the
+    reversed two-call path, source first."""
+    cli = _cli()
+    m = mesh("spot.obj")
+
+    def point(x):
+        return x[0] if len(x) == 1 else SurfacePoint(x[1], x[2:])
+
+    def args(x, kind):
+        if len(x) == 1:
+            return [f"--{kind}", x[0]]
+        return [f"--{kind}-face" if kind == "target" else "--face-source", *x[1:]]
+
+    cmd = [cli, "path", MESHES / "spot.obj", *args(source, "source"), *args(target, "target")]
+    p = run(*cmd, "-o", "-")
+    faces, bary, xyz = read_path_csv(p.stdout)
+    want = m.path(point(source), point(target))
+    back = m.geodesic_path(m.distance(point(source)), point(target), sources=[point(source)])
+    assert np.array_equal(xyz, want.points) and np.array_equal(xyz, back.points[::-1])
+    assert np.array_equal(faces, want.faces)
+    assert np.allclose(bary, want.barycentric, rtol=0, atol=1e-12)
+    # every point in its face where its coordinates say
+    FV = m.vertices[m.faces[faces]]
+    assert np.allclose(np.einsum("ij,ijk->ik", bary, FV), xyz, rtol=0, atol=1e-12)
+    if len(source) == 1:
+        assert np.array_equal(xyz[0], m.vertices[source[0]])
+    if len(target) == 1:
+        assert np.array_equal(xyz[-1], m.vertices[target[0]])
+    obj = tmp_path / "p.obj"
+    run(*cmd, "-o", obj)
+    text = obj.read_text()
+    assert "source first" in text
+    v = np.array([[float(x) for x in ln.split()[1:]] for ln in text.splitlines()
+                  if ln.startswith("v ")])
+    assert np.array_equal(v, want.points)
