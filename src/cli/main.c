@@ -18,6 +18,7 @@ static const cli_command commands[] = {
     {"allpairs", cmd_allpairs, "the distance matrix of many sources, streamed into a .npy file"},
     {"path", cmd_path, "the minimal geodesic from the nearest source to a target"},
     {"landmarks", cmd_landmarks, "geodesic farthest-point sampling: K well-spread vertex ids"},
+    {"voronoi", cmd_voronoi, "geodesic Voronoi labels: which source each vertex is nearest"},
     {"weld", cmd_weld, "weld vertices at the same position (seams) and write the mesh"},
 };
 

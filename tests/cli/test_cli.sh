@@ -40,7 +40,7 @@ value() { awk -F: -v k="$1" '$1 == k { gsub(/ /, "", $2); print $2 }' "$2"; }
 expect 0 "--version" "$BIN" --version && grep -q '^meshfmm [0-9]*\.[0-9]*\.[0-9]*$' "$T/out" ||
     fail "--version output: $(cat "$T/out")"
 expect 0 "--help" "$BIN" --help
-for c in info distance generate path allpairs landmarks weld; do
+for c in info distance generate path allpairs landmarks voronoi weld; do
     expect 0 "$c --help" "$BIN" "$c" --help && grep -q "usage: meshfmm $c" "$T/out" ||
         fail "$c --help text"
 done
@@ -52,6 +52,9 @@ expect 2 "distance without a source" "$BIN" distance "$DATA/meshes/hand_lowres.o
 expect 2 "distance without -o" "$BIN" distance "$DATA/meshes/hand_lowres.obj" --source 0
 expect 2 "distance bad output extension" "$BIN" distance "$DATA/meshes/hand_lowres.obj" --source 0 -o "$T/d.csv"
 expect 2 "distance bad source number" "$BIN" distance "$DATA/meshes/hand_lowres.obj" --source 1x -o "$T/d.txt"
+expect 2 "voronoi without a source" "$BIN" voronoi "$DATA/meshes/hand_lowres.obj" -o "$T/l.npy"
+expect 2 "voronoi --distances with a bad extension" "$BIN" voronoi "$DATA/meshes/hand_lowres.obj" --source 0 --distances "$T/d.csv" -o "$T/l.npy"
+expect 2 "voronoi --distances twice" "$BIN" voronoi "$DATA/meshes/hand_lowres.obj" --source 0 --distances "$T/d.npy" --distances "$T/e.npy" -o "$T/l.npy"
 expect 1 "distance --weld source out of range" "$BIN" distance "$DATA/meshes/hand_lowres.obj" --weld --source 810 -o "$T/d.txt" &&
     grep -q "vertex 810 is outside \\[0, 810)" "$T/err" || fail "--weld range message: $(cat "$T/err")"
 expect 2 "generate unknown shape" "$BIN" generate cube 3 -o "$T/c.obj"

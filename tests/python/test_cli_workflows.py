@@ -1,7 +1,8 @@
 """The workflow commands against the Python API and the unsplit mesh:
---weld on distance, path, allpairs and landmarks (a mesh split at a seam
-gives the unsplit mesh's values, in the split file's ids), and paths
-written from the source as Mesh.path writes them."""
+--weld on distance, path, allpairs, landmarks and voronoi (a mesh split at
+a seam gives the unsplit mesh's values, in the split file's ids), paths
+written from the source, and `meshfmm voronoi` against the argmin over
+single-source fields."""
 
 from __future__ import annotations
 
@@ -188,6 +189,16 @@ def test_landmarks_weld(spot_split, tmp_path):
     assert f"within {dist.max():.6g}" in p.stderr and "unreached" not in p.stderr
 
 
+def test_voronoi_weld(spot_split, tmp_path):
+    cli = _cli()
+    V, F, V2, F2, orig, off = spot_split
+    base = mesh("spot.obj")
+    copy = V.shape[0] + 3
+    lab = tmp_path / "lab.npy"
+    run(cli, "voronoi", off, "--weld", "--source", copy, "--source", 1500, "-o", lab)
+    assert np.array_equal(np.load(lab), base.voronoi_labels([int(orig[copy]), 1500])[orig])
+
+
 # ------------------------------------------------------------------- path
 @pytest.mark.parametrize("source,target", [
     ((77,), (1500,)),
@@ -230,3 +241,41 @@ def test_path_runs_from_the_source_to_the_target(source, target, tmp_path):
     v = np.array([[float(x) for x in ln.split()[1:]] for ln in text.splitlines()
                   if ln.startswith("v ")])
     assert np.array_equal(v, want.points)
+
+
+# ---------------------------------------------------------------- voronoi
+def test_voronoi_command_equals_the_argmin_of_single_fields(tmp_path):
+    """Labels from landmarks (--sources FILE, the output of `meshfmm
+    landmarks`): Python's voronoi_labels exactly, the argmin over the
+    single-source fields but within an edge of a cell's border."""
+    cli = _cli()
+    m = mesh("spot.obj")
+    L = tmp_path / "L.txt"
+    run(cli, "landmarks", MESHES / "spot.obj", "-k", 8, "-o", L)
+    ids = np.loadtxt(L, dtype=np.int64)
+    lab, dist = tmp_path / "lab.npy", tmp_path / "d.npy"
+    p = run(cli, "voronoi", MESHES / "spot.obj", "--sources", L, "--distances", dist, "-o", lab)
+    labels = np.load(lab)
+    assert labels.dtype == np.int32 and labels.shape == (m.n_vertices,)
+    assert np.array_equal(labels, m.voronoi_labels(ids.tolist()))
+    assert np.array_equal(np.load(dist), m.distance(ids.tolist()))
+    assert f"{m.n_vertices} vertices in 8 cells of 8 sources" in p.stderr
+    fields = np.stack([m.distance(int(s)) for s in ids])
+    best = np.argmin(fields, axis=0)
+    srt = np.sort(fields, axis=0)
+    wrong = labels != best
+    assert wrong.sum() <= 0.01 * m.n_vertices
+    assert np.all(srt[1][wrong] - srt[0][wrong] < m.info.mean_edge_length)
+    assert np.array_equal(labels[ids], np.arange(8))
+    # --source before --sources in the numbering; text output; a radius
+    txt = tmp_path / "lab.txt"
+    run(cli, "voronoi", MESHES / "spot.obj", "--source", 5, "--sources", L, "--max-distance",
+        0.2, "--exact-start-radius", 0, "-o", txt)
+    got = np.loadtxt(txt, dtype=np.int64)
+    d = m.distance([5, *ids.tolist()], max_distance=0.2, exact_start=0)
+    assert np.array_equal(got == -1, np.isinf(d)) and (got == -1).any()
+    assert np.array_equal(got, m.voronoi_labels([5, *ids.tolist()], d))
+    # exact distances
+    run(cli, "voronoi", MESHES / "spot.obj", "--source", 0, "--source", 2000, "--exact",
+        "-o", lab)
+    assert np.array_equal(np.load(lab), m.voronoi_labels([0, 2000], method="exact"))
