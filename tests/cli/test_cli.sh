@@ -46,17 +46,25 @@ for c in info distance generate path allpairs landmarks voronoi weld; do
 done
 expect 2 "no command" "$BIN"
 expect 2 "unknown command" "$BIN" frobnicate
+# the Python package's commands: listed, and named when given here
+"$BIN" --help | grep -q '^  render ' && "$BIN" --help | grep -q '^  isolines ' &&
+    "$BIN" --help | grep -q 'python -m meshfmm' && ok "--help lists the python commands" ||
+    fail "--help lacks the python commands"
+for c in render isolines; do
+    expect 2 "$c (a python command)" "$BIN" "$c" x.obj -o x.png &&
+        grep -q "python -m meshfmm $c" "$T/err" || fail "$c: no pointer to python -m meshfmm"
+done
+expect 2 "voronoi without a source" "$BIN" voronoi "$DATA/meshes/hand_lowres.obj" -o "$T/l.npy"
+expect 2 "voronoi --distances with a bad extension" "$BIN" voronoi "$DATA/meshes/hand_lowres.obj" --source 0 --distances "$T/d.csv" -o "$T/l.npy"
+expect 2 "voronoi --distances twice" "$BIN" voronoi "$DATA/meshes/hand_lowres.obj" --source 0 --distances "$T/d.npy" --distances "$T/e.npy" -o "$T/l.npy"
+expect 1 "distance --weld source out of range" "$BIN" distance "$DATA/meshes/hand_lowres.obj" --weld --source 810 -o "$T/d.txt" &&
+    grep -q "vertex 810 is outside \[0, 810)" "$T/err" || fail "--weld range message: $(cat "$T/err")"
 expect 2 "info without a mesh" "$BIN" info
 expect 2 "info unknown option" "$BIN" info --bogus x.obj
 expect 2 "distance without a source" "$BIN" distance "$DATA/meshes/hand_lowres.obj" -o "$T/d.txt"
 expect 2 "distance without -o" "$BIN" distance "$DATA/meshes/hand_lowres.obj" --source 0
 expect 2 "distance bad output extension" "$BIN" distance "$DATA/meshes/hand_lowres.obj" --source 0 -o "$T/d.csv"
 expect 2 "distance bad source number" "$BIN" distance "$DATA/meshes/hand_lowres.obj" --source 1x -o "$T/d.txt"
-expect 2 "voronoi without a source" "$BIN" voronoi "$DATA/meshes/hand_lowres.obj" -o "$T/l.npy"
-expect 2 "voronoi --distances with a bad extension" "$BIN" voronoi "$DATA/meshes/hand_lowres.obj" --source 0 --distances "$T/d.csv" -o "$T/l.npy"
-expect 2 "voronoi --distances twice" "$BIN" voronoi "$DATA/meshes/hand_lowres.obj" --source 0 --distances "$T/d.npy" --distances "$T/e.npy" -o "$T/l.npy"
-expect 1 "distance --weld source out of range" "$BIN" distance "$DATA/meshes/hand_lowres.obj" --weld --source 810 -o "$T/d.txt" &&
-    grep -q "vertex 810 is outside \\[0, 810)" "$T/err" || fail "--weld range message: $(cat "$T/err")"
 expect 2 "generate unknown shape" "$BIN" generate cube 3 -o "$T/c.obj"
 expect 2 "generate bad N" "$BIN" generate grid 0 -o "$T/c.obj"
 

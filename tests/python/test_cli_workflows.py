@@ -1,8 +1,9 @@
 """The workflow commands against the Python API and the unsplit mesh:
 --weld on distance, path, allpairs, landmarks and voronoi (a mesh split at
 a seam gives the unsplit mesh's values, in the split file's ids), paths
-written from the source, and `meshfmm voronoi` against the argmin over
-single-source fields."""
+written from the source, `meshfmm voronoi` against the argmin over
+single-source fields, `meshfmm isolines` against the linear interpolant,
+and the C and Python helps listing the same commands."""
 
 from __future__ import annotations
 
@@ -279,3 +280,133 @@ def test_voronoi_command_equals_the_argmin_of_single_fields(tmp_path):
     run(cli, "voronoi", MESHES / "spot.obj", "--source", 0, "--source", 2000, "--exact",
         "-o", lab)
     assert np.array_equal(np.load(lab), m.voronoi_labels([0, 2000], method="exact"))
+
+
+# --------------------------------------------------------------- isolines
+def parse_obj_polylines(text):
+    """{object name: [polyline as (k, 3) points]} of an OBJ of v/l records."""
+    verts, objects, name = [], {}, None
+    for ln in text.splitlines():
+        if ln.startswith("o "):
+            name = ln.split()[1]
+            objects[name] = []
+        elif ln.startswith("v "):
+            verts.append([float(x) for x in ln.split()[1:]])
+        elif ln.startswith("l "):
+            ids = [int(x) - 1 for x in ln.split()[1:]]
+            objects[name].append(np.array(verts)[ids])
+    return objects
+
+
+def test_isolines_command_writes_mesh_isolines(tmp_path):
+    m = mesh("spot.obj")
+    d = m.distance([0, 1700])
+    values = [0.1, 0.35, 0.6]
+    lines = m.isolines(d, values)
+    out = tmp_path / "iso.obj"
+    p = py("isolines", MESHES / "spot.obj", "--source", 0, "--source", 1700, "--values",
+           "0.1,0.35,0.6", "-o", out)
+    n = sum(len(x) for x in lines)
+    assert f"({n} polylines at 3 values)" in p.stdout
+    objs = parse_obj_polylines(out.read_text())
+    assert list(objs) == ["isoline_0", "isoline_1", "isoline_2"]
+    for j, want in enumerate(lines):
+        got = objs[f"isoline_{j}"]
+        assert len(got) == len(want) > 0
+        for g, w in zip(got, want):
+            assert np.array_equal(g, w.points)  # a closed line ends at its first vertex
+    # CSV: every point where the linear interpolant over its face is the value
+    csv = tmp_path / "iso.csv"
+    py("isolines", MESHES / "spot.obj", "--source", 0, "--source", 1700, "--values",
+       "0.1,0.35,0.6", "-o", csv)
+    a = np.loadtxt(csv, delimiter=",", skiprows=1)
+    faces = a[:, 3].astype(np.int64)
+    interp = (a[:, 4:7] * d[m.faces[faces]]).sum(axis=1)
+    assert np.allclose(interp, a[:, 0], rtol=0, atol=1e-12)
+    xyz = np.einsum("ij,ijk->ik", a[:, 4:7], m.vertices[m.faces[faces]])
+    assert np.allclose(xyz, a[:, 7:10], rtol=0, atol=1e-12)
+    assert a.shape[0] == sum(len(ln) for x in lines for ln in x)
+    # a field from a file: the same lines
+    np.save(tmp_path / "d.npy", d)
+    py("isolines", MESHES / "spot.obj", "--field", tmp_path / "d.npy", "--values",
+       "0.1,0.35,0.6", "-o", tmp_path / "f.csv")
+    assert (tmp_path / "f.csv").read_text() == csv.read_text()
+
+
+def test_isolines_command_weld_and_errors(spot_split, tmp_path):
+    V, F, V2, F2, orig, off = spot_split
+    base = mesh("spot.obj")
+    copy = V.shape[0] + 3
+    want = base.isolines(base.distance(int(orig[copy])), [0.3])[0]
+    csv = tmp_path / "w.csv"
+    py("isolines", off, "--weld", "--source", copy, "--values", "0.3", "-o", csv)
+    a = np.loadtxt(csv, delimiter=",", skiprows=1)
+    assert np.array_equal(a[:, 7:10], np.concatenate([ln.points for ln in want]))
+    assert np.array_equal(a[:, 3], np.concatenate([ln.faces for ln in want]))
+    p = py("isolines", off, "--source", copy, "--values", "0.3", "-o", csv)
+    assert "coincident vertices" in p.stderr and "--weld" in p.stderr
+    for args, words in [
+        ([MESHES / "spot.obj", "--values", "0.3", "-o", tmp_path / "x.obj"], "no source"),
+        ([MESHES / "spot.obj", "--source", 0, "--values", "a", "-o", tmp_path / "x.obj"],
+         "--values"),
+        ([MESHES / "spot.obj", "--source", 0, "--values", "1", "-o", tmp_path / "x.png"],
+         ".obj or .csv"),
+        ([tmp_path / "missing.obj", "--source", 0, "--values", "1", "-o", tmp_path / "x.obj"],
+         "missing.obj"),
+        ([MESHES / "spot.obj", "--source", 99999, "--values", "1", "-o", tmp_path / "x.obj"],
+         "99999"),
+    ]:
+        p = py("isolines", *args, ok=False)
+        assert p.returncode == 2 and p.stderr.startswith("meshfmm isolines: "), p.stderr
+        assert words in p.stderr and p.stderr.count("\n") == 1
+    assert not (tmp_path / "x.obj").exists()
+    p = py("isolines", "--help")
+    for option in ("--output", "--values", "--source", "--sources", "--field", "--method",
+                   "--max-distance", "--cost", "--cost-per-face", "--weld"):
+        assert option in p.stdout, option
+
+
+# ----------------------------------------------------------------- helps
+def test_c_and_python_helps_list_the_same_commands():
+    """The C command's --help lists the Python package's commands with the
+    lines the package gives them; each runs through python -m meshfmm, and
+    the C command points there; the docs page gets a section for each."""
+    from meshfmm.__main__ import PYTHON_COMMANDS
+
+    cli = _cli()
+    top = run(cli, "--help").stdout
+    section = top[top.index("python commands"):]
+    for name, line in PYTHON_COMMANDS.items():
+        assert f"  {name:<10} {line}\n" in section
+        assert py(name, "--help").stdout.startswith(f"usage: meshfmm {name}")
+        p = run(cli, name, "x", ok=False)
+        assert p.returncode == 2 and f"python -m meshfmm {name}" in p.stderr
+    assert "python -m meshfmm" in top
+    import importlib.util
+
+    from conftest import REPO
+
+    spec = importlib.util.spec_from_file_location("docs_cli_hook",
+                                                  REPO / "docs" / "hooks" / "cli.py")
+    hook = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(hook)
+    assert hook._commands(top, "python commands") == list(PYTHON_COMMANDS)
+    c_commands = hook._commands(top)
+    assert "voronoi" in c_commands and not set(c_commands) & set(PYTHON_COMMANDS)
+    # the pip-installed command runs the C help: the same text
+    assert py("--help").stdout == top
+
+
+def test_python_help_without_the_binary_lists_its_commands(tmp_path):
+    from meshfmm.__main__ import PYTHON_COMMANDS
+
+    env = {k: v for k, v in os.environ.items() if k != "MESHFMM_CLI"}
+    probe = subprocess.run([sys.executable, "-c", "from meshfmm.__main__ import cli_path; "
+                            "print(cli_path())"], capture_output=True, text=True, env=env)
+    if probe.stdout.strip() != "None":
+        pytest.skip("the package holds its own binary")
+    p = subprocess.run([sys.executable, "-m", "meshfmm", "--help"], capture_output=True,
+                       text=True, env=env)
+    assert p.returncode == 0
+    for name in PYTHON_COMMANDS:
+        assert f"  {name} " in p.stdout
