@@ -2,9 +2,10 @@
 
 Runs the built command line (``$MESHFMM_CLI``, else ``build/meshfmm``):
 ``meshfmm --help``, then ``meshfmm COMMAND --help`` for every command that
-help lists, ``python -m meshfmm.distributed --help`` (the Dask + Zarr
-job behind ``meshfmm allpairs ... -o OUT.zarr``) when that module exists, and
-``python -m meshfmm render --help`` (meshfmm.plot) when that one exists.
+help lists under "commands:", ``python -m meshfmm COMMAND --help`` for every
+one it lists under "python commands" (render, isolines: the Python
+package's), and ``python -m meshfmm.distributed --help`` (the Dask + Zarr
+job behind ``meshfmm allpairs ... -o OUT.zarr``) when that module exists.
 The page holds only a marker (``<!-- cli -->``) that this hook replaces, so
 the page says what the binary says. Without a built binary the build fails:
 build first (see the message).
@@ -45,16 +46,21 @@ def _run(argv, env=None) -> str:
     return r.stdout if r.stdout.strip() else r.stderr
 
 
-def _commands(top: str):
-    """The commands `meshfmm --help` lists under "commands:"."""
+def _commands(top: str, section: str = "commands"):
+    """The commands `meshfmm --help` lists in the section whose heading (a
+    line ending in ":") starts with `section`."""
     out, inside = [], False
     for line in top.splitlines():
         if re.match(r"^\S.*:\s*$", line):
-            inside = line.strip().lower().startswith("commands")
+            inside = line.strip().lower().startswith(section)
+            continue
+        if not line.strip():
             continue
         m = re.match(r"^\s{1,8}([a-z][\w-]*)\s{2,}", line)
         if inside and m:
             out.append(m.group(1))
+        elif not line.startswith(" "):
+            inside = False  # a paragraph after the list ends the section
     return out
 
 
@@ -82,6 +88,11 @@ def render() -> str:
     for c in commands:
         md += [f"## meshfmm {c}", ""] + _block(_run([str(cli), c, "--help"]))
     env = _python_env()
+    for c in _commands(top, "python commands"):
+        md += [f"## meshfmm {c}", "",
+               f"A command of the Python package's `meshfmm` (`python -m meshfmm {c}`, or the "
+               "`meshfmm` that pip installs), not of the C command line.", ""]
+        md += _block(_run([sys.executable, "-m", "meshfmm", c, "--help"], env=env))
     probe = subprocess.run([sys.executable, "-c",
                             "import importlib.util as u, sys; "
                             "sys.exit(0 if u.find_spec('meshfmm.distributed') else 3)"],
@@ -91,16 +102,6 @@ def render() -> str:
                "The Dask + Zarr job: what `meshfmm allpairs MESH -o OUT.zarr` runs when the "
                "`meshfmm` command comes from the Python package (`pip install .`).", ""]
         md += _block(_run([sys.executable, "-m", "meshfmm.distributed", "--help"], env=env))
-    probe = subprocess.run([sys.executable, "-c",
-                            "import importlib.util as u, sys; "
-                            "sys.exit(0 if u.find_spec('meshfmm.plot') else 3)"],
-                           capture_output=True, text=True, env=env)
-    if probe.returncode == 0:
-        md += ["## meshfmm render", "",
-               "A picture of the distance field (`meshfmm.plot.render`): a command of the "
-               "Python package's `meshfmm` (it needs matplotlib, the `[plot]` extra), not of "
-               "the C command line.", ""]
-        md += _block(_run([sys.executable, "-m", "meshfmm", "render", "--help"], env=env))
     return "\n".join(md)
 
 

@@ -19,6 +19,7 @@ int cmd_allpairs(int argc, char **argv);
 int cmd_path(int argc, char **argv);
 int cmd_landmarks(int argc, char **argv);
 int cmd_weld(int argc, char **argv);
+int cmd_voronoi(int argc, char **argv);
 
 /* Prints "meshfmm: <message>\n" on stderr. */
 void cli_error(const char *fmt, ...)
@@ -41,9 +42,63 @@ int cli_parse_double(const char *s, double *out);
 /* 1 when `path` ends with `.ext` (case-insensitive; ext without the dot). */
 int cli_has_ext(const char *path, const char *ext);
 
-/* Loads a mesh file and builds an mfmm_mesh; prints the error and returns
- * NULL on failure. in_no_face (may be NULL): set to (nv,) flags, 1 for the
- * vertices no face names (malloc'ed), or NULL when there are none. */
+/* ---- the mesh of a command (mesh.c) ---- */
+
+/* A mesh file loaded and built; with --weld, vertices at exactly the same
+ * position (-0.0 as 0.0) are one vertex, numbered by their lowest file id
+ * in file order, faces keep their corner order and a face two of whose
+ * corners weld together (zero area) is dropped, as `meshfmm weld` and
+ * Python's Mesh(V, F, weld=True) do. Arguments and results stay in the
+ * file's ids: the maps below translate them. */
+typedef struct cli_mesh {
+    mfmm_mesh *mesh;
+    int32_t nv_in, nf_in; /* the file's counts */
+    int32_t nv, nf;       /* the built mesh's (the same unless welded) */
+    /* welded only (NULL otherwise): */
+    int32_t *to_welded;   /* (nv_in) the built vertex of each file vertex */
+    int32_t *rep;         /* (nv) the lowest file id of each built vertex */
+    int32_t *face_in;     /* (nf) the file's face of each built face */
+    int32_t *face_welded; /* (nf_in) the built face of each file face, -1: dropped */
+    /* (nv_in) 1 for the file's vertices in no face (once welded), or NULL
+     * when there are none */
+    uint8_t *in_no_face;
+    double *V;            /* (nv, 3) and (nf, 3): the built mesh's arrays, */
+    int32_t *F;           /* when asked for (keep_arrays), else NULL */
+} cli_mesh;
+
+/* 0, or -1 with the error printed (m is then empty). weld: 0 or 1; a file
+ * with non-finite coordinates or face ids out of range is built unwelded,
+ * so that the library's error names the file's vertex or face. */
+int cli_mesh_load(cli_mesh *m, const char *path, const mfmm_mesh_options *options, int weld,
+                  int keep_arrays);
+void cli_mesh_free(cli_mesh *m);
+/* The file's id -> the built mesh's, in place. Welded: checked against the
+ * file's counts (and a dropped face refused), the error printed as
+ * "WHAT: vertex V is outside [0, N)"; unwelded: unchanged, for the library
+ * to check. 0 or -1. */
+int cli_mesh_vertex(const cli_mesh *m, const char *what, int32_t *v);
+int cli_mesh_face(const cli_mesh *m, const char *what, int32_t *f);
+int cli_mesh_point(const cli_mesh *m, const char *what, mfmm_source *s);
+/* A cost per file vertex (the lowest file id's value is kept) or face, in
+ * place, -> per built vertex or face. */
+void cli_mesh_cost(const cli_mesh *m, double *cost, int per_face);
+/* Built per-vertex values (malloc'ed, itemsize bytes each) -> per file
+ * vertex: `values` itself when unwelded, else a new array (values freed).
+ * NULL with "out of memory" printed (values freed). */
+void *cli_mesh_per_input_vertex(const cli_mesh *m, void *values, size_t itemsize);
+/* A built face or vertex id -> the file's (its lowest id for a vertex). */
+int32_t cli_mesh_input_face(const cli_mesh *m, int32_t f);
+int32_t cli_mesh_input_vertex(const cli_mesh *m, int32_t v);
+/* Welds V (nv) and F (nf, rewritten in place): map[v] the welded id of
+ * vertex v (first occurrence order), W (room for nv vertices) the welded
+ * vertices, F's first *n_kept faces the faces kept, face_in (room for nf;
+ * may be NULL) the input face of each. 0, or -1 out of memory (nothing
+ * printed). */
+int cli_weld(const double *V, int32_t nv, int32_t *F, int32_t nf, int32_t *map, double *W,
+             int32_t *face_in, int32_t *n_welded, int32_t *n_kept);
+/* cli_mesh_load without weld, for a command that needs only the mesh:
+ * NULL on failure (printed); in_no_face (may be NULL): m.in_no_face, now
+ * the caller's. */
 mfmm_mesh *cli_load_mesh(const char *path, const mfmm_mesh_options *options,
                          uint8_t **in_no_face);
 /* The note for `count` vertex sources on vertices in no face (the first
@@ -58,7 +113,7 @@ enum {
     OPT_NO_UNFOLDING, OPT_EXACT, OPT_TARGET, OPT_TARGET_FACE, OPT_MAX_POINTS, OPT_NO_STRAIGHTEN,
     OPT_JSON, OPT_MAX_UNFOLD_STEPS, OPT_STRETCH, OPT_RADII, OPT_DTYPE, OPT_BACKEND,
     OPT_SOURCES, OPT_THREADS, OPT_MEMORY, OPT_TARGETS, OPT_PLAIN_START, OPT_EXACT_START_RADIUS,
-    OPT_NO_SPOKES, OPT_START, OPT_NO_SIZE_CHECK, OPT_MAP
+    OPT_NO_SPOKES, OPT_START, OPT_NO_SIZE_CHECK, OPT_MAP, OPT_WELD, OPT_DISTANCES
 };
 /* Refuses a value option given a second time, which getopt_long would let
  * win silently (`-o a.npy -o b.npy`): call it with every code getopt_long
@@ -141,6 +196,8 @@ typedef struct cli_sources_and_cost {
     int cost_per_face;
     mfmm_source *src; /* room for one source per argument */
     int32_t n_src;
+    mfmm_source *src_in; /* with --weld: the sources as given (src: in the built ids) */
+    int weld;         /* --weld */
     double *cost;     /* loaded by cli_sources_and_cost_load */
     double exact_start_radius; /* --exact-start-radius R, --plain-start (0) */
     int start_given;  /* 1: --plain-start, 2: --exact-start-radius (both: an error) */
@@ -154,7 +211,13 @@ typedef struct cli_sources_and_cost {
         {"cost", required_argument, NULL, OPT_COST},                                         \
         {"cost-per-face", no_argument, NULL, OPT_COST_PER_FACE},                             \
         {"plain-start", no_argument, NULL, OPT_PLAIN_START},                                 \
-        {"exact-start-radius", required_argument, NULL, OPT_EXACT_START_RADIUS}
+        {"exact-start-radius", required_argument, NULL, OPT_EXACT_START_RADIUS},            \
+        {"weld", no_argument, NULL, OPT_WELD}
+/* The help line of --weld. */
+#define CLI_WELD_HELP                                                                        \
+    "  --weld                  weld vertices at the same position (texture seams,\n"        \
+    "                          unmerged corners) before solving, as `meshfmm weld`\n"       \
+    "                          does; ids given and written stay the file's\n"
 /* A macro's value as a string literal (help texts quote the library's defaults). */
 #define CLI_STR_(x) #x
 #define CLI_STR(x) CLI_STR_(x)
@@ -196,20 +259,26 @@ int cli_sources_and_cost_check_inputs(const cli_sources_and_cost *o);
  * not an input. CLI_OK or CLI_USAGE (printed). */
 int cli_sources_and_cost_check_output(const cli_sources_and_cost *o, const char *ext0,
                                       const char *ext1, int text_which, int *which);
-/* Loads --cost FILE (if given) into o->cost, checks its length against the
- * mesh and sets opt->cost and opt->cost_location. hint_per_face: suggest
- * --cost-per-face when a per-vertex cost has one value per face. 0, or -1
- * with the error printed. */
-int cli_sources_and_cost_load(cli_sources_and_cost *o, const mfmm_mesh *mesh,
+/* Loads the mesh (welded with --weld; keep_arrays as cli_mesh_load), then
+ * --cost FILE (if given) into o->cost, checks its length against the
+ * file's vertices or faces, carries it to the built mesh and sets
+ * opt->cost and opt->cost_location; then takes the sources to the built
+ * mesh's ids (with --weld, o->src_in keeps them as given). hint_per_face:
+ * suggest --cost-per-face when a per-vertex cost has one value per face.
+ * 0, or -1 with the error printed (m is then empty). */
+int cli_sources_and_cost_load(cli_sources_and_cost *o, cli_mesh *m, int keep_arrays,
                               int hint_per_face, mfmm_solve_options *opt);
-/* cli_note_sources_in_no_face for o's vertex sources (in range: after a
- * solve took them) flagged in in_no_face (cli_load_mesh; NULL: none). */
-void cli_sources_and_cost_note_in_no_face(const cli_sources_and_cost *o,
-                                          const uint8_t *in_no_face);
-/* Distances from o's sources to every vertex (malloc'ed), or NULL with the
- * error printed. */
+/* cli_note_sources_in_no_face for o's vertex sources as given (in range:
+ * after a solve took them) flagged in m->in_no_face. */
+void cli_sources_and_cost_note_in_no_face(const cli_sources_and_cost *o, const cli_mesh *m);
+/* Distances from o's sources to every vertex of the built mesh
+ * (malloc'ed), or NULL with the error printed. */
 double *cli_solve_distances(const mfmm_mesh *mesh, const cli_sources_and_cost *o,
                             const mfmm_solve_options *opt);
+/* The same by the exact solver (mfmm_solve_exact) within max_distance;
+ * notes on standard error when non-manifold edges became walls. */
+double *cli_solve_exact_distances(const mfmm_mesh *mesh, const cli_sources_and_cost *o,
+                                  double max_distance);
 
 /* ---- .npy files (format 1.0) ---- */
 
@@ -276,6 +345,11 @@ int cli_npy_parse_vector(const unsigned char *data, size_t size, const char *nam
 int cli_npy_read_ints(const char *path, int32_t **ids, int64_t *n);
 int cli_npy_parse_ints(const unsigned char *data, size_t size, const char *name, int32_t **ids,
                        int64_t *n);
+
+/* Vertex ids from a file: .npy (a 1-D integer array, or floats that are
+ * whole numbers) or text (numbers separated by blanks, newlines or commas).
+ * 0 with *ids malloc'ed (*n may be 0), or -1 with the error printed. */
+int cli_read_ids(const char *path, int32_t **ids, int64_t *n);
 
 /* Numbers separated by blanks, newlines or commas ('#' comments), read
  * without the locale. data[size] must be '\0'. */

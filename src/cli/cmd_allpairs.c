@@ -20,7 +20,7 @@ static void help(FILE *out)
             "                        [--cost FILE [--cost-per-face]] [--max-distance X]\n"
             "                        [--exact-start-radius R | --plain-start]\n"
             "                        [--threads N] [--memory MB] [--no-spokes] [--quiet]\n"
-            "                        [--no-size-check]\n\n"
+            "                        [--no-size-check] [--weld]\n\n"
             "The geodesic distance matrix: one row per source (default every vertex), one\n"
             "column per vertex, streamed into a .npy file block by block (the matrix is\n"
             "never held in memory). The file appears under its name only when complete.\n\n"
@@ -60,6 +60,11 @@ static void help(FILE *out)
             "  --no-size-check     write a dense .npy even when it exceeds the free space\n"
             "                      of its file system (by default the size is compared\n"
             "                      with it first and the job refused with both numbers)\n"
+            "  --weld              weld vertices at the same position (texture seams,\n"
+            "                      unmerged corners) before solving, as `meshfmm weld`\n"
+            "                      does; --sources, --targets, rows and columns stay the\n"
+            "                      file's ids (every file vertex a row and a column by\n"
+            "                      default)\n"
             "  -h, --help          this text\n\n"
             "Environment: MESHFMM_OPENCL_DEVICE (device index or name substring),\n"
             "MESHFMM_CACHE_DIR (OpenCL program cache, default ~/.cache/meshfmm).\n"
@@ -75,49 +80,25 @@ static double now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-/* ---- --sources FILE ---- */
-
-static int read_sources(const char *path, int32_t **ids, int64_t *n)
-{
-    *ids = NULL;
-    *n = 0;
-    double *v = NULL;
-    int64_t count = 0;
-    if (cli_has_ext(path, "npy")) {
-        int r = cli_npy_read_ints(path, ids, n);
-        if (r <= 0)
-            return r;
-        if (cli_npy_read_vector(path, &v, &count))
-            return -1;
-    } else if (cli_txt_read_vector(path, &v, &count)) {
-        return -1;
-    }
-    *ids = malloc(count ? (size_t)count * sizeof **ids : 1);
-    if (!*ids) {
-        free(v);
-        cli_error("out of memory");
-        return -1;
-    }
-    for (int64_t i = 0; i < count; i++) {
-        if (!(v[i] == floor(v[i])) || fabs(v[i]) > 2147483647.0) {
-            cli_error("%s: value %lld (%g) is not a vertex id", path, (long long)i, v[i]);
-            free(v);
-            free(*ids);
-            *ids = NULL;
-            return -1;
-        }
-        (*ids)[i] = (int32_t)v[i];
-    }
-    free(v);
-    *n = count;
-    return 0;
-}
-
 /* ---- the run ---- */
 
 typedef struct run_state {
     cli_npy_writer w;
     cli_npz_writer z;
+    /* --weld without --targets: rows of the built mesh's columns written in
+     * the file's columns (to_welded: the built column of each; inv_ptr,
+     * inv_idx: the file columns of each built one, ascending) */
+    const int32_t *to_welded;
+    int32_t n_file_cols, n_built_cols;
+    int64_t *inv_ptr;
+    int32_t *inv_idx;
+    unsigned char *row;  /* one dense row of the file's columns */
+    int64_t *x_ptr;      /* a sparse block in the file's columns */
+    int32_t *x_idx;
+    unsigned char *x_val;
+    struct file_entry *x_sort;
+    int64_t x_cap;
+    int32_t x_rows;
     int32_t total;
     int32_t done;
     int write_failed;
@@ -141,12 +122,106 @@ static void progress(run_state *s, int final)
     fflush(stderr);
 }
 
+/* A sparse entry in a file column: its column and its entry in the block. */
+struct file_entry {
+    int64_t e;
+    int32_t col;
+};
+
+static int by_col(const void *a, const void *b)
+{
+    int32_t x = ((const struct file_entry *)a)->col, y = ((const struct file_entry *)b)->col;
+    return (x > y) - (x < y);
+}
+
+/* The inverse of s->to_welded (CSR over the built columns). 0 or -1. */
+static int build_inverse(run_state *s)
+{
+    s->inv_ptr = calloc((size_t)s->n_built_cols + 1, sizeof *s->inv_ptr);
+    s->inv_idx = malloc((size_t)s->n_file_cols * sizeof *s->inv_idx + 1);
+    if (!s->inv_ptr || !s->inv_idx)
+        return -1;
+    for (int32_t v = 0; v < s->n_file_cols; v++)
+        s->inv_ptr[s->to_welded[v] + 1]++;
+    for (int32_t w = 0; w < s->n_built_cols; w++)
+        s->inv_ptr[w + 1] += s->inv_ptr[w];
+    for (int32_t v = 0; v < s->n_file_cols; v++) /* ascending within each */
+        s->inv_idx[s->inv_ptr[s->to_welded[v]]++] = v;
+    for (int32_t w = s->n_built_cols; w > 0; w--)
+        s->inv_ptr[w] = s->inv_ptr[w - 1];
+    s->inv_ptr[0] = 0;
+    return 0;
+}
+
+/* A CSR block in built columns -> s->x_* in the file's columns (each row's
+ * columns ascending). 0, or -1 out of memory (printed). */
+static int to_file_columns(run_state *s, int32_t n, const int64_t *indptr,
+                           const int32_t *indices, const void *values)
+{
+    size_t isz = s->z.itemsize;
+    int64_t total = 0;
+    for (int64_t e = 0; e < indptr[n]; e++)
+        total += s->inv_ptr[indices[e] + 1] - s->inv_ptr[indices[e]];
+    if (n > s->x_rows) {
+        int64_t *p = realloc(s->x_ptr, ((size_t)n + 1) * sizeof *p);
+        if (!p)
+            goto oom;
+        s->x_ptr = p;
+        s->x_rows = n;
+    }
+    if (total > s->x_cap) {
+        int32_t *idx = realloc(s->x_idx, (size_t)total * sizeof *idx);
+        if (idx)
+            s->x_idx = idx;
+        unsigned char *val = realloc(s->x_val, (size_t)total * isz);
+        if (val)
+            s->x_val = val;
+        struct file_entry *srt = realloc(s->x_sort, (size_t)total * sizeof *srt);
+        if (srt)
+            s->x_sort = srt;
+        if (!idx || !val || !srt)
+            goto oom;
+        s->x_cap = total;
+    }
+    const unsigned char *in = values;
+    int64_t k = 0;
+    s->x_ptr[0] = 0;
+    for (int32_t r = 0; r < n; r++) {
+        int64_t row0 = k;
+        for (int64_t e = indptr[r]; e < indptr[r + 1]; e++)
+            for (int64_t j = s->inv_ptr[indices[e]]; j < s->inv_ptr[indices[e] + 1]; j++) {
+                s->x_sort[k].e = e;
+                s->x_sort[k].col = s->inv_idx[j];
+                k++;
+            }
+        qsort(s->x_sort + row0, (size_t)(k - row0), sizeof *s->x_sort, by_col);
+        for (int64_t j = row0; j < k; j++) {
+            s->x_idx[j] = s->x_sort[j].col;
+            memcpy(s->x_val + (size_t)j * isz, in + (size_t)s->x_sort[j].e * isz, isz);
+        }
+        s->x_ptr[r + 1] = k;
+    }
+    return 0;
+oom:
+    cli_error("out of memory");
+    return -1;
+}
+
 static int on_sparse(void *user, int32_t first, int32_t n, const int64_t *indptr,
                      const int32_t *indices, const void *values)
 {
     run_state *s = user;
     if (cli_interrupted())
         return 1;
+    if (s->to_welded) {
+        if (to_file_columns(s, n, indptr, indices, values)) {
+            s->write_failed = 1;
+            return 1;
+        }
+        indptr = s->x_ptr;
+        indices = s->x_idx;
+        values = s->x_val;
+    }
     if (cli_npz_append(&s->z, n, indptr, indices, values)) {
         s->write_failed = 1;
         return 1;
@@ -161,7 +236,23 @@ static int on_rows(void *user, int32_t first, int32_t n, const void *rows)
     run_state *s = user;
     if (cli_interrupted())
         return 1;
-    if (cli_npy_append(&s->w, rows, n)) {
+    if (s->to_welded) {
+        size_t isz = s->w.itemsize;
+        for (int32_t r = 0; r < n; r++) {
+            const unsigned char *in = (const unsigned char *)rows + (size_t)r * isz *
+                                                                    (size_t)s->n_built_cols;
+            if (isz == 4)
+                for (int32_t v = 0; v < s->n_file_cols; v++)
+                    memcpy(s->row + 4 * (size_t)v, in + 4 * (size_t)s->to_welded[v], 4);
+            else
+                for (int32_t v = 0; v < s->n_file_cols; v++)
+                    memcpy(s->row + 8 * (size_t)v, in + 8 * (size_t)s->to_welded[v], 8);
+            if (cli_npy_append(&s->w, s->row, 1)) {
+                s->write_failed = 1;
+                return 1;
+            }
+        }
+    } else if (cli_npy_append(&s->w, rows, n)) {
         s->write_failed = 1;
         return 1;
     }
@@ -182,15 +273,16 @@ static int parse_backend(const char *s, mfmm_backend *b)
     return 0;
 }
 
-/* --cost FILE: one value per vertex or per face, as `distance --cost`. */
-static int load_cost(const char *path, int per_face, const mfmm_mesh *mesh, double **cost)
+/* --cost FILE: one value per vertex or per face of the file, as `distance
+ * --cost`, carried to the built mesh. */
+static int load_cost(const char *path, int per_face, const cli_mesh *m, double **cost)
 {
     int64_t nc;
     int r = cli_has_ext(path, "npy") ? cli_npy_read_vector(path, cost, &nc)
                                      : cli_txt_read_vector(path, cost, &nc);
     if (r)
         return -1;
-    int32_t nv = mfmm_mesh_vertex_count(mesh), nf = mfmm_mesh_face_count(mesh);
+    int32_t nv = m->nv_in, nf = m->nf_in;
     int64_t want = per_face ? nf : nv;
     if (nc != want) {
         cli_error("%s: %lld cost values, the mesh has %lld %s%s", path, (long long)nc,
@@ -198,6 +290,7 @@ static int load_cost(const char *path, int per_face, const mfmm_mesh *mesh, doub
                   !per_face && nc == nf ? " (use --cost-per-face for face costs)" : "");
         return -1;
     }
+    cli_mesh_cost(m, *cost, per_face);
     return 0;
 }
 
@@ -211,7 +304,7 @@ int cmd_allpairs(int argc, char **argv)
     mfmm_backend backend = MFMM_BACKEND_AUTO;
     mfmm_mesh_options mo;
     mfmm_mesh_options_init(&mo);
-    int quiet = 0, start_given = 0, threads_given = 0, size_check = 1;
+    int quiet = 0, start_given = 0, threads_given = 0, size_check = 1, weld = 0;
     static const struct option longopts[] = {
         {"help", no_argument, NULL, 'h'},
         {"output", required_argument, NULL, 'o'},
@@ -229,6 +322,7 @@ int cmd_allpairs(int argc, char **argv)
         {"exact-start-radius", required_argument, NULL, OPT_EXACT_START_RADIUS},
         {"no-spokes", no_argument, NULL, OPT_NO_SPOKES},
         {"no-size-check", no_argument, NULL, OPT_NO_SIZE_CHECK},
+        {"weld", no_argument, NULL, OPT_WELD},
         /* not an option of allpairs: named so that getopt does not take it
          * for an abbreviation of --sources */
         {"source", required_argument, NULL, OPT_SOURCE},
@@ -297,6 +391,9 @@ int cmd_allpairs(int argc, char **argv)
         case OPT_NO_SIZE_CHECK:
             size_check = 0;
             break;
+        case OPT_WELD:
+            weld = 1;
+            break;
         case OPT_EXACT_START_RADIUS:
             if (cli_start_option("allpairs", 2, &start_given) != CLI_OK ||
                 cli_parse_start_radius("allpairs", val, &o.exact_start_radius) != CLI_OK)
@@ -349,19 +446,18 @@ int cmd_allpairs(int argc, char **argv)
     run_state s;
     memset(&s, 0, sizeof s);
     cli_signals_install();
-    uint8_t *in_no_face = NULL;
-    mfmm_mesh *mesh = cli_load_mesh(path, &mo, &in_no_face);
-    if (!mesh)
+    cli_mesh m;
+    if (cli_mesh_load(&m, path, &mo, weld, 0))
         return CLI_FAIL;
-    int32_t nv = mfmm_mesh_vertex_count(mesh);
+    int32_t nv = m.nv_in; /* ids given and columns written: the file's */
     if (cost_path) {
-        if (load_cost(cost_path, cost_per_face, mesh, &cost))
+        if (load_cost(cost_path, cost_per_face, &m, &cost))
             goto done;
         o.cost = cost;
         o.cost_location = cost_per_face ? MFMM_COST_PER_FACE : MFMM_COST_PER_VERTEX;
     }
     if (sources_path) {
-        if (read_sources(sources_path, &src, &n_src))
+        if (cli_read_ids(sources_path, &src, &n_src))
             goto done;
         if (n_src == 0) {
             cli_error("%s: no sources", sources_path);
@@ -375,7 +471,7 @@ int cmd_allpairs(int argc, char **argv)
             }
     } else {
         n_src = nv;
-        src = malloc((size_t)nv * sizeof *src);
+        src = malloc((size_t)nv * sizeof *src + 1);
         if (!src) {
             cli_error("out of memory");
             goto done;
@@ -385,7 +481,7 @@ int cmd_allpairs(int argc, char **argv)
     }
 
     if (targets_path) {
-        if (read_sources(targets_path, &tgt, &n_tgt))
+        if (cli_read_ids(targets_path, &tgt, &n_tgt))
             goto done;
         if (n_tgt == 0 || n_tgt > INT32_MAX) {
             cli_error("%s: %s", targets_path, n_tgt ? "too many targets" : "no targets");
@@ -400,13 +496,30 @@ int cmd_allpairs(int argc, char **argv)
         o.targets = tgt;
         o.n_targets = (int32_t)n_tgt;
     }
-    if (in_no_face && !quiet) {
+    if (m.in_no_face && !quiet) {
         int64_t count = 0;
         int32_t first = -1;
         for (int64_t i = 0; i < n_src; i++)
-            if (in_no_face[src[i]] && count++ == 0)
+            if (m.in_no_face[src[i]] && count++ == 0)
                 first = src[i];
         cli_note_sources_in_no_face("allpairs", count, first);
+    }
+    if (m.to_welded) { /* in range: checked above */
+        for (int64_t i = 0; i < n_src; i++)
+            src[i] = m.to_welded[src[i]];
+        for (int64_t i = 0; i < n_tgt; i++)
+            tgt[i] = m.to_welded[tgt[i]];
+        if (!tgt) {
+            s.to_welded = m.to_welded;
+            s.n_file_cols = m.nv_in;
+            s.n_built_cols = m.nv;
+            if (!sparse)
+                s.row = malloc((size_t)m.nv_in * (o.dtype == MFMM_FLOAT64 ? 8 : 4) + 1);
+            if (sparse ? build_inverse(&s) : !s.row) {
+                cli_error("out of memory");
+                goto done;
+            }
+        }
     }
     int64_t n_cols = tgt ? n_tgt : nv;
     if (cli_interrupted())
@@ -449,7 +562,7 @@ int cmd_allpairs(int argc, char **argv)
     /* auto: the library runs OpenCL, or threads (from the first row not
      * delivered) when OpenCL fails or cannot keep every core busy */
     mfmm_matrix_info info = {.struct_size = sizeof info};
-    mfmm_status st = mfmm_distance_matrix(mesh, src, (int32_t)n_src, &o, &info, &err);
+    mfmm_status st = mfmm_distance_matrix(m.mesh, src, (int32_t)n_src, &o, &info, &err);
     mfmm_backend used = info.backend_used;
     if (cli_interrupted()) {
         if (sparse)
@@ -500,7 +613,13 @@ done:
     free(src);
     free(tgt);
     free(cost);
-    free(in_no_face);
-    mfmm_mesh_destroy(mesh);
+    free(s.inv_ptr);
+    free(s.inv_idx);
+    free(s.row);
+    free(s.x_ptr);
+    free(s.x_idx);
+    free(s.x_val);
+    free(s.x_sort);
+    cli_mesh_free(&m);
     return rc;
 }

@@ -13,7 +13,7 @@ static void help(FILE *out)
             "                        [--face-source F W0 W1 W2 ...] [--max-distance X]\n"
             "                        [--no-unfolding] [--cost FILE [--cost-per-face]]\n"
             "                        [--exact-start-radius R | --plain-start]\n"
-            "                        [--exact] -o OUT\n\n"
+            "                        [--exact] [--weld] -o OUT\n\n"
             "Geodesic distance (Fast Marching) from the sources to every vertex of MESH.\n\n"
             "  --source I              a vertex source (0-based id); repeatable\n"
             "  --face-source F W0 W1 W2  a point in face F with barycentric coordinates\n"
@@ -22,6 +22,7 @@ static void help(FILE *out)
             CLI_START_HELP
             "  --exact                 exact polyhedral geodesic distance (window\n"
             "                          propagation) instead of Fast Marching; no --cost\n"
+            CLI_WELD_HELP
             "  --cost FILE             slowness F (.npy float64/float32 or .txt), one value\n"
             "                          per vertex (default) or per face (--cost-per-face)\n"
             "  -o, --output OUT        .npy (float64, shape (nv,)) or .txt (one value per\n"
@@ -44,41 +45,6 @@ static int write_txt(const char *path, const double *d, int32_t n)
     return cli_output_close(&out, bad);
 }
 
-/* Exact polyhedral distances (mfmm_solve_exact) from the parsed sources. */
-static double *solve_exact(const mfmm_mesh *mesh, const cli_sources_and_cost *o, double max_d)
-{
-    int32_t nv = mfmm_mesh_vertex_count(mesh);
-    double *dist = malloc((size_t)nv * sizeof *dist);
-    mfmm_exact_solver *solver = NULL;
-    if (!dist) {
-        cli_error("out of memory");
-        return NULL;
-    }
-    mfmm_error err;
-    mfmm_status st = mfmm_exact_solver_create(mesh, &solver);
-    if (st != MFMM_OK) {
-        cli_error("%s", mfmm_status_string(st));
-        free(dist);
-        return NULL;
-    }
-    mfmm_exact_options eo;
-    mfmm_exact_options_init(&eo);
-    eo.max_distance = max_d;
-    mfmm_exact_info info = {.struct_size = sizeof info};
-    st = mfmm_solve_exact(solver, o->src, o->n_src, &eo, dist, &info, &err);
-    mfmm_exact_solver_destroy(solver);
-    if (st != MFMM_OK) {
-        cli_error("%s", err.message);
-        free(dist);
-        return NULL;
-    }
-    if (info.nonmanifold_walls)
-        fprintf(stderr, "meshfmm distance: note: windows across the non-manifold edges passed "
-                        "their budget (degenerate folded fans); those edges were walls, where "
-                        "distances are upper bounds\n");
-    return dist;
-}
-
 int cmd_distance(int argc, char **argv)
 {
     static const struct option longopts[] = {
@@ -93,8 +59,7 @@ int cmd_distance(int argc, char **argv)
     mfmm_solve_options_init(&opt);
     cli_sources_and_cost o;
     double *dist = NULL;
-    mfmm_mesh *mesh = NULL;
-    uint8_t *in_no_face = NULL;
+    cli_mesh m = {0};
     if (cli_sources_and_cost_init(&o, "distance", help, argc))
         return CLI_FAIL;
     int c;
@@ -130,14 +95,16 @@ int cmd_distance(int argc, char **argv)
     rc = CLI_FAIL;
     cli_signals_install();
 
-    mesh = cli_load_mesh(o.mesh_path, NULL, &in_no_face);
-    if (!mesh || cli_sources_and_cost_load(&o, mesh, 1, &opt))
+    if (cli_sources_and_cost_load(&o, &m, 0, 1, &opt))
         goto done;
-    int32_t nv = mfmm_mesh_vertex_count(mesh);
-    dist = exact ? solve_exact(mesh, &o, opt.max_distance) : cli_solve_distances(mesh, &o, &opt);
+    int32_t nv = m.nv_in;
+    dist = exact ? cli_solve_exact_distances(m.mesh, &o, opt.max_distance)
+                 : cli_solve_distances(m.mesh, &o, &opt);
+    if (dist)
+        dist = cli_mesh_per_input_vertex(&m, dist, sizeof *dist);
     if (!dist || cli_interrupted())
         goto done;
-    cli_sources_and_cost_note_in_no_face(&o, in_no_face);
+    cli_sources_and_cost_note_in_no_face(&o, &m);
     if (!is_txt) {
         cli_npy_writer w;
         if (cli_npy_open(&w, o.out_path, "<f8", nv, -1))
@@ -157,9 +124,8 @@ done:
         fprintf(stderr, "meshfmm distance: interrupted; no output written\n");
         rc = CLI_EXIT_INTERRUPTED;
     }
-    mfmm_mesh_destroy(mesh);
+    cli_mesh_free(&m);
     free(dist);
-    free(in_no_face);
     cli_sources_and_cost_free(&o);
     return rc;
 }

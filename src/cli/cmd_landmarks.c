@@ -10,7 +10,8 @@ static void help(FILE *out)
 {
     fprintf(out,
             "usage: meshfmm landmarks MESH -k K [--start V] [--no-unfolding]\n"
-            "                         [--exact-start-radius R | --plain-start] -o OUT\n\n"
+            "                         [--exact-start-radius R | --plain-start] [--weld]\n"
+            "                         -o OUT\n\n"
             "Geodesic farthest-point sampling (mfmm_farthest_points): K vertex ids of MESH,\n"
             "the first V, each next the vertex farthest from those chosen (ties to the\n"
             "lowest id). One march per point, each stopped at the farthest distance so\n"
@@ -22,6 +23,10 @@ static void help(FILE *out)
             "  --start V               the first landmark, a vertex id (default 0)\n"
             "  --no-unfolding          plain stencils at obtuse corners (for comparison)\n"
             CLI_START_HELP_NO_LIMIT
+            "  --weld                  weld vertices at the same position (texture seams,\n"
+            "                          unmerged corners) first, as `meshfmm weld` does; the\n"
+            "                          start and the landmarks are the file's ids (of\n"
+            "                          coincident vertices, the lowest)\n"
             "  -o, --output OUT        .txt (one id per line; - for standard output) or\n"
             "                          .npy (int32, shape (K,))\n"
             "  -h, --help              this text\n\n"
@@ -39,10 +44,11 @@ int cmd_landmarks(int argc, char **argv)
         {"no-unfolding", no_argument, NULL, OPT_NO_UNFOLDING},
         {"plain-start", no_argument, NULL, OPT_PLAIN_START},
         {"exact-start-radius", required_argument, NULL, OPT_EXACT_START_RADIUS},
+        {"weld", no_argument, NULL, OPT_WELD},
         {NULL, 0, NULL, 0}};
     const char *mesh_path = NULL, *out_path = NULL;
     int32_t k = -1, start = 0;
-    int start_given = 0;
+    int start_given = 0, weld = 0;
     mfmm_solve_options opt;
     mfmm_solve_options_init(&opt);
     int c, rc;
@@ -64,6 +70,8 @@ int cmd_landmarks(int argc, char **argv)
                 return cli_usage_error("landmarks", "--start needs a vertex id >= 0");
         } else if (c == OPT_NO_UNFOLDING) {
             opt.unfolding = 0;
+        } else if (c == OPT_WELD) {
+            weld = 1;
         } else if (c == OPT_PLAIN_START) {
             if ((rc = cli_start_option("landmarks", 1, &start_given)) != CLI_OK)
                 return rc;
@@ -97,20 +105,22 @@ int cmd_landmarks(int argc, char **argv)
     cli_signals_install();
 
     rc = CLI_FAIL;
-    mfmm_mesh *mesh = cli_load_mesh(mesh_path, NULL, NULL);
+    cli_mesh m;
     mfmm_solver *solver = NULL;
     int32_t *pts = NULL;
     double *dist = NULL;
-    if (!mesh)
-        goto done;
-    int32_t nv = mfmm_mesh_vertex_count(mesh);
+    if (cli_mesh_load(&m, mesh_path, NULL, weld, 0))
+        return CLI_FAIL;
+    int32_t nv = m.nv;
     pts = malloc((size_t)k * sizeof *pts);
-    dist = malloc((size_t)nv * sizeof *dist);
+    dist = malloc((size_t)nv * sizeof *dist + 1);
     if (!pts || !dist) {
         cli_error("out of memory");
         goto done;
     }
-    mfmm_status st = mfmm_solver_create(mesh, &solver);
+    if (cli_mesh_vertex(&m, "start", &start))
+        goto done;
+    mfmm_status st = mfmm_solver_create(m.mesh, &solver);
     if (st != MFMM_OK) {
         cli_error("%s", mfmm_status_string(st));
         goto done;
@@ -121,9 +131,14 @@ int cmd_landmarks(int argc, char **argv)
         cli_error("%s: %s", mesh_path, err.message);
         goto done;
     }
+    for (int32_t i = 0; i < k; i++)
+        pts[i] = cli_mesh_input_vertex(&m, pts[i]);
+    dist = cli_mesh_per_input_vertex(&m, dist, sizeof *dist);
+    if (!dist)
+        goto done;
     double cover = 0.0;
     int32_t unreached = 0;
-    for (int32_t v = 0; v < nv; v++) {
+    for (int32_t v = 0; v < m.nv_in; v++) {
         if (isfinite(dist[v]))
             cover = fmax(cover, dist[v]);
         else
@@ -162,7 +177,7 @@ done:
         rc = CLI_EXIT_INTERRUPTED;
     }
     mfmm_solver_destroy(solver);
-    mfmm_mesh_destroy(mesh);
+    cli_mesh_free(&m);
     free(pts);
     free(dist);
     return rc;

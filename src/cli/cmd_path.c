@@ -1,5 +1,6 @@
 /* meshfmm path MESH --source I [...] --target J -o OUT (.csv or .obj):
- * the minimal geodesic from a target back to the sources (paper section 5). */
+ * the minimal geodesic from the nearest source to a target, traced back
+ * from the target (paper section 5) and written from the source. */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -14,11 +15,13 @@ static void help(FILE *out)
             "usage: meshfmm path MESH --source I [--source J ...] [--face-source F W0 W1 W2 ...]\n"
             "                    (--target J | --target-face F W0 W1 W2)\n"
             "                    [--cost FILE [--cost-per-face]] [--max-points N] [--no-straighten]\n"
-            "                    [--exact-start-radius R | --plain-start]\n"
+            "                    [--exact-start-radius R | --plain-start] [--weld]\n"
             "                    -o OUT\n\n"
-            "The minimal geodesic from the target back to the nearest source: distances by\n"
-            "Fast Marching, then backtracking along -grad T (Heun's method). Prints the\n"
-            "path's length on stdout (with --cost: the length and the cost-weighted length).\n\n"
+            "The minimal geodesic from the nearest source to the target: distances by Fast\n"
+            "Marching, then backtracking from the target along -grad T (Heun's method).\n"
+            "The path is written from the source (first point) to the target (last), as\n"
+            "Python's Mesh.path(source, target). Prints the path's length on stdout (with\n"
+            "--cost: the length and the cost-weighted length).\n\n"
             "  --source I              a vertex source (0-based id); repeatable\n"
             "  --face-source F W0 W1 W2  a point in face F with barycentric coordinates\n"
             "  --target J              the target vertex\n"
@@ -29,8 +32,12 @@ static void help(FILE *out)
             CLI_START_HELP_NO_LIMIT
             "  --no-straighten         keep the traced path of section 5 (by default it is\n"
             "                          straightened inside the strip of faces it crossed)\n"
-            "  -o, --output OUT        .csv (face,b0,b1,b2,x,y,z per point, with a header) or\n"
-            "                          .obj (v lines and one polyline 'l' element); - writes\n"
+            CLI_WELD_HELP
+            "  -o, --output OUT        .csv (face,b0,b1,b2,x,y,z per point, with a header;\n"
+            "                          the face of point i > 0 is the one the segment from\n"
+            "                          point i-1 runs through, b0-b2 the point's barycentric\n"
+            "                          coordinates in it) or .obj (v lines and one polyline\n"
+            "                          'l' element); - writes\n"
             "                          the .csv to standard output (the length then goes to\n"
             "                          standard error)\n"
             "  -h, --help              this text\n\n"
@@ -46,7 +53,7 @@ static int write_path(const char *path, const mfmm_surface_point *p, int32_t n, 
     FILE *f = out.f;
     int bad = 0;
     if (obj) {
-        bad = fprintf(f, "# meshfmm path: %d points, target first\n", (int)n) < 0;
+        bad = fprintf(f, "# meshfmm path: %d points, source first\n", (int)n) < 0;
         for (int32_t i = 0; i < n && !bad && !cli_interrupted(); i++)
             for (int k = 0; k < 3 && !bad; k++)
                 bad = fputs(k ? " " : "v ", f) < 0 || cli_put_double(f, p[i].xyz[k]) < 0 ||
@@ -71,6 +78,70 @@ static int write_path(const char *path, const mfmm_surface_point *p, int32_t n, 
     return cli_output_close(&out, bad);
 }
 
+/* q's barycentric coordinates moved into `face` (built ids), which holds
+ * the point on its boundary: by the corners the two faces share, or, when
+ * the point is not on them, from its position (least squares in the face's
+ * plane, negative weights clamped). */
+static void move_to_face(const cli_mesh *m, mfmm_surface_point *q, int32_t face)
+{
+    const int32_t *a = m->F + 3 * (size_t)q->face, *b = m->F + 3 * (size_t)face;
+    double w[3] = {0.0, 0.0, 0.0}, lost = 0.0;
+    for (int i = 0; i < 3; i++) {
+        int k = 0;
+        while (k < 3 && b[k] != a[i])
+            k++;
+        if (k < 3)
+            w[k] += q->bary[i];
+        else
+            lost += fabs(q->bary[i]);
+    }
+    if (lost > 1e-12) {
+        const double *A = m->V + 3 * (size_t)b[0], *B = m->V + 3 * (size_t)b[1],
+                     *C = m->V + 3 * (size_t)b[2];
+        double e1[3], e2[3], r[3];
+        for (int k = 0; k < 3; k++) {
+            e1[k] = B[k] - A[k];
+            e2[k] = C[k] - A[k];
+            r[k] = q->xyz[k] - A[k];
+        }
+        double g11 = 0, g12 = 0, g22 = 0, h1 = 0, h2 = 0;
+        for (int k = 0; k < 3; k++) {
+            g11 += e1[k] * e1[k];
+            g12 += e1[k] * e2[k];
+            g22 += e2[k] * e2[k];
+            h1 += e1[k] * r[k];
+            h2 += e2[k] * r[k];
+        }
+        double det = g11 * g22 - g12 * g12;
+        double l1 = det != 0.0 ? (h1 * g22 - h2 * g12) / det : 0.0;
+        double l2 = det != 0.0 ? (h2 * g11 - h1 * g12) / det : 0.0;
+        w[0] = fmax(1.0 - l1 - l2, 0.0);
+        w[1] = fmax(l1, 0.0);
+        w[2] = fmax(l2, 0.0);
+    }
+    double sum = w[0] + w[1] + w[2];
+    for (int k = 0; k < 3; k++)
+        q->bary[k] = sum > 0.0 ? w[k] / sum : 1.0 / 3.0;
+    q->face = face;
+}
+
+/* The traced path (target first) in place from the source to the target,
+ * keeping its convention: point i > 0 names the face of the segment from
+ * point i-1, and its coordinates are in that face. */
+static void reverse_path(const cli_mesh *m, mfmm_surface_point *p, int32_t n)
+{
+    for (int32_t i = 0, j = n - 1; i < j; i++, j--) {
+        mfmm_surface_point t = p[i];
+        p[i] = p[j];
+        p[j] = t;
+    }
+    /* the segment from new point j-1 to j was the old segment into old
+     * point j-1: its face is p[j-1]'s (not yet moved: j descends) */
+    for (int32_t j = n - 1; j >= 1; j--)
+        if (p[j - 1].face >= 0 && p[j].face >= 0 && p[j - 1].face != p[j].face)
+            move_to_face(m, &p[j], p[j - 1].face);
+}
+
 int cmd_path(int argc, char **argv)
 {
     static const struct option longopts[] = {
@@ -87,8 +158,7 @@ int cmd_path(int argc, char **argv)
     cli_sources_and_cost o;
     double *dist = NULL;
     mfmm_surface_point *pts = NULL;
-    mfmm_mesh *mesh = NULL;
-    uint8_t *in_no_face = NULL;
+    cli_mesh m = {0};
     if (cli_sources_and_cost_init(&o, "path", help, argc))
         return CLI_FAIL;
     int c;
@@ -141,20 +211,19 @@ int cmd_path(int argc, char **argv)
     rc = CLI_FAIL;
     cli_signals_install();
 
-    mesh = cli_load_mesh(o.mesh_path, NULL, &in_no_face);
     mfmm_solve_options opt;
     mfmm_solve_options_init(&opt);
-    if (!mesh || cli_sources_and_cost_load(&o, mesh, 0, &opt))
+    if (cli_sources_and_cost_load(&o, &m, 1, 0, &opt) || cli_mesh_point(&m, "target", &target))
         goto done;
     pts = malloc((size_t)max_points * sizeof *pts);
     if (!pts) {
         cli_error("out of memory");
         goto done;
     }
-    dist = cli_solve_distances(mesh, &o, &opt);
+    dist = cli_solve_distances(m.mesh, &o, &opt);
     if (!dist)
         goto done;
-    cli_sources_and_cost_note_in_no_face(&o, in_no_face);
+    cli_sources_and_cost_note_in_no_face(&o, &m);
     mfmm_path_options po;
     mfmm_path_options_init(&po);
     double wlen = 0.0, len = 0.0;
@@ -167,10 +236,14 @@ int cmd_path(int argc, char **argv)
     po.cost = opt.cost;
     po.cost_location = opt.cost_location;
     po.weighted_length = &wlen;
-    if (mfmm_trace_path(mesh, dist, &target, &po, pts, max_points, &n, &len, &err) != MFMM_OK) {
+    if (mfmm_trace_path(m.mesh, dist, &target, &po, pts, max_points, &n, &len, &err) !=
+        MFMM_OK) {
         cli_error("%s", err.message);
         goto done;
     }
+    reverse_path(&m, pts, n);
+    for (int32_t i = 0; i < n; i++)
+        pts[i].face = cli_mesh_input_face(&m, pts[i].face);
     if (cli_interrupted() || write_path(o.out_path, pts, n, obj))
         goto done;
     /* The length goes to stdout, or to stderr when stdout holds the path. */
@@ -192,9 +265,8 @@ done:
         fprintf(stderr, "meshfmm path: interrupted; no output written\n");
         rc = CLI_EXIT_INTERRUPTED;
     }
-    mfmm_mesh_destroy(mesh);
+    cli_mesh_free(&m);
     free(pts);
-    free(in_no_face);
     free(dist);
     cli_sources_and_cost_free(&o);
     return rc;

@@ -23,54 +23,6 @@ static void help(FILE *out)
             "complete; they may not be the mesh.\n");
 }
 
-static uint64_t hash3(const double *p)
-{
-    uint64_t h = 1469598103934665603u;
-    for (int k = 0; k < 3; k++) {
-        double x = p[k] + 0.0; /* -0.0 as 0.0 */
-        uint64_t bits;
-        memcpy(&bits, &x, sizeof bits);
-        h = (h ^ bits) * 1099511628211u;
-        h ^= h >> 29;
-    }
-    return h;
-}
-
-/* map[v]: the welded id of input vertex v (first occurrence order); the
- * count of welded vertices, or -1 when out of memory. */
-static int32_t weld_map(const double *V, int32_t nv, int32_t *map)
-{
-    size_t cap = 16;
-    while (cap < 2 * (size_t)nv)
-        cap *= 2;
-    int32_t *table = malloc(cap * sizeof *table);
-    if (!table)
-        return -1;
-    for (size_t i = 0; i < cap; i++)
-        table[i] = -1;
-    int32_t n = 0;
-    for (int32_t v = 0; v < nv; v++) {
-        const double *p = V + 3 * (size_t)v;
-        size_t i = (size_t)hash3(p) & (cap - 1);
-        for (;;) {
-            int32_t w = table[i];
-            if (w < 0) {
-                table[i] = v;
-                map[v] = n++;
-                break;
-            }
-            const double *q = V + 3 * (size_t)w;
-            if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) {
-                map[v] = map[w];
-                break;
-            }
-            i = (i + 1) & (cap - 1);
-        }
-    }
-    free(table);
-    return n;
-}
-
 static int write_map(const char *path, const int32_t *map, int32_t nv)
 {
     if (cli_has_ext(path, "npy")) {
@@ -146,22 +98,10 @@ int cmd_weld(int argc, char **argv)
     }
     map = malloc((size_t)nv * sizeof *map);
     W = malloc(3 * (size_t)nv * sizeof *W);
-    int32_t nw = map && W ? weld_map(V, nv, map) : -1;
-    if (nw < 0) {
+    int32_t nw = 0, kept = 0;
+    if (!map || !W || cli_weld(V, nv, F, nf, map, W, NULL, &nw, &kept)) {
         cli_error("out of memory");
         goto done;
-    }
-    for (int32_t v = 0; v < nv; v++)
-        memcpy(W + 3 * (size_t)map[v], V + 3 * (size_t)v, 3 * sizeof *W);
-    int32_t kept = 0;
-    for (int32_t f = 0; f < nf; f++) {
-        int32_t a = map[F[3 * f]], b = map[F[3 * f + 1]], d = map[F[3 * f + 2]];
-        if (a == b || b == d || a == d)
-            continue;
-        F[3 * kept] = a;
-        F[3 * kept + 1] = b;
-        F[3 * kept + 2] = d;
-        kept++;
     }
     char comment[160];
     snprintf(comment, sizeof comment, "meshfmm weld: %ld vertices welded into %ld, %ld faces "

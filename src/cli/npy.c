@@ -1,7 +1,8 @@
 /* .npy (format 1.0) streaming writer and small readers of 1-D float and
- * integer vectors; plain text vectors. */
+ * integer vectors; plain text vectors; vertex id lists. */
 #include <errno.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -488,4 +489,40 @@ int cli_txt_read_vector(const char *path, double **values, int64_t *n)
     int r = cli_txt_parse_vector((const char *)d, size, path, values, n);
     free(d);
     return r;
+}
+
+int cli_read_ids(const char *path, int32_t **ids, int64_t *n)
+{
+    *ids = NULL;
+    *n = 0;
+    double *v = NULL;
+    int64_t count = 0;
+    if (cli_has_ext(path, "npy")) {
+        int r = cli_npy_read_ints(path, ids, n);
+        if (r <= 0)
+            return r;
+        if (cli_npy_read_vector(path, &v, &count))
+            return -1;
+    } else if (cli_txt_read_vector(path, &v, &count)) {
+        return -1;
+    }
+    *ids = malloc(count ? (size_t)count * sizeof **ids : 1);
+    if (!*ids) {
+        free(v);
+        cli_error("out of memory");
+        return -1;
+    }
+    for (int64_t i = 0; i < count; i++) {
+        if (!(v[i] == floor(v[i])) || fabs(v[i]) > 2147483647.0) {
+            cli_error("%s: value %lld (%g) is not a vertex id", path, (long long)i, v[i]);
+            free(v);
+            free(*ids);
+            *ids = NULL;
+            return -1;
+        }
+        (*ids)[i] = (int32_t)v[i];
+    }
+    free(v);
+    *n = count;
+    return 0;
 }

@@ -1,5 +1,6 @@
-/* Options shared by `distance` and `path`: the mesh, the sources, the cost
- * file and the output; their checks and the cost loader. */
+/* Options shared by `distance`, `path` and `voronoi`: the mesh, the
+ * sources, the cost file, --weld and the output; their checks, the loader
+ * of the mesh and the cost, and the solves. */
 #include <getopt.h>
 #include <math.h>
 #include <stdlib.h>
@@ -25,19 +26,20 @@ int cli_sources_and_cost_init(cli_sources_and_cost *o, const char *sub, void (*h
 void cli_sources_and_cost_free(cli_sources_and_cost *o)
 {
     free(o->src);
+    free(o->src_in);
     free(o->cost);
-    o->src = NULL;
+    o->src = o->src_in = NULL;
     o->cost = NULL;
 }
 
-void cli_sources_and_cost_note_in_no_face(const cli_sources_and_cost *o,
-                                          const uint8_t *in_no_face)
+void cli_sources_and_cost_note_in_no_face(const cli_sources_and_cost *o, const cli_mesh *m)
 {
     int64_t count = 0;
     int32_t first = -1;
-    for (int32_t i = 0; in_no_face && i < o->n_src; i++)
-        if (o->src[i].face < 0 && in_no_face[o->src[i].vertex] && count++ == 0)
-            first = o->src[i].vertex;
+    const mfmm_source *src = o->src_in ? o->src_in : o->src;
+    for (int32_t i = 0; m->in_no_face && i < o->n_src; i++)
+        if (src[i].face < 0 && m->in_no_face[src[i].vertex] && count++ == 0)
+            first = src[i].vertex;
     cli_note_sources_in_no_face(o->sub, count, first);
 }
 
@@ -67,6 +69,9 @@ int cli_sources_and_cost_opt(cli_sources_and_cost *o, int c, int argc, char **ar
         return CLI_OK;
     case OPT_COST_PER_FACE:
         o->cost_per_face = 1;
+        return CLI_OK;
+    case OPT_WELD:
+        o->weld = 1;
         return CLI_OK;
     case 'o':
         o->out_path = optarg;
@@ -122,29 +127,49 @@ int cli_sources_and_cost_check_output(const cli_sources_and_cost *o, const char 
     return cli_check_output_not_input(o->sub, o->out_path, inputs, 2);
 }
 
-int cli_sources_and_cost_load(cli_sources_and_cost *o, const mfmm_mesh *mesh,
+int cli_sources_and_cost_load(cli_sources_and_cost *o, cli_mesh *m, int keep_arrays,
                               int hint_per_face, mfmm_solve_options *opt)
 {
-    if (!o->cost_path)
-        return 0;
-    int32_t nv = mfmm_mesh_vertex_count(mesh), nf = mfmm_mesh_face_count(mesh);
-    int64_t nc;
-    int r = cli_has_ext(o->cost_path, "npy") ? cli_npy_read_vector(o->cost_path, &o->cost, &nc)
-                                             : cli_txt_read_vector(o->cost_path, &o->cost, &nc);
-    if (r)
+    if (cli_mesh_load(m, o->mesh_path, NULL, o->weld, keep_arrays))
         return -1;
-    int64_t want = o->cost_per_face ? nf : nv;
-    if (nc != want) {
-        cli_error("%s: %lld cost values, the mesh has %lld %s%s", o->cost_path, (long long)nc,
-                  (long long)want, o->cost_per_face ? "faces" : "vertices",
-                  hint_per_face && !o->cost_per_face && nc == nf
-                      ? " (use --cost-per-face for face costs)"
-                      : "");
-        return -1;
+    if (o->cost_path) {
+        int64_t nc;
+        int r = cli_has_ext(o->cost_path, "npy")
+                    ? cli_npy_read_vector(o->cost_path, &o->cost, &nc)
+                    : cli_txt_read_vector(o->cost_path, &o->cost, &nc);
+        if (r)
+            goto fail;
+        int64_t want = o->cost_per_face ? m->nf_in : m->nv_in;
+        if (nc != want) {
+            cli_error("%s: %lld cost values, the mesh has %lld %s%s", o->cost_path,
+                      (long long)nc, (long long)want, o->cost_per_face ? "faces" : "vertices",
+                      hint_per_face && !o->cost_per_face && nc == m->nf_in
+                          ? " (use --cost-per-face for face costs)"
+                          : "");
+            goto fail;
+        }
+        cli_mesh_cost(m, o->cost, o->cost_per_face);
+        opt->cost = o->cost;
+        opt->cost_location = o->cost_per_face ? MFMM_COST_PER_FACE : MFMM_COST_PER_VERTEX;
     }
-    opt->cost = o->cost;
-    opt->cost_location = o->cost_per_face ? MFMM_COST_PER_FACE : MFMM_COST_PER_VERTEX;
+    if (m->to_welded) {
+        o->src_in = malloc((size_t)o->n_src * sizeof *o->src_in + 1);
+        if (!o->src_in) {
+            cli_error("out of memory");
+            goto fail;
+        }
+        memcpy(o->src_in, o->src, (size_t)o->n_src * sizeof *o->src);
+        for (int32_t i = 0; i < o->n_src; i++) {
+            char what[32];
+            snprintf(what, sizeof what, "source %ld", (long)i);
+            if (cli_mesh_point(m, what, &o->src[i]))
+                goto fail;
+        }
+    }
     return 0;
+fail:
+    cli_mesh_free(m);
+    return -1;
 }
 
 double *cli_solve_distances(const mfmm_mesh *mesh, const cli_sources_and_cost *o,
@@ -177,6 +202,41 @@ double *cli_solve_distances(const mfmm_mesh *mesh, const cli_sources_and_cost *o
         free(dist);
         return NULL;
     }
+    return dist;
+}
+
+double *cli_solve_exact_distances(const mfmm_mesh *mesh, const cli_sources_and_cost *o,
+                                  double max_distance)
+{
+    int32_t nv = mfmm_mesh_vertex_count(mesh);
+    double *dist = malloc((size_t)nv * sizeof *dist + 1);
+    mfmm_exact_solver *solver = NULL;
+    if (!dist) {
+        cli_error("out of memory");
+        return NULL;
+    }
+    mfmm_error err;
+    mfmm_status st = mfmm_exact_solver_create(mesh, &solver);
+    if (st != MFMM_OK) {
+        cli_error("%s", mfmm_status_string(st));
+        free(dist);
+        return NULL;
+    }
+    mfmm_exact_options eo;
+    mfmm_exact_options_init(&eo);
+    eo.max_distance = max_distance;
+    mfmm_exact_info info = {.struct_size = sizeof info};
+    st = mfmm_solve_exact(solver, o->src, o->n_src, &eo, dist, &info, &err);
+    mfmm_exact_solver_destroy(solver);
+    if (st != MFMM_OK) {
+        cli_error("%s", err.message);
+        free(dist);
+        return NULL;
+    }
+    if (info.nonmanifold_walls)
+        fprintf(stderr, "meshfmm %s: note: windows across the non-manifold edges passed "
+                        "their budget (degenerate folded fans); those edges were walls, where "
+                        "distances are upper bounds\n", o->sub);
     return dist;
 }
 

@@ -88,6 +88,7 @@ int cli_once(const char *sub, int c, uint32_t *seen)
                 {OPT_MEMORY, "--memory"},
                 {OPT_START, "--start"},
                 {OPT_MAP, "--map"},
+                {OPT_DISTANCES, "--distances"},
                 {'k', "-k/--count"}};
     for (unsigned i = 0; i < sizeof once / sizeof once[0]; i++) {
         if (once[i].code != c)
@@ -389,47 +390,6 @@ int cli_put_double(FILE *f, double x)
     if (mfmm_io_format_double(buf, sizeof buf, x) < 0)
         return EOF;
     return fputs(buf, f);
-}
-
-mfmm_mesh *cli_load_mesh(const char *path, const mfmm_mesh_options *options,
-                         uint8_t **in_no_face)
-{
-    double *V = NULL;
-    int32_t *F = NULL, nv = 0, nf = 0;
-    mfmm_error err;
-    if (in_no_face)
-        *in_no_face = NULL;
-    mfmm_status st = mfmm_load_mesh(path, &V, &nv, &F, &nf, &err);
-    if (st != MFMM_OK) {
-        cli_error("%s", err.message);
-        return NULL;
-    }
-    mfmm_mesh *mesh = NULL;
-    st = mfmm_mesh_create(V, nv, F, nf, options, &mesh, &err);
-    mfmm_mesh_info info = {.struct_size = sizeof info};
-    if (st == MFMM_OK && in_no_face && mfmm_mesh_get_info(mesh, &info) == MFMM_OK &&
-        info.n_unreferenced_vertices > 0) {
-        /* (F's ids are in range: the mesh was built from it) */
-        uint8_t *flag = malloc((size_t)nv);
-        if (!flag) {
-            mfmm_mesh_destroy(mesh);
-            mesh = NULL;
-            st = MFMM_ERR_OUT_OF_MEMORY;
-            snprintf(err.message, sizeof err.message, "out of memory");
-        } else {
-            memset(flag, 1, (size_t)nv);
-            for (int64_t i = 0; i < 3 * (int64_t)nf; i++)
-                flag[F[i]] = 0;
-            *in_no_face = flag;
-        }
-    }
-    mfmm_free(V);
-    mfmm_free(F);
-    if (st != MFMM_OK) {
-        cli_error("%s: %s", path, err.message);
-        return NULL;
-    }
-    return mesh;
 }
 
 void cli_note_sources_in_no_face(const char *sub, int64_t count, int32_t first)

@@ -40,12 +40,25 @@ value() { awk -F: -v k="$1" '$1 == k { gsub(/ /, "", $2); print $2 }' "$2"; }
 expect 0 "--version" "$BIN" --version && grep -q '^meshfmm [0-9]*\.[0-9]*\.[0-9]*$' "$T/out" ||
     fail "--version output: $(cat "$T/out")"
 expect 0 "--help" "$BIN" --help
-for c in info distance generate path allpairs; do
+for c in info distance generate path allpairs landmarks voronoi weld; do
     expect 0 "$c --help" "$BIN" "$c" --help && grep -q "usage: meshfmm $c" "$T/out" ||
         fail "$c --help text"
 done
 expect 2 "no command" "$BIN"
 expect 2 "unknown command" "$BIN" frobnicate
+# the Python package's commands: listed, and named when given here
+"$BIN" --help | grep -q '^  render ' && "$BIN" --help | grep -q '^  isolines ' &&
+    "$BIN" --help | grep -q 'python -m meshfmm' && ok "--help lists the python commands" ||
+    fail "--help lacks the python commands"
+for c in render isolines; do
+    expect 2 "$c (a python command)" "$BIN" "$c" x.obj -o x.png &&
+        grep -q "python -m meshfmm $c" "$T/err" || fail "$c: no pointer to python -m meshfmm"
+done
+expect 2 "voronoi without a source" "$BIN" voronoi "$DATA/meshes/hand_lowres.obj" -o "$T/l.npy"
+expect 2 "voronoi --distances with a bad extension" "$BIN" voronoi "$DATA/meshes/hand_lowres.obj" --source 0 --distances "$T/d.csv" -o "$T/l.npy"
+expect 2 "voronoi --distances twice" "$BIN" voronoi "$DATA/meshes/hand_lowres.obj" --source 0 --distances "$T/d.npy" --distances "$T/e.npy" -o "$T/l.npy"
+expect 1 "distance --weld source out of range" "$BIN" distance "$DATA/meshes/hand_lowres.obj" --weld --source 810 -o "$T/d.txt" &&
+    grep -q "vertex 810 is outside \[0, 810)" "$T/err" || fail "--weld range message: $(cat "$T/err")"
 expect 2 "info without a mesh" "$BIN" info
 expect 2 "info unknown option" "$BIN" info --bogus x.obj
 expect 2 "distance without a source" "$BIN" distance "$DATA/meshes/hand_lowres.obj" -o "$T/d.txt"

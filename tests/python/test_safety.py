@@ -231,6 +231,52 @@ def test_open_memmap_writes_a_valid_npy(tmp_path):
     assert E.shape == (3, 4) and E.dtype == np.float64 and not E.any()
 
 
+class _Usage:
+    def __init__(self, free):
+        self.total, self.used, self.free = 10 * free + 1, 9 * free + 1, free
+
+
+def test_open_memmap_compares_the_size_with_the_free_space(tmp_path, monkeypatch):
+    """open_memmap asks shutil.disk_usage about the file's folder before
+    touching the file: a file larger than the free space is refused with
+    both numbers (header included) and nothing written; one that fits, a
+    file it replaces (its blocks count as free) and size_check=False go
+    ahead."""
+    asked = []
+
+    def usage(free):
+        def disk_usage(path):
+            asked.append(os.fspath(path))
+            return _Usage(free)
+        return disk_usage
+
+    path = tmp_path / "m.npy"
+    need = 100 * 200 * 8 + 128                       # float64 (100, 200) and its header
+    monkeypatch.setattr(shutil, "disk_usage", usage(need - 1))
+    with pytest.raises(OSError) as info:
+        meshfmm.open_memmap(path, (100, 200), np.float64)
+    assert info.value.errno == errno.ENOSPC and info.value.filename == str(path)
+    assert "160 kB (160128 bytes)" in str(info.value)
+    assert "160 kB (160127 bytes) free" in str(info.value)
+    assert asked == [str(tmp_path)] and not path.exists()
+    D = meshfmm.open_memmap(path, (100, 200), np.float64, size_check=False)
+    assert D.shape == (100, 200) and os.path.getsize(path) == need
+    del D
+    # the file it replaces frees its blocks: the same size fits again
+    monkeypatch.setattr(shutil, "disk_usage", usage(1000))
+    D = meshfmm.open_memmap(path, (100, 200), np.float64)
+    del D
+    os.remove(path)
+    with pytest.raises(OSError, match="160 kB"):
+        meshfmm.open_memmap(path, (100, 200), np.float64)
+    monkeypatch.setattr(shutil, "disk_usage", usage(need))
+    D = meshfmm.open_memmap(path, (100, 200), np.float64)
+    assert D.shape == (100, 200) and not D.any()
+    del D
+    with pytest.raises(TypeError, match="size_check"):
+        meshfmm.open_memmap(path, (1, 1), size_check="no")
+
+
 def _tmpfs(size: str):
     """A fresh tmpfs of `size`, or a skip saying why there is none."""
     if not hasattr(os, "geteuid") or os.geteuid() != 0:
@@ -258,14 +304,23 @@ def small_tmpfs():
 
 
 def test_open_memmap_full_disk_raises_enospc_up_front(small_tmpfs):
-    """On a 1 MiB file system a 2 MiB matrix: OSError(ENOSPC) at once and no
-    file left behind (numpy's open_memmap makes a sparse file there, and the
-    process dies of SIGBUS half-way through the rows)."""
+    """On a 1 MiB file system a 2 MiB matrix: refused with both sizes before
+    the file is made; with size_check=False, OSError(ENOSPC) when its blocks
+    are reserved, at once and no file left behind (numpy's open_memmap makes
+    a sparse file there, and the process dies of SIGBUS half-way through the
+    rows)."""
     path = small_tmpfs / "big.npy"
     with pytest.raises(OSError) as info:
         meshfmm.open_memmap(path, (724, 724), "float32")
+    free = shutil.disk_usage(small_tmpfs).free
+    assert info.value.errno == errno.ENOSPC and info.value.filename == str(path)
+    assert f"({724 * 724 * 4 + 128} bytes)" in str(info.value)
+    assert f"({free} bytes) free" in str(info.value) and "size_check=False" in str(info.value)
+    assert not path.exists()
+    with pytest.raises(OSError) as info:
+        meshfmm.open_memmap(path, (724, 724), "float32", size_check=False)
     assert info.value.errno == errno.ENOSPC
-    assert str(path) in str(info.value)
+    assert "cannot reserve" in str(info.value) and str(path) in str(info.value)
     assert not path.exists()
     # what fits still works, and the space is really taken
     m = meshfmm.Mesh(*grid(15))

@@ -219,6 +219,43 @@ def test_isolines_cross_faces_where_the_interpolant_says():
     assert m.isolines(d, 1e9) == [[]]
 
 
+def test_isolines_of_many_values_at_once_on_a_non_manifold_mesh():
+    """beetle.obj has non-manifold edges (more than two segments meet at
+    some crossing points) and unreached vertices under a radius: many
+    values in one call, values at vertices' own values and out of range,
+    each value's segments where the linear interpolant says, one per crossed
+    face, and equal to the value asked alone."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshWarning)
+        m = meshfmm.Mesh.from_file(MESHES / "beetle.obj")
+    assert m.info.n_nonmanifold_edges > 0
+    d = m.distance([0, 500], max_distance=0.6)
+    assert np.isinf(d).any()
+    top = d[np.isfinite(d)].max()
+    levels = [*np.linspace(0.02, 0.98, 25) * top, d[3], d[3], -1.0, 10 * top]
+    res = m.isolines(d, levels)
+    F, V = m.faces, m.vertices
+    for c, lines in zip(levels, res):
+        assert lines == [] if not 0 < c <= top else lines
+        seen = []
+        for ln in lines:
+            assert ln.value == c
+            vals = (ln.barycentric * d[F[ln.faces]]).sum(axis=1)
+            assert np.allclose(vals, c, rtol=0, atol=1e-12)
+            xyz = np.einsum("ij,ijk->ik", ln.barycentric, V[F[ln.faces]])
+            assert np.allclose(xyz, ln.points, atol=1e-12)
+            seen.extend(ln.faces[1:].tolist())
+        with np.errstate(invalid="ignore"):
+            A = d[F] >= c
+        crossed = np.flatnonzero(np.isfinite(d[F]).all(axis=1) & A.any(axis=1) & ~A.all(axis=1))
+        assert sorted(seen) == crossed.tolist()
+        alone = m.isolines(d, c)[0]
+        assert len(alone) == len(lines)
+        for a, b in zip(alone, lines):
+            assert np.array_equal(a.points, b.points) and np.array_equal(a.faces, b.faces)
+            assert np.array_equal(a.barycentric, b.barycentric) and a.closed == b.closed
+
+
 # ---------------------------------------------------------------- paths
 @pytest.mark.parametrize("source,target", [(0, 1234),
                                            (SurfacePoint(100, (0.3, 0.3, 0.4)),
@@ -387,7 +424,7 @@ def test_every_cli_help_lists_every_option():
             names.discard("source")  # a trap for --source, not an option (--sources is)
         if "CLI_SHARED_LONG_OPTIONS" in table:
             names |= {"help", "output", "source", "face-source", "cost", "cost-per-face",
-                      "plain-start", "exact-start-radius"}
+                      "plain-start", "exact-start-radius", "weld"}
         helptext = subprocess.run([cli, sub, "--help"], capture_output=True, text=True).stdout
         missing = [n for n in names if not re.search(rf"--{n}\b", helptext)]
         assert not missing, f"meshfmm {sub} --help lacks {missing}"

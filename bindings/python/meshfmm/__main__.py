@@ -4,9 +4,11 @@ console script that ``pip install .`` installs.
 The commands are the C command line's (src/cli), built into the wheel as
 ``meshfmm/_bin/meshfmm``: this wrapper replaces itself with that binary
 (os.execv), so arguments, output, signals (Ctrl-C) and exit codes are the
-binary's own. Only ``allpairs ... -o OUT.zarr`` (Dask + Zarr) and ``render``
-(a picture, :mod:`meshfmm.plot`) are Python's, dispatched in :func:`main`
-before the exec.
+binary's own. Only ``allpairs ... -o OUT.zarr`` (Dask + Zarr) and the
+commands in :data:`PYTHON_COMMANDS` (``render``, a picture by
+:mod:`meshfmm.plot`; ``isolines``, polylines by :meth:`Mesh.isolines`) are
+Python's, dispatched in :func:`main` before the exec; the C command's
+``--help`` lists them under "python commands".
 """
 
 from __future__ import annotations
@@ -16,9 +18,26 @@ import sys
 from pathlib import Path
 from typing import List, Optional
 
-__all__ = ["main", "cli_path"]
+__all__ = ["main", "cli_path", "PYTHON_COMMANDS"]
 
 _NAME = "meshfmm.exe" if sys.platform == "win32" else "meshfmm"
+
+#: The commands this package runs itself, with the line the C command's
+#: ``--help`` gives each (src/cli/main.c lists the same).
+PYTHON_COMMANDS = {
+    "render": "a PNG of a distance field with isolines and paths (matplotlib)",
+    "isolines": "isolines of a distance field as polylines (.obj or .csv)",
+}
+
+
+def _run_python_command(name: str, args: List[str]) -> int:
+    if name == "render":
+        from .plot import cli_render
+
+        return cli_render(args)
+    from ._isolines import cli_isolines
+
+    return cli_isolines(args)
 
 
 def cli_path() -> Optional[str]:
@@ -95,9 +114,9 @@ def _allpairs_help() -> int:
 def main(argv: Optional[List[str]] = None) -> int:
     """Runs the ``meshfmm`` command.
 
-    ``render`` and ``allpairs ... -o OUT.zarr`` (the Dask + Zarr job) run
-    in Python; every other command replaces this process with the C
-    command line (``os.execv``), so it does not return.
+    ``render``, ``isolines`` and ``allpairs ... -o OUT.zarr`` (the Dask +
+    Zarr job) run in Python; every other command replaces this process with
+    the C command line (``os.execv``), so it does not return.
 
     Parameters
     ----------
@@ -113,15 +132,23 @@ def main(argv: Optional[List[str]] = None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
     if args and args[0] == "allpairs" and any(a in ("-h", "--help") for a in args[1:]):
         return _allpairs_help()
-    if args and args[0] == "render":
-        from .plot import cli_render
-
-        return cli_render(args[1:])
+    if args and args[0] in PYTHON_COMMANDS:
+        return _run_python_command(args[0], args[1:])
     if args and args[0] == "allpairs":
         out = _output(args[1:])
         if out is not None and out.rstrip("/").lower().endswith(".zarr"):
             return _allpairs_zarr(args[1:])
     exe = cli_path()
+    if exe is None and (not args or args[0] in ("-h", "--help", "help")):
+        # the C command's help lists its own commands; without it, these
+        print("usage: meshfmm COMMAND [ARGS]   (meshfmm COMMAND --help for details)\n\n"
+              "The command-line binary is not installed with this package; its commands\n"
+              "(info, distance, path, allpairs, ...) need `pip install .` at the repository\n"
+              "root or MESHFMM_CLI naming a built build/meshfmm.\n\n"
+              "python commands (python -m meshfmm COMMAND --help for details):")
+        for name, line in PYTHON_COMMANDS.items():
+            print(f"  {name:<10} {line}")
+        return 0 if args else 2
     if exe is None:
         sys.stderr.write(
             "meshfmm: the command-line binary is not installed with this package "

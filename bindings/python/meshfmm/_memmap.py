@@ -1,16 +1,21 @@
-"""open_memmap: a .npy file on disk for a matrix bigger than memory, with its
-space reserved up front.
+"""open_memmap: a .npy file on disk for a matrix bigger than memory, its size
+compared with the free space first and its space reserved up front.
 
 numpy.lib.format.open_memmap makes a sparse file: the disk blocks are only
 taken when rows are written, so a full disk shows up half-way through as
 SIGBUS (the process dies) and leaves a full-size .npy that looks complete.
-Reserving the blocks first turns that into an OSError(ENOSPC) before any work.
+Comparing the size with the file system's free space refuses such a job
+with both numbers before the file is touched; reserving the blocks turns
+what the comparison cannot see (a quota, another writer) into an
+OSError(ENOSPC) before any work.
 """
 
 from __future__ import annotations
 
 import errno
+import io
 import os
+import shutil
 from typing import Any, Tuple, Union
 
 import numpy as np
@@ -40,14 +45,42 @@ def _reserve(fd: int, offset: int, length: int) -> None:
     os.fsync(fd)
 
 
+def _check_free_space(fspath: str, nbytes: int) -> None:
+    """Refuses (OSError ENOSPC, with both numbers) a file of `nbytes` that
+    the free space of its folder's file system cannot hold; a file already
+    at `fspath`, which the new one replaces, counts as free."""
+    from ._guards import format_bytes
+
+    folder = os.path.dirname(os.path.abspath(fspath))
+    try:
+        free = shutil.disk_usage(folder).free
+    except OSError:
+        return  # the folder's own error comes when the file is created
+    try:
+        if os.path.isfile(fspath):
+            free += os.stat(fspath).st_blocks * 512
+    except (OSError, AttributeError):
+        pass
+    if nbytes > free:
+        raise OSError(
+            errno.ENOSPC,
+            f"the array would take {format_bytes(nbytes)} ({nbytes} bytes) on disk but its "
+            f"file system has {format_bytes(free)} ({free} bytes) free; write it elsewhere, "
+            "ask for fewer rows or columns, or pass size_check=False to try anyway",
+            fspath,
+        )
+
+
 def open_memmap(path: Union[str, "os.PathLike[str]"], shape: Tuple[int, ...],
-                dtype: Any = "float32") -> np.memmap:
+                dtype: Any = "float32", *, size_check: bool = True) -> np.memmap:
     """A .npy file on disk, its full size reserved, memory-mapped for writing.
 
-    Creates (or truncates) the file for a C-order array, reserves its blocks
-    on disk, and returns it ready for ``Mesh.distance_matrix(out=...)``.
-    Without the reservation a full disk would show up half-way through as
-    SIGBUS. The contents read as zeros until written: to tell a finished
+    Compares the file's size with the free space of its file system (unless
+    ``size_check=False``), creates (or truncates) the file for a C-order
+    array, reserves its blocks on disk, and returns it ready for
+    ``Mesh.distance_matrix(out=...)``. Without the reservation a full disk
+    would show up half-way through as SIGBUS. The contents read as zeros
+    until written: to tell a finished
     matrix from an interrupted one, write to a temporary name and rename it
     when the job has returned::
 
@@ -64,6 +97,12 @@ def open_memmap(path: Union[str, "os.PathLike[str]"], shape: Tuple[int, ...],
         The array's shape, each >= 0.
     dtype : numpy dtype
         The array's dtype (default float32).
+    size_check : bool
+        True (default): before touching the file, compare its size (header
+        included) with the free space of the file system that holds its
+        folder (``shutil.disk_usage``; a file it replaces counts as free)
+        and refuse with both numbers. False skips the comparison; the
+        reservation still fails at once on a full disk.
 
     Returns
     -------
@@ -73,9 +112,10 @@ def open_memmap(path: Union[str, "os.PathLike[str]"], shape: Tuple[int, ...],
     Raises
     ------
     OSError
-        errno ENOSPC ("No space left on device") at once when the disk
-        cannot hold the file (the file is removed), or another error
-        creating it.
+        errno ENOSPC: the file would not fit in the free space (both sizes
+        in the message; nothing is created or truncated), or the disk
+        cannot hold it when its blocks are reserved ("No space left on
+        device"; the file is removed); or another error creating it.
     ValueError
         A negative dimension.
     """
@@ -91,6 +131,12 @@ def open_memmap(path: Union[str, "os.PathLike[str]"], shape: Tuple[int, ...],
     nbytes = dt.itemsize
     for n in shape:
         nbytes *= n
+    if not isinstance(size_check, (bool, np.bool_)):
+        raise TypeError(f"size_check must be True or False, got {size_check!r}")
+    if size_check:
+        with io.BytesIO() as head:
+            np.lib.format.write_array_header_1_0(head, header)
+            _check_free_space(fspath, head.tell() + nbytes)
     fd = os.open(fspath, os.O_RDWR | os.O_CREAT | os.O_TRUNC, 0o666)
     try:
         with os.fdopen(os.dup(fd), "wb") as f:

@@ -974,7 +974,8 @@ class Mesh:
         """Isolines of a per-vertex field at given values, as polylines.
 
         Where the linear interpolant of ``distances`` over each face equals a
-        value: one pass over the faces per value, segments joined through
+        value: one pass over the faces for all the values (which values each
+        face's corners straddle), then the segments found, joined through
         their shared edges. A corner counts as above a level when its value
         is >= it; faces with an infinite corner hold no segment.
 
@@ -1000,12 +1001,9 @@ class Mesh:
             raise ValueError("values must be finite numbers")
         if self._weld is not None:
             d = self._weld.distances_in(d)
-        out = []
-        for c in vals:
-            lines = _isolines.isolines(self._V, self._F, d, float(c))
-            if self._weld is not None:
-                lines = _isolines.fix_faces(lines, self._weld.faces_out)
-            out.append(lines)
+        out = _isolines.isolines(self._V, self._F, d, vals)
+        if self._weld is not None:
+            out = [_isolines.fix_faces(lines, self._weld.faces_out) for lines in out]
         return out
 
     # ---- many sources

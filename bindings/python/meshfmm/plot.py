@@ -18,7 +18,7 @@ from typing import Any, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from . import _extras
+from . import _extras, _isolines
 
 __all__ = ["render", "default_view", "isoline_segments"]
 
@@ -73,43 +73,26 @@ def isoline_segments(vertices: Any, faces: Any, values: Any,
                      level: float) -> Tuple[np.ndarray, np.ndarray]:
     """Where the linear interpolant of `values` over each face equals `level`.
 
-    A face whose corners are not all on one side of `level` (corners equal
-    to it count as above) holds one segment, between the two points where
-    its edges cross, each found by linear interpolation along the edge.
-    Faces with a non-finite value hold none.
+    The segments that :meth:`Mesh.isolines <meshfmm.Mesh.isolines>` joins
+    into polylines, unjoined: a face whose corners are not all on one side
+    of `level` (corners equal to it count as above) holds one segment,
+    between the two points where its edges cross, each found by linear
+    interpolation along the edge. Faces with a non-finite value hold none.
 
     Returns
     -------
     segments : numpy.ndarray, float64 (k, 2, 3)
         The segments' end points.
     faces : numpy.ndarray, int64 (k,)
-        The face of each segment.
+        The face of each segment, ascending.
     """
-    V = np.asarray(vertices, dtype=np.float64)
-    F = np.asarray(faces, dtype=np.int64)
-    d = np.asarray(values, dtype=np.float64)[F]  # (m, 3)
-    ok = np.isfinite(d).all(axis=1)
-    above = d >= level
-    edges = ((0, 1), (1, 2), (2, 0))
-    cross = np.stack([above[:, i] != above[:, j] for i, j in edges], axis=1) & ok[:, None]
-    hit = np.nonzero(cross.any(axis=1))[0]
-    if hit.size == 0:
-        return np.empty((0, 2, 3)), np.empty(0, np.int64)
-    pts = np.empty((hit.size, 3, 3))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        for e, (i, j) in enumerate(edges):
-            a, b = d[hit, i], d[hit, j]
-            t = np.clip((level - a) / (b - a), 0.0, 1.0)
-            t = np.where(np.isfinite(t), t, 0.0)
-            pi, pj = V[F[hit, i]], V[F[hit, j]]
-            pts[:, e] = pi + t[:, None] * (pj - pi)
-    c = cross[hit]
-    # exactly two of the three edges cross: take them in edge order
-    first = np.argmax(c, axis=1)
-    second = 2 - np.argmax(c[:, ::-1], axis=1)
-    rows = np.arange(hit.size)
-    seg = np.stack([pts[rows, first], pts[rows, second]], axis=1)
-    return seg, hit
+    V = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
+    F = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    d = np.asarray(values, dtype=np.float64).ravel()
+    if d.shape[0] != V.shape[0]:
+        raise ValueError(f"values has {d.shape[0]} entries for {V.shape[0]} vertices")
+    fids, seg, _, _ = _isolines.crossings(V, F, d, float(level))
+    return seg, fids
 
 
 def _levels(isolines: Union[None, int, Sequence[float]], lo: float, hi: float) -> np.ndarray:
@@ -271,10 +254,9 @@ def render(mesh: Any, distances: Any, path_png: Union[str, "os.PathLike[str]"], 
     on_top: List[Tuple[np.ndarray, Any]] = []
 
     iso_half = 0.0018 * scale * 800.0 / max(width, height) + 0.0008 * scale
-    for level in _levels(isolines, lo, hi):
-        seg, seg_faces = isoline_segments(V, F, d, level)
-        if seg.shape[0] == 0:
-            continue
+    # every level's segments from one pass over the faces
+    _, seg_faces, seg, _, _ = _isolines.segments(V, F, d, _levels(isolines, lo, hi))
+    if seg.shape[0]:
         p = np.stack([seg[:, 0] @ right, seg[:, 0] @ upv], axis=1)
         q = np.stack([seg[:, 1] @ right, seg[:, 1] @ upv], axis=1)
         polys.append(_quads(p, q, iso_half))
