@@ -626,7 +626,7 @@ struct mfmm_opencl_options {
      * $XDG_CACHE_HOME/meshfmm, else $HOME/.cache/meshfmm. "": no disk cache. */
     const char *cache_dir;
     /* The OpenCL ICD loader to open. NULL: $MESHFMM_OPENCL_LIBRARY, else
-     * "libOpenCL.so.1". */
+     * "libOpenCL.so.1" (macOS: the OpenCL framework). */
     const char *library;
 };
 

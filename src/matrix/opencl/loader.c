@@ -30,13 +30,21 @@ static const struct {
     MFMM_CL_ENTRY(clGetEventInfo),         MFMM_CL_ENTRY(clReleaseEvent),
 };
 
+/* The system's OpenCL loader: a framework on macOS, the ICD loader's soname
+ * elsewhere. */
+#ifdef __APPLE__
+#define MFMM_CL_DEFAULT_LIBRARY "/System/Library/Frameworks/OpenCL.framework/OpenCL"
+#else
+#define MFMM_CL_DEFAULT_LIBRARY "libOpenCL.so.1"
+#endif
+
 mfmm_status mfmm_cl_api_load(mfmm_cl_api *api, const char *library, mfmm_error *err)
 {
     memset(api, 0, sizeof *api);
     if (!library || !*library)
         library = getenv("MESHFMM_OPENCL_LIBRARY");
     if (!library || !*library)
-        library = "libOpenCL.so.1";
+        library = MFMM_CL_DEFAULT_LIBRARY;
     void *h = dlopen(library, RTLD_NOW | RTLD_LOCAL);
     if (!h) {
         const char *why = dlerror();
