@@ -491,6 +491,65 @@ MFMM_API mfmm_status mfmm_voronoi_labels(const mfmm_mesh *mesh, const double *di
                                          const mfmm_source *sources, int32_t n_sources,
                                          int32_t *labels, mfmm_error *err);
 
+/* One polyline of mfmm_isolines: points[start .. start + n_points) of the
+ * call's points. */
+typedef struct mfmm_isoline {
+    int64_t start;    /* its first point's index in points */
+    int64_t n_points; /* >= 2: its segments plus one */
+    int32_t value;    /* its level: an index into values */
+    int32_t closed;   /* 1: a loop, its last point at the first's position (on
+                         the face of its last segment); 0: it ends at a
+                         boundary, a face with a non-finite corner or a
+                         non-manifold edge */
+} mfmm_isoline;
+
+/* Isolines of a per-vertex field: for each of `values`, where the linear
+ * interpolant of `field` over each face equals it, as polylines. One pass
+ * over the faces for all the values (each vertex's rank among the sorted
+ * values; a face crosses the values between its corners' least and
+ * greatest rank), then work in proportion to the segments found.
+ * A corner counts as above a value when field >= value; a face whose
+ * corners are not all on one side holds one segment per value, between the
+ * two points where its edges cross; a face with a non-finite corner holds
+ * none. Each crossing point is interpolated along its edge from the edge's
+ * lower vertex id p to the higher q (t = (value - field[p]) / (field[q] -
+ * field[p]), xyz = p + t (q - p), barycentric 1 - t at p and t at q), so
+ * that faces sharing an edge share the point bit for bit.
+ * Each value's segments are joined through the edges they share. Its
+ * polylines come in this order: first those with an end where a segment
+ * meets no other (a boundary, a face with a non-finite corner), each from
+ * that end, by the end's edge (lower vertex id, then higher); then the
+ * others (loops; lines between non-manifold edges), each from the first
+ * segment not yet used (faces ascending) at the crossing on its face's
+ * lower-numbered edge (edge k is opposite corner k). Where more than two
+ * segments meet at an edge (a non-manifold edge), a polyline goes on with
+ * the first one not yet used (faces ascending). On a mesh whose
+ * T-junctions were closed (section 3) the faces are those built: a split
+ * face's pieces, each point's face and coordinates mapped to the face as
+ * given, and a dropped needle holds none.
+ *   field:    (nv,) float64, one value per vertex (e.g. distances); no
+ *             NaN; +-inf allowed (faces with such a corner hold none).
+ *   values:   (n_values,) the levels: finite, any order, repeats allowed
+ *             (each has its own polylines); NULL when n_values is 0.
+ *   points:   out: (*n_points,) the polylines' points one after another;
+ *             points[i].face (i > a polyline's start) is the face the
+ *             segment from point i-1 runs through, the start's face that of
+ *             the point after it; bary: coordinates in that face; xyz: the
+ *             position. Allocated by the library (free with mfmm_free); NULL
+ *             when *n_points is 0 and on failure.
+ *   n_points: out: the count: the segments plus *n_lines.
+ *   lines:    out: (*n_lines,) the polylines by value index, each value's
+ *             in the order above; allocated by the library (mfmm_free);
+ *             NULL when *n_lines is 0 and on failure.
+ *   n_lines:  out: the count.
+ * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_COUNT (n_values < 0);
+ * MFMM_ERR_BAD_ARGUMENT (a value not finite, err->index: its index; a NaN
+ * in field, err->index: its vertex); MFMM_ERR_OUT_OF_MEMORY. Thread-safe. */
+MFMM_API mfmm_status mfmm_isolines(const mfmm_mesh *mesh, const double *field,
+                                   const double *values, int32_t n_values,
+                                   mfmm_surface_point **points, int64_t *n_points,
+                                   mfmm_isoline **lines, int64_t *n_lines, mfmm_error *err);
+
 /* ================================================== 8. distance matrices */
 
 typedef enum mfmm_backend {

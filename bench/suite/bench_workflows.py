@@ -3,12 +3,12 @@
 default single-source solve; Voronoi labels of 8 sources
 (``Mesh.voronoi_labels`` given the distances: one pass over the vertices'
 edges in C) against the 8-source solve they follow; isolines at 10 values
-(``Mesh.isolines``: one pass over the faces for all values, the crossing
-points of the faces found, then the joins into polylines; the segments
-alone, as ``meshfmm.plot`` draws them, timed apart) against one numpy pass
-over the faces (each face's three corner values gathered, their min and
-max). The claim measured: each costs at most about one extra pass over the
-faces after the solve.
+(``Mesh.isolines``: in C, ``mfmm_isolines``, one pass over the faces for all
+values, the crossing points of the faces found and joined into polylines;
+then Python's Isoline objects. The C call alone, its arrays copied out, is
+timed apart) against one numpy pass over the faces (each face's three
+corner values gathered, their min and max). The claim measured: each
+costs at most about one extra pass over the faces after the solve.
 
 Writes bench/results/workflows.json. Not a test: timings on a shared
 machine are noisy; the best of a few rounds is reported.
@@ -52,7 +52,6 @@ def face_pass(d: np.ndarray, F: np.ndarray):
 
 def bench_mesh(name: str, rounds: int) -> dict:
     import meshfmm
-    from meshfmm import _isolines
 
     V, F = load_data(name)
     mesh = meshfmm.Mesh(V, F)
@@ -73,10 +72,9 @@ def bench_mesh(name: str, rounds: int) -> dict:
     finite = d1[np.isfinite(d1)]
     values = finite.max() * np.arange(1, 11) / 11.0
     r["isolines_10_s"], lines = best_of(rounds, lambda: mesh.isolines(d1, values))
-    Vi = np.asarray(mesh.vertices)
-    r["isoline_segments_10_s"], seg = best_of(
-        rounds, lambda: _isolines.segments(Vi, Fi, d1, values))
-    r["isoline_segments"] = int(seg[0].size)
+    r["isolines_c_10_s"], (pts, polys) = best_of(
+        rounds, lambda: mesh._isoline_records(d1, values))
+    r["isoline_segments"] = int(pts.shape[0] - polys.shape[0])
     r["isolines_polylines"] = int(sum(len(x) for x in lines))
     r["isolines_points"] = int(sum(len(ln) for x in lines for ln in x))
 
@@ -85,7 +83,7 @@ def bench_mesh(name: str, rounds: int) -> dict:
     r["isolines_10_over_face_pass"] = r["isolines_10_s"] / r["face_pass_s"]
     r["isolines_per_value_over_face_pass"] = r["isolines_10_over_face_pass"] / 10
     r["isolines_10_over_solve_1"] = r["isolines_10_s"] / r["solve_1_s"]
-    r["isoline_segments_10_over_face_pass"] = r["isoline_segments_10_s"] / r["face_pass_s"]
+    r["isolines_c_10_over_face_pass"] = r["isolines_c_10_s"] / r["face_pass_s"]
     r["face_pass_over_solve_1"] = r["face_pass_s"] / r["solve_1_s"]
     return r
 
@@ -119,9 +117,9 @@ def main() -> None:
               f"({r['isolines_per_value_over_face_pass']:.2f} per value), "
               f"{r['isolines_10_over_solve_1']:.3f} x the 1-source solve; "
               f"{r['isolines_polylines']} polylines")
-        print(f"    of which the segments  {ms(r['isoline_segments_10_s'])}   "
-              f"{r['isoline_segments_10_over_face_pass']:.2f} x a face pass; "
-              f"{r['isoline_segments']} segments (the rest: joining them, in Python)")
+        print(f"    of which the C call    {ms(r['isolines_c_10_s'])}   "
+              f"{r['isolines_c_10_over_face_pass']:.2f} x a face pass; "
+              f"{r['isoline_segments']} segments (the rest: Isoline objects, in Python)")
     print(f"wrote {out}")
 
 

@@ -1,6 +1,7 @@
 /* Coincident vertices in mfmm_mesh_info, farthest-point sampling against a
- * loop of full solves, and Voronoi labels against the argmin over
- * single-source solves. */
+ * loop of full solves, Voronoi labels against the argmin over single-source
+ * solves, and isolines against analytic lines and each face's linear
+ * interpolant. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -201,6 +202,271 @@ static void test_voronoi_argmin(void **state)
     mfmm_gen_free(&g);
 }
 
+
+/* Checks mfmm_isolines' result on mesh (V, F as given): the lines by
+ * value, their points one after another; each point on its face (its
+ * coordinates >= 0, one 0, summing to 1, its position their combination of
+ * the corners) where the face's linear interpolant is the value (to 1e-12
+ * of `scale`); a polyline's first point on its second's face; a loop's last
+ * point at the first's position; and per value, one segment in each face
+ * whose finite corners straddle it, no other. Returns the lines per value
+ * in counts (n_values). */
+static void check_isolines(const double *V, const int32_t *F, int32_t nf, const double *field,
+                           const double *values, int32_t n_values, double scale,
+                           const mfmm_surface_point *pts, int64_t n_pts,
+                           const mfmm_isoline *lines, int64_t n_lines, int32_t *counts)
+{
+    int64_t next = 0;
+    for (int32_t j = 0; j < n_values; j++)
+        counts[j] = 0;
+    for (int64_t l = 0; l < n_lines; l++) {
+        const mfmm_isoline *L = lines + l;
+        assert_int_equal(L->start, next);
+        assert_true(L->n_points >= 2);
+        assert_true(L->value >= 0 && L->value < n_values);
+        assert_true(l == 0 || lines[l - 1].value <= L->value);
+        assert_true(L->closed == 0 || L->closed == 1);
+        next += L->n_points;
+        counts[L->value]++;
+        double c = values[L->value];
+        const mfmm_surface_point *P = pts + L->start;
+        assert_int_equal(P[0].face, P[1].face);
+        if (L->closed)
+            assert_memory_equal(P[0].xyz, P[L->n_points - 1].xyz, sizeof P[0].xyz);
+        for (int64_t i = 0; i < L->n_points; i++) {
+            int32_t f = P[i].face;
+            assert_true(f >= 0 && f < nf);
+            const double *b = P[i].bary;
+            assert_true(b[0] >= 0.0 && b[1] >= 0.0 && b[2] >= 0.0);
+            assert_true(b[0] == 0.0 || b[1] == 0.0 || b[2] == 0.0);
+            tm_assert_close(b[0] + b[1] + b[2], 1.0, 1e-12);
+            double val = 0.0, x[3] = {0.0, 0.0, 0.0};
+            for (int k = 0; k < 3; k++) {
+                int32_t v = F[3 * f + k];
+                val += b[k] * field[v];
+                for (int d = 0; d < 3; d++)
+                    x[d] += b[k] * V[3 * v + d];
+            }
+            tm_assert_close(val, c, 1e-12 * scale);
+            for (int d = 0; d < 3; d++)
+                tm_assert_close(x[d], P[i].xyz[d], 1e-12);
+        }
+    }
+    assert_int_equal(next, n_pts);
+    /* the crossed faces, value by value */
+    for (int32_t j = 0; j < n_values; j++) {
+        int32_t *mine = calloc((size_t)nf, sizeof *mine);
+        assert_non_null(mine);
+        for (int64_t l = 0; l < n_lines; l++)
+            if (lines[l].value == j)
+                for (int64_t i = 1; i < lines[l].n_points; i++)
+                    mine[pts[lines[l].start + i].face]++;
+        for (int32_t f = 0; f < nf; f++) {
+            int finite = 1, above = 0;
+            for (int k = 0; k < 3; k++) {
+                double x = field[F[3 * f + k]];
+                finite &= isfinite(x) != 0;
+                above += x >= values[j];
+            }
+            assert_int_equal(mine[f], finite && above > 0 && above < 3);
+        }
+        free(mine);
+    }
+}
+
+static void test_isolines_of_a_linear_field_on_a_grid(void **state)
+{
+    (void)state;
+    /* f = 8 x + 4 y on the unit square: i + j / 2 at vertex (i, j) / 8;
+     * the levels 2.3, 5.25, 9.7 meet no vertex, 3 and 6.5 meet some, -1
+     * and 13 none of the square */
+    mfmm_gen_mesh g = mfmm_gen_grid(8);
+    mfmm_mesh *mesh = tm_make(&g);
+    double *f = malloc((size_t)g.nv * sizeof *f);
+    assert_non_null(f);
+    for (int32_t v = 0; v < g.nv; v++)
+        f[v] = 8.0 * g.V[3 * v] + 4.0 * g.V[3 * v + 1];
+    enum { NVAL = 7 };
+    const double values[NVAL] = {5.25, 2.3, 13.0, 9.7, 3.0, -1.0, 6.5};
+    mfmm_surface_point *pts = NULL;
+    mfmm_isoline *lines = NULL;
+    int64_t n_pts = -1, n_lines = -1;
+    mfmm_error err;
+    assert_int_equal(mfmm_isolines(mesh, f, values, NVAL, &pts, &n_pts, &lines, &n_lines, &err),
+                     MFMM_OK);
+    int32_t counts[NVAL];
+    check_isolines(g.V, g.F, g.nf, f, values, NVAL, 12.0, pts, n_pts, lines, n_lines, counts);
+    for (int64_t l = 0; l < n_lines; l++) {
+        double c = values[lines[l].value];
+        const mfmm_surface_point *P = pts + lines[l].start;
+        int64_t n = lines[l].n_points;
+        /* on the line 8 x + 4 y = c, in the plane */
+        for (int64_t i = 0; i < n; i++) {
+            tm_assert_close(8.0 * P[i].xyz[0] + 4.0 * P[i].xyz[1], c, 1e-12);
+            assert_true(P[i].xyz[2] == 0.0);
+        }
+        if (c == 3.0 || c == 6.5)
+            continue; /* through vertices: pieces between them */
+        /* one open polyline across the square, boundary to boundary,
+         * monotone along the line */
+        assert_int_equal(lines[l].closed, 0);
+        for (int e = 0; e < 2; e++) {
+            const double *x = P[e ? n - 1 : 0].xyz;
+            assert_true(x[0] == 0.0 || x[0] == 1.0 || x[1] == 0.0 || x[1] == 1.0);
+        }
+        double dir = P[n - 1].xyz[0] - P[0].xyz[0];
+        for (int64_t i = 1; i < n; i++)
+            assert_true((P[i].xyz[0] - P[i - 1].xyz[0]) * dir >= 0.0);
+    }
+    assert_int_equal(counts[0], 1);
+    assert_int_equal(counts[1], 1);
+    assert_int_equal(counts[2], 0);
+    assert_int_equal(counts[3], 1);
+    assert_true(counts[4] >= 1);
+    assert_int_equal(counts[5], 0);
+    assert_true(counts[6] >= 1);
+    mfmm_free(pts);
+    mfmm_free(lines);
+    mfmm_mesh_destroy(mesh);
+    free(f);
+    mfmm_gen_free(&g);
+}
+
+static void test_isolines_loops_ends_and_errors(void **state)
+{
+    (void)state;
+    /* f = |p - (.5, .5)|^2: a level of radius .3 is one loop */
+    mfmm_gen_mesh g = mfmm_gen_grid(16);
+    mfmm_mesh *mesh = tm_make(&g);
+    double *f = malloc((size_t)g.nv * sizeof *f);
+    assert_non_null(f);
+    for (int32_t v = 0; v < g.nv; v++) {
+        double x = g.V[3 * v] - 0.5, y = g.V[3 * v + 1] - 0.5;
+        f[v] = x * x + y * y;
+    }
+    double c = 0.09;
+    mfmm_surface_point *pts = NULL;
+    mfmm_isoline *lines = NULL;
+    int64_t n_pts = 0, n_lines = 0;
+    int32_t count;
+    mfmm_error err;
+    assert_int_equal(mfmm_isolines(mesh, f, &c, 1, &pts, &n_pts, &lines, &n_lines, &err),
+                     MFMM_OK);
+    check_isolines(g.V, g.F, g.nf, f, &c, 1, 1.0, pts, n_pts, lines, n_lines, &count);
+    assert_int_equal(n_lines, 1);
+    assert_int_equal(lines[0].closed, 1);
+    assert_int_equal(n_pts, lines[0].n_points);
+    mfmm_free(pts);
+    mfmm_free(lines);
+    /* an unreached vertex on the loop's way: its faces hold none, the loop
+     * opens there */
+    int32_t v = 17 * 8 + 3; /* (3, 8) / 16: f = .0977 */
+    f[v] = INFINITY;
+    assert_int_equal(mfmm_isolines(mesh, f, &c, 1, &pts, &n_pts, &lines, &n_lines, &err),
+                     MFMM_OK);
+    check_isolines(g.V, g.F, g.nf, f, &c, 1, 1.0, pts, n_pts, lines, n_lines, &count);
+    assert_int_equal(n_lines, 1);
+    assert_int_equal(lines[0].closed, 0);
+    for (int64_t i = 0; i < n_pts; i++)
+        for (int k = 0; k < 3; k++)
+            assert_true(g.F[3 * pts[i].face + k] != v);
+    mfmm_free(pts);
+    mfmm_free(lines);
+    /* no value, or none crossed: nothing, and no arrays */
+    double far = 5.0;
+    assert_int_equal(mfmm_isolines(mesh, f, NULL, 0, &pts, &n_pts, &lines, &n_lines, &err),
+                     MFMM_OK);
+    assert_true(pts == NULL && lines == NULL && n_pts == 0 && n_lines == 0);
+    assert_int_equal(mfmm_isolines(mesh, f, &far, 1, &pts, &n_pts, &lines, &n_lines, &err),
+                     MFMM_OK);
+    assert_true(pts == NULL && lines == NULL && n_pts == 0 && n_lines == 0);
+    /* refusals: NULL, a negative count, a level not finite, a NaN */
+    assert_int_equal(mfmm_isolines(NULL, f, &c, 1, &pts, &n_pts, &lines, &n_lines, &err),
+                     MFMM_ERR_NULL_POINTER);
+    assert_int_equal(mfmm_isolines(mesh, NULL, &c, 1, &pts, &n_pts, &lines, &n_lines, &err),
+                     MFMM_ERR_NULL_POINTER);
+    assert_int_equal(mfmm_isolines(mesh, f, NULL, 1, &pts, &n_pts, &lines, &n_lines, &err),
+                     MFMM_ERR_NULL_POINTER);
+    assert_int_equal(mfmm_isolines(mesh, f, &c, 1, NULL, &n_pts, &lines, &n_lines, &err),
+                     MFMM_ERR_NULL_POINTER);
+    assert_int_equal(mfmm_isolines(mesh, f, &c, 1, &pts, &n_pts, &lines, NULL, &err),
+                     MFMM_ERR_NULL_POINTER);
+    assert_int_equal(mfmm_isolines(mesh, f, &c, -1, &pts, &n_pts, &lines, &n_lines, &err),
+                     MFMM_ERR_BAD_COUNT);
+    double bad[2] = {0.1, NAN};
+    assert_int_equal(mfmm_isolines(mesh, f, bad, 2, &pts, &n_pts, &lines, &n_lines, &err),
+                     MFMM_ERR_BAD_ARGUMENT);
+    assert_int_equal(err.index, 1);
+    bad[1] = -INFINITY;
+    assert_int_equal(mfmm_isolines(mesh, f, bad, 2, &pts, &n_pts, &lines, &n_lines, &err),
+                     MFMM_ERR_BAD_ARGUMENT);
+    assert_int_equal(err.index, 1);
+    f[40] = NAN;
+    assert_int_equal(mfmm_isolines(mesh, f, &c, 1, &pts, &n_pts, &lines, &n_lines, &err),
+                     MFMM_ERR_BAD_ARGUMENT);
+    assert_int_equal(err.index, 40);
+    assert_true(pts == NULL && lines == NULL && n_pts == 0 && n_lines == 0);
+    mfmm_mesh_destroy(mesh);
+    free(f);
+    mfmm_gen_free(&g);
+}
+
+static void test_isolines_across_a_t_junction(void **state)
+{
+    (void)state;
+    /* tests/c/test_tjunction.c's square: M = 5 on edge 0-4 of face 0,
+     * closed by the needle 5 (0, 4, 5), which the mesh drops after
+     * splitting face 0 at M. A linear field's levels: one polyline each, on
+     * the line, every point's face and coordinates those of the faces as
+     * given (not the needle), through face 0's pieces */
+    static const double V[7 * 3] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0.5, 0.5, 0,
+                                    0.25, 0.25, 0, 0, 0, 0};
+    static const int32_t F[6 * 3] = {0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 5, 3, 5, 4, 0, 4, 5};
+    mfmm_mesh *mesh = NULL;
+    assert_int_equal(mfmm_mesh_create(V, 7, F, 6, NULL, &mesh, NULL), MFMM_OK);
+    double f[7];
+    for (int v = 0; v < 7; v++)
+        f[v] = V[3 * v] - 0.5 * V[3 * v + 1];
+    const double values[2] = {0.2, -0.2};
+    mfmm_surface_point *pts = NULL;
+    mfmm_isoline *lines = NULL;
+    int64_t n_pts = 0, n_lines = 0;
+    mfmm_error err;
+    assert_int_equal(mfmm_isolines(mesh, f, values, 2, &pts, &n_pts, &lines, &n_lines, &err),
+                     MFMM_OK);
+    assert_int_equal(n_lines, 2);
+    for (int64_t l = 0; l < n_lines; l++) {
+        assert_int_equal(lines[l].value, l);
+        assert_int_equal(lines[l].closed, 0);
+        const mfmm_surface_point *P = pts + lines[l].start;
+        for (int64_t i = 0; i < lines[l].n_points; i++) {
+            assert_true(P[i].face != 5);
+            tm_assert_close(P[i].xyz[0] - 0.5 * P[i].xyz[1], values[l], 1e-12);
+            double val = 0.0, x[3] = {0.0, 0.0, 0.0};
+            for (int k = 0; k < 3; k++) {
+                int32_t v = F[3 * P[i].face + k];
+                assert_true(P[i].bary[k] >= -1e-15);
+                val += P[i].bary[k] * f[v];
+                for (int d = 0; d < 3; d++)
+                    x[d] += P[i].bary[k] * V[3 * v + d];
+            }
+            tm_assert_close(val, values[l], 1e-12);
+            for (int d = 0; d < 3; d++)
+                tm_assert_close(x[d], P[i].xyz[d], 1e-12);
+        }
+    }
+    /* level .2 crosses face 0 (0, 1, 4) in both pieces: a point inside it,
+     * on M's edge 1-5 */
+    int inside = 0;
+    for (int64_t i = lines[0].start; i < lines[0].start + lines[0].n_points; i++)
+        inside += pts[i].face == 0 && pts[i].bary[0] > 0 && pts[i].bary[1] > 0 &&
+                  pts[i].bary[2] > 0;
+    assert_int_equal(inside, 1);
+    mfmm_free(pts);
+    mfmm_free(lines);
+    mfmm_mesh_destroy(mesh);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -208,6 +474,9 @@ int main(void)
         cmocka_unit_test(test_fps_equals_full_solves),
         cmocka_unit_test(test_fps_errors),
         cmocka_unit_test(test_voronoi_argmin),
+        cmocka_unit_test(test_isolines_of_a_linear_field_on_a_grid),
+        cmocka_unit_test(test_isolines_loops_ends_and_errors),
+        cmocka_unit_test(test_isolines_across_a_t_junction),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

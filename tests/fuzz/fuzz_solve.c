@@ -2,7 +2,10 @@
  * matrix on meshes decoded from the input. Properties checked (abort on a
  * break): no NaN in any distance; sources at distance 0 (vertex sources);
  * the matrix rows of every backend equal mfmm_solve's bit for bit (float64);
- * a traced path has finite points in range. Built twice: serial + threads
+ * a traced path has finite points in range; isolines of the distances
+ * (levels at the target's distance, half of it and one from the input)
+ * come in order, have finite points in range on their faces, and a loop
+ * ends where it starts. Built twice: serial + threads
  * (default) and, with FUZZ_OPENCL, the OpenCL backend against the serial
  * core (slow to start: run it briefly).
  *
@@ -12,7 +15,8 @@
  *           16 face source, 32 no straighten
  *   byte 3: number of vertex sources - 1 (1..4)
  *   then nv * 3 int8 coordinates / 8, nf * 3 vertex bytes (mod nv),
- *   sources, cost bytes ((1 + b) / 16), a max_distance byte, a target. */
+ *   sources, cost bytes ((1 + b) / 16), a max_distance byte, a target,
+ *   a level byte (b / 16). */
 #include <math.h>
 #include <stdio.h>
 #include <stdint.h>
@@ -23,6 +27,56 @@
 #include "byte_reader.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+/* mfmm_isolines of d at up to three levels: a well-formed result. */
+static void check_isolines(const mfmm_mesh *mesh, const double *d, int32_t nf, double target,
+                           double level)
+{
+    double values[3];
+    int32_t n = 0;
+    if (isfinite(target)) {
+        values[n++] = target;
+        values[n++] = 0.5 * target;
+    }
+    values[n++] = level;
+    mfmm_surface_point *pts = NULL;
+    mfmm_isoline *lines = NULL;
+    int64_t np = 0, nl = 0, next = 0;
+    mfmm_error err;
+    mfmm_status st = mfmm_isolines(mesh, d, values, n, &pts, &np, &lines, &nl, &err);
+    if (st != MFMM_OK) {
+        if (st != MFMM_ERR_OUT_OF_MEMORY)
+            abort();
+        return;
+    }
+    for (int64_t l = 0; l < nl; l++) {
+        const mfmm_isoline *L = lines + l;
+        if (L->start != next || L->n_points < 2 || L->value < 0 || L->value >= n ||
+            (l > 0 && L->value < lines[l - 1].value) || (L->closed & ~1))
+            abort();
+        next += L->n_points;
+        const mfmm_surface_point *P = pts + L->start;
+        if (P[0].face != P[1].face ||
+            (L->closed && memcmp(P[0].xyz, P[L->n_points - 1].xyz, sizeof P[0].xyz) != 0))
+            abort();
+        for (int64_t i = 0; i < L->n_points; i++) {
+            if (P[i].face < 0 || P[i].face >= nf)
+                abort();
+            double sum = 0.0;
+            for (int k = 0; k < 3; k++) {
+                if (!isfinite(P[i].xyz[k]) || !(P[i].bary[k] >= -1e-12))
+                    abort();
+                sum += P[i].bary[k];
+            }
+            if (!(fabs(sum - 1.0) <= 1e-9))
+                abort();
+        }
+    }
+    if (next != np || (np == 0) != (pts == NULL) || (nl == 0) != (lines == NULL))
+        abort();
+    mfmm_free(pts);
+    mfmm_free(lines);
+}
 
 static void check_row(const double *row, int32_t nv)
 {
@@ -97,6 +151,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         so.max_distance = next(&r) / 16.0;
     so.unfolding = (flags & 8) ? 0 : 1;
     int32_t target = next(&r) % nv;
+    double level = next(&r) / 16.0;
 
     mfmm_solver *solver = NULL;
     double *d = malloc((size_t)nv * sizeof *d);
@@ -109,6 +164,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         for (int32_t i = 0; i < n_src; i++)
             if (d[src_ids[i]] != 0.0)
                 abort();
+        check_isolines(mesh, d, nf, d[target], level);
         /* a path from the target, when it was reached */
         mfmm_path_options po;
         mfmm_path_options_init(&po);

@@ -229,6 +229,15 @@ class mfmm_surface_point(Structure):
     ]
 
 
+class mfmm_isoline(Structure):
+    _fields_ = [
+        ("start", c_int64),
+        ("n_points", c_int64),
+        ("value", c_int32),
+        ("closed", c_int32),
+    ]
+
+
 class mfmm_path_options(_Sized):
     _fields_ = [
         ("struct_size", c_size_t),
@@ -317,6 +326,19 @@ SURFACE_POINT_DTYPE = np.dtype(
             mfmm_surface_point.xyz.offset,
         ],
         "itemsize": ctypes.sizeof(mfmm_surface_point),
+    }
+)
+ISOLINE_DTYPE = np.dtype(
+    {
+        "names": ["start", "n_points", "value", "closed"],
+        "formats": [np.int64, np.int64, np.int32, np.int32],
+        "offsets": [
+            mfmm_isoline.start.offset,
+            mfmm_isoline.n_points.offset,
+            mfmm_isoline.value.offset,
+            mfmm_isoline.closed.offset,
+        ],
+        "itemsize": ctypes.sizeof(mfmm_isoline),
     }
 )
 
@@ -450,6 +472,14 @@ mfmm_voronoi_labels = _proto(
     c_enum,
     # mesh, distances (double *), sources (mfmm_source *), n_sources, labels (int32_t *), err
     [c_void_p, c_void_p, c_void_p, c_int32, c_void_p, P(mfmm_error)],
+)
+mfmm_isolines = _proto(
+    "mfmm_isolines",
+    c_enum,
+    # mesh, field (double *), values (double *), n_values, points (mfmm_surface_point **),
+    # n_points, lines (mfmm_isoline **), n_lines, err
+    [c_void_p, c_void_p, c_void_p, c_int32, P(c_void_p), P(c_int64), P(c_void_p), P(c_int64),
+     P(mfmm_error)],
 )
 # exact
 mfmm_exact_solver_create = _proto("mfmm_exact_solver_create", c_enum, [c_void_p, P(c_void_p)])
@@ -599,3 +629,4 @@ def check(status: int, err: Optional[mfmm_error] = None, *, mesh: bool = False,
 # The numpy record layouts must be the ctypes mirrors byte for byte.
 assert SOURCE_DTYPE.itemsize == ctypes.sizeof(mfmm_source)
 assert SURFACE_POINT_DTYPE.itemsize == ctypes.sizeof(mfmm_surface_point)
+assert ISOLINE_DTYPE.itemsize == ctypes.sizeof(mfmm_isoline)

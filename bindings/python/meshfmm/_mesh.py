@@ -974,10 +974,17 @@ class Mesh:
         """Isolines of a per-vertex field at given values, as polylines.
 
         Where the linear interpolant of ``distances`` over each face equals a
-        value: one pass over the faces for all the values (which values each
-        face's corners straddle), then the segments found, joined through
-        their shared edges. A corner counts as above a level when its value
-        is >= it; faces with an infinite corner hold no segment.
+        value, computed in C (``mfmm_isolines``): one pass over the faces for
+        all the values (which values each face's corners straddle), then the
+        segments found, joined through their shared edges. A corner counts
+        as above a level when its value is >= it; faces with an infinite
+        corner hold no segment. Each crossing point is interpolated from its
+        edge's lower vertex id, so neighbouring faces share it bit for bit.
+        A value's polylines: first the open ones, each from its end with the
+        lower edge (vertex ids); then the loops (and, on non-manifold
+        edges, the pieces between them), each from the first unused face.
+        On a mesh whose T-junctions were closed, the faces as built (a
+        split face's pieces, reported as that face).
 
         Parameters
         ----------
@@ -999,12 +1006,22 @@ class Mesh:
         vals = np.atleast_1d(np.asarray(values, dtype=np.float64))
         if vals.ndim != 1 or not np.isfinite(vals).all():
             raise ValueError("values must be finite numbers")
+        points, lines = self._isoline_records(d, vals)
+        return _isolines.polylines(points, lines, vals)
+
+    def _isoline_records(self, d: np.ndarray, values: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+        """mfmm_isolines of a checked field (n_vertices,) at checked values:
+        (points, lines) as _lib.SURFACE_POINT_DTYPE and _lib.ISOLINE_DTYPE
+        records, the face ids the input's (also for meshfmm.plot)."""
         if self._weld is not None:
             d = self._weld.distances_in(d)
-        out = _isolines.isolines(self._V, self._F, d, vals)
+        d = np.ascontiguousarray(d, dtype=np.float64)
+        vals = np.ascontiguousarray(values, dtype=np.float64)
+        with self._in_call() as mesh_ptr:
+            points, lines = _isolines.compute(mesh_ptr, d, vals)
         if self._weld is not None:
-            out = [_isolines.fix_faces(lines, self._weld.faces_out) for lines in out]
-        return out
+            points["face"] = self._weld.faces_out(points["face"])
+        return points, lines
 
     # ---- many sources
     def distance_matrix(

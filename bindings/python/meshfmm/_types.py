@@ -149,7 +149,8 @@ class Isoline:
 
     ``faces[i]`` (i > 0) is the face the segment from point i-1 runs
     through (``faces[0] == faces[1]``) and ``barycentric[i]`` the point's
-    coordinates in ``faces[i]``; every point lies on an edge. A closed
+    coordinates in ``faces[i]``; every point lies on an edge (where a
+    T-junction was closed, possibly the edge that splits a face). A closed
     polyline repeats its first point at its end.
 
     Attributes

@@ -73,16 +73,17 @@ def isoline_segments(vertices: Any, faces: Any, values: Any,
                      level: float) -> Tuple[np.ndarray, np.ndarray]:
     """Where the linear interpolant of `values` over each face equals `level`.
 
-    The segments that :meth:`Mesh.isolines <meshfmm.Mesh.isolines>` joins
-    into polylines, unjoined: a face whose corners are not all on one side
-    of `level` (corners equal to it count as above) holds one segment,
-    between the two points where its edges cross, each found by linear
-    interpolation along the edge. Faces with a non-finite value hold none.
+    The segments of :meth:`Mesh.isolines <meshfmm.Mesh.isolines>`'
+    polylines, taken apart: a face whose corners are not all on one side of
+    `level` (corners equal to it count as above) holds one segment, between
+    the two points where its edges cross, each found by linear interpolation
+    along the edge. Faces with a non-finite value hold none. The mesh must
+    be one :class:`~meshfmm.Mesh` accepts; it is built for the call.
 
     Returns
     -------
     segments : numpy.ndarray, float64 (k, 2, 3)
-        The segments' end points.
+        The segments' end points, each in the direction of its polyline.
     faces : numpy.ndarray, int64 (k,)
         The face of each segment, ascending.
     """
@@ -91,8 +92,31 @@ def isoline_segments(vertices: Any, faces: Any, values: Any,
     d = np.asarray(values, dtype=np.float64).ravel()
     if d.shape[0] != V.shape[0]:
         raise ValueError(f"values has {d.shape[0]} entries for {V.shape[0]} vertices")
-    fids, seg, _, _ = _isolines.crossings(V, F, d, float(level))
-    return seg, fids
+    seg, fids = _segments(None, V, F, d, np.array([float(level)]))
+    order = np.argsort(fids, kind="stable")
+    return seg[order], fids[order]
+
+
+def _segments(mesh: Any, V: np.ndarray, F: np.ndarray, d: np.ndarray,
+              levels: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    """Every level's isoline segments (:meth:`Mesh.isolines`' polylines cut
+    at their points: one pass over the faces for all levels, in C), as
+    (ends (k, 2, 3), faces (k,) int64); `mesh` a :class:`Mesh`, or anything
+    else to build one from V and F. NaN values hold none, as infinite ones."""
+    if levels.size == 0:
+        return np.empty((0, 2, 3)), np.empty(0, dtype=np.int64)
+    import warnings
+
+    from ._mesh import Mesh
+    from ._types import MeshWarning
+
+    if not isinstance(mesh, Mesh):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", MeshWarning)
+            mesh = Mesh(V, F)
+    d = np.where(np.isnan(d), np.inf, d)
+    points, lines = mesh._isoline_records(d, levels)
+    return _isolines.segments(points, lines)
 
 
 def _levels(isolines: Union[None, int, Sequence[float]], lo: float, hi: float) -> np.ndarray:
@@ -192,7 +216,9 @@ def render(mesh: Any, distances: Any, path_png: Union[str, "os.PathLike[str]"], 
         is drawn.
     ValueError
         `distances` does not have one value per vertex, or a bad `view`,
-        `up`, `size` or `isolines`.
+        `up`, `size` or `isolines`; with isolines, a mesh (not a
+        :class:`~meshfmm.Mesh`) that :class:`~meshfmm.Mesh` refuses (the
+        isolines are :meth:`Mesh.isolines <meshfmm.Mesh.isolines>`').
     """
     _extras.require("meshfmm.plot.render", "plot")
     from matplotlib import colormaps
@@ -255,7 +281,7 @@ def render(mesh: Any, distances: Any, path_png: Union[str, "os.PathLike[str]"], 
 
     iso_half = 0.0018 * scale * 800.0 / max(width, height) + 0.0008 * scale
     # every level's segments from one pass over the faces
-    _, seg_faces, seg, _, _ = _isolines.segments(V, F, d, _levels(isolines, lo, hi))
+    seg, seg_faces = _segments(mesh, V, F, d, _levels(isolines, lo, hi))
     if seg.shape[0]:
         p = np.stack([seg[:, 0] @ right, seg[:, 0] @ upv], axis=1)
         q = np.stack([seg[:, 1] @ right, seg[:, 1] @ upv], axis=1)
