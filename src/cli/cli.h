@@ -304,6 +304,11 @@ int cli_npy_append(cli_npy_writer *w, const void *data, int64_t n_rows);
 int cli_npy_close(cli_npy_writer *w);
 /* Closes and removes the temporary file; safe after a failed open. */
 void cli_npy_abort(cli_npy_writer *w);
+/* Writes a vector of n values (int32, or double when is_double) to path:
+ * a one-dimensional .npy ("<i4" / "<f8") when npy, else text, one value a
+ * line (doubles as cli_put_double). 0, or -1 with the error printed and no
+ * file left (an interrupt counts as a failure). */
+int cli_write_vector(const char *path, int npy, const void *values, int32_t n, int is_double);
 
 /* ---- .npz files: a scipy.sparse CSR matrix (npz.c) ---- */
 

@@ -34,17 +34,6 @@ static void help(FILE *out)
             "of the inputs.\n");
 }
 
-static int write_txt(const char *path, const double *d, int32_t n)
-{
-    cli_output out;
-    if (cli_output_open(&out, path))
-        return -1;
-    int bad = 0;
-    for (int32_t i = 0; i < n && !bad && !cli_interrupted(); i++)
-        bad = cli_put_double(out.f, d[i]) < 0 || fputc('\n', out.f) == EOF;
-    return cli_output_close(&out, bad);
-}
-
 int cmd_distance(int argc, char **argv)
 {
     static const struct option longopts[] = {
@@ -105,19 +94,8 @@ int cmd_distance(int argc, char **argv)
     if (!dist || cli_interrupted())
         goto done;
     cli_sources_and_cost_note_in_no_face(&o, &m);
-    if (!is_txt) {
-        cli_npy_writer w;
-        if (cli_npy_open(&w, o.out_path, "<f8", nv, -1))
-            goto done;
-        if (cli_npy_append(&w, dist, nv)) {
-            cli_npy_abort(&w);
-            goto done;
-        }
-        if (cli_npy_close(&w))
-            goto done;
-    } else if (write_txt(o.out_path, dist, nv)) {
+    if (cli_write_vector(o.out_path, !is_txt, dist, nv, 1))
         goto done;
-    }
     rc = CLI_OK;
 done:
     if (rc != CLI_OK && cli_interrupted()) {

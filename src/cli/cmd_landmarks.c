@@ -144,26 +144,8 @@ int cmd_landmarks(int argc, char **argv)
         else
             unreached++;
     }
-    if (is_npy) {
-        cli_npy_writer w;
-        if (cli_npy_open(&w, out_path, "<i4", k, -1))
-            goto done;
-        if (cli_npy_append(&w, pts, k)) {
-            cli_npy_abort(&w);
-            goto done;
-        }
-        if (cli_npy_close(&w))
-            goto done;
-    } else {
-        cli_output out;
-        if (cli_output_open(&out, out_path))
-            goto done;
-        int bad = 0;
-        for (int32_t i = 0; i < k && !bad; i++)
-            bad = fprintf(out.f, "%ld\n", (long)pts[i]) < 0;
-        if (cli_output_close(&out, bad))
-            goto done;
-    }
+    if (cli_write_vector(out_path, is_npy, pts, k, 0))
+        goto done;
     fprintf(stderr, "meshfmm landmarks: %ld landmarks; every vertex within %.6g of one", (long)k,
             cover);
     if (unreached)

@@ -47,32 +47,6 @@ static void help(FILE *out)
 }
 
 /* values: n int32 (labels) or doubles, as .npy or one per line. */
-static int write_vector(const char *path, const void *values, int32_t n, int is_double)
-{
-    if (cli_has_ext(path, "npy")) {
-        cli_npy_writer w;
-        if (cli_npy_open(&w, path, is_double ? "<f8" : "<i4", n, -1))
-            return -1;
-        if (cli_npy_append(&w, values, n)) {
-            cli_npy_abort(&w);
-            return -1;
-        }
-        return cli_npy_close(&w);
-    }
-    cli_output out;
-    if (cli_output_open(&out, path))
-        return -1;
-    int bad = 0;
-    for (int32_t i = 0; i < n && !bad && !cli_interrupted(); i++) {
-        if (is_double)
-            bad = cli_put_double(out.f, ((const double *)values)[i]) < 0;
-        else
-            bad = fprintf(out.f, "%ld", (long)((const int32_t *)values)[i]) < 0;
-        bad = bad || fputc('\n', out.f) == EOF;
-    }
-    return cli_output_close(&out, bad);
-}
-
 /* Appends the ids of --sources FILE to o's sources. 0, or -1 (printed). */
 static int add_file_sources(cli_sources_and_cost *o, const char *path)
 {
@@ -222,8 +196,8 @@ int cmd_voronoi(int argc, char **argv)
         }
     }
     free(has);
-    if (write_vector(o.out_path, labels, nv, 0) ||
-        (dist_path && write_vector(dist_path, dist, nv, 1)))
+    if (cli_write_vector(o.out_path, cli_has_ext(o.out_path, "npy"), labels, nv, 0) ||
+        (dist_path && cli_write_vector(dist_path, cli_has_ext(dist_path, "npy"), dist, nv, 1)))
         goto done;
     fprintf(stderr, "meshfmm voronoi: %ld vertices in %ld cells of %ld sources", (long)nv,
             (long)cells, (long)o.n_src);

@@ -23,27 +23,6 @@ static void help(FILE *out)
             "complete; they may not be the mesh.\n");
 }
 
-static int write_map(const char *path, const int32_t *map, int32_t nv)
-{
-    if (cli_has_ext(path, "npy")) {
-        cli_npy_writer w;
-        if (cli_npy_open(&w, path, "<i4", nv, -1))
-            return -1;
-        if (cli_npy_append(&w, map, nv)) {
-            cli_npy_abort(&w);
-            return -1;
-        }
-        return cli_npy_close(&w);
-    }
-    cli_output out;
-    if (cli_output_open(&out, path))
-        return -1;
-    int bad = 0;
-    for (int32_t i = 0; i < nv && !bad; i++)
-        bad = fprintf(out.f, "%ld\n", (long)map[i]) < 0;
-    return cli_output_close(&out, bad);
-}
-
 int cmd_weld(int argc, char **argv)
 {
     static const struct option longopts[] = {
@@ -108,7 +87,7 @@ int cmd_weld(int argc, char **argv)
              "(%ld dropped)", (long)nv, (long)nw, (long)kept, (long)(nf - kept));
     if (cli_write_obj(out_path, W, nw, F, kept, comment))
         goto done;
-    if (map_path && write_map(map_path, map, nv))
+    if (map_path && cli_write_vector(map_path, cli_has_ext(map_path, "npy"), map, nv, 0))
         goto done;
     fprintf(stderr, "meshfmm weld: %ld vertices, %ld once welded (%ld removed); %ld faces, "
             "%ld dropped (zero area once welded)\n", (long)nv, (long)nw, (long)(nv - nw),

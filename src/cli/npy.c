@@ -526,3 +526,29 @@ int cli_read_ids(const char *path, int32_t **ids, int64_t *n)
     *n = count;
     return 0;
 }
+
+int cli_write_vector(const char *path, int npy, const void *values, int32_t n, int is_double)
+{
+    if (npy) {
+        cli_npy_writer w;
+        if (cli_npy_open(&w, path, is_double ? "<f8" : "<i4", n, -1))
+            return -1;
+        if (cli_npy_append(&w, values, n)) {
+            cli_npy_abort(&w);
+            return -1;
+        }
+        return cli_npy_close(&w);
+    }
+    cli_output out;
+    if (cli_output_open(&out, path))
+        return -1;
+    int bad = 0;
+    for (int32_t i = 0; i < n && !bad && !cli_interrupted(); i++) {
+        if (is_double)
+            bad = cli_put_double(out.f, ((const double *)values)[i]) < 0;
+        else
+            bad = fprintf(out.f, "%ld", (long)((const int32_t *)values)[i]) < 0;
+        bad = bad || fputc('\n', out.f) == EOF;
+    }
+    return cli_output_close(&out, bad);
+}
