@@ -109,6 +109,48 @@ static mfmm_opencl_context *opencl_context(int *unavailable)
 }
 #endif
 
+/* mfmm_voronoi_labels of d: a source index where d is finite, -1 where not. */
+static void check_voronoi(const mfmm_mesh *mesh, const double *d, int32_t nv,
+                          const mfmm_source *src, int32_t n_src)
+{
+    int32_t labels[66];
+    mfmm_error err;
+    mfmm_status st = mfmm_voronoi_labels(mesh, d, src, n_src, labels, &err);
+    if (st == MFMM_ERR_OUT_OF_MEMORY)
+        return;
+    if (st != MFMM_OK)
+        abort(); /* the solve accepted these sources */
+    for (int32_t v = 0; v < nv; v++)
+        if (labels[v] < -1 || labels[v] >= n_src || (labels[v] == -1) != !isfinite(d[v]))
+            abort();
+}
+
+/* mfmm_farthest_points from `start`: k distinct vertices, the first start,
+ * radii +inf then non-increasing, distances finite at the points. */
+static void check_farthest(mfmm_solver *solver, int32_t nv, int32_t start,
+                           const mfmm_solve_options *so)
+{
+    int32_t pts[3];
+    double radii[3], dist[66];
+    mfmm_solve_options o = *so;
+    o.max_distance = INFINITY;
+    mfmm_error err;
+    int32_t k = nv < 3 ? nv : 3;
+    if (mfmm_farthest_points(solver, start, k, &o, pts, radii, dist, &err) != MFMM_OK)
+        return; /* start in no face, or fewer vertices in faces than k */
+    if (pts[0] != start || radii[0] != INFINITY)
+        abort();
+    for (int32_t i = 0; i < k; i++) {
+        if (pts[i] < 0 || pts[i] >= nv || dist[pts[i]] != 0.0)
+            abort();
+        for (int32_t j = 0; j < i; j++)
+            if (pts[j] == pts[i])
+                abort();
+        if (i > 1 && !(radii[i] <= radii[i - 1]))
+            abort();
+    }
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     reader r = {data, size};
@@ -165,6 +207,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (d[src_ids[i]] != 0.0)
                 abort();
         check_isolines(mesh, d, nf, d[target], level);
+        check_voronoi(mesh, d, nv, src, n_all);
         /* a path from the target, when it was reached */
         mfmm_path_options po;
         mfmm_path_options_init(&po);
@@ -191,6 +234,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             }
         }
     }
+    check_farthest(solver, nv, src_ids[0], &so);
     /* rows of the matrix == mfmm_solve from each vertex source alone */
     int have_ref = 1;
     for (int32_t i = 0; i < n_src && have_ref; i++)
