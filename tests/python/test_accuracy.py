@@ -6,7 +6,7 @@ positive exact distance, and max error in percent of the mesh diameter (the
 bounding-box diagonal of the referenced vertices). Bound: no worse than
 geometry-central's FMM from the same sources on the same mesh, within 2% of its
 value; on the obtuse-heavy meshes unfolding must be clearly (1.5x) better in
-mean relative error.
+mean relative error; no value more than 2% below the exact distance.
 """
 
 from __future__ import annotations
@@ -34,6 +34,10 @@ from conftest import (
 pp3d = pytest.importorskip("potpourri3d")
 
 SLACK = 1.02  # "no worse than geometry-central, within 2% of its value"
+# The march is first order: a few values fall below the exact distance
+# (docs/methods.md#what-every-distance-is). Least (d - e) / e measured over
+# the stored sources: -1.61 % (hand_lowres) to -0.44 % (bunny).
+UNDER = -0.02
 CLEARLY = 1.5  # obtuse-heavy meshes: geometry-central's MRE / ours at least this
 
 
@@ -80,6 +84,9 @@ def test_against_exact_and_geometry_central(name):
         # +inf exactly where the exact distance is +inf (unreferenced vertices)
         np.testing.assert_array_equal(np.isinf(d), np.isinf(e))
         ours.append(errors(d, e, diam))
+        ok = np.isfinite(e) & (e > 0)
+        under = float(np.min((d[ok] - e[ok]) / e[ok]))
+        assert under >= UNDER, f"source {s}: {-100 * under:.2f}% below the exact distance"
         gc.append(errors(gc_distance(name, int(s)), e, diam))
         plain.append(errors(m.distance(int(s), unfolding=False), e, diam))
     ours_mre = float(np.mean([o[0] for o in ours]))
