@@ -201,6 +201,22 @@ MFMM_API mfmm_status mfmm_mesh_get_info(const mfmm_mesh *mesh, mfmm_mesh_info *i
 MFMM_API int32_t mfmm_mesh_vertex_count(const mfmm_mesh *mesh);
 MFMM_API int32_t mfmm_mesh_face_count(const mfmm_mesh *mesh);
 
+/* Welds coincident vertices (texture seams, unmerged STL corners): the
+ * welded id of each vertex. Vertices of exactly equal position (-0.0 equal
+ * to 0.0) share an id; ids are numbered by first occurrence, so a mesh
+ * without coincident vertices keeps its numbering. The welded surface is
+ * the welded vertices (each at its first occurrence's position) with the
+ * faces mapped through `map`, less those with a repeated corner: the one
+ * mfmm_mesh_info's n_coincident_vertices and n_welded_components describe.
+ *   vertices: (nv, 3) float64, finite.
+ *   map:      (nv,) int32 out: each vertex's welded id, in [0, *n_welded).
+ *   n_welded: out: the number of distinct positions.
+ * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_COUNT (nv < 0);
+ * MFMM_ERR_NONFINITE_VERTEX (err->index: the vertex); MFMM_ERR_OUT_OF_MEMORY.
+ * Thread-safe. */
+MFMM_API mfmm_status mfmm_weld_map(const double *vertices, int32_t nv, int32_t *map,
+                                   int32_t *n_welded, mfmm_error *err);
+
 /* ===================================================== 4. sources and costs */
 
 /* A source: a vertex (face == -1), or a point in a face by barycentric

@@ -9,62 +9,15 @@
 
 #include "cli.h"
 
-static uint64_t hash3(const double *p)
-{
-    uint64_t h = 1469598103934665603u;
-    for (int k = 0; k < 3; k++) {
-        double x = p[k] + 0.0; /* -0.0 as 0.0 */
-        uint64_t bits;
-        memcpy(&bits, &x, sizeof bits);
-        h = (h ^ bits) * 1099511628211u;
-        h ^= h >> 29;
-    }
-    return h;
-}
-
-/* map[v]: the welded id of vertex v, numbered by first occurrence; the
- * count of welded vertices, or -1 when out of memory. */
-static int32_t weld_map(const double *V, int32_t nv, int32_t *map)
-{
-    size_t cap = 16;
-    while (cap < 2 * (size_t)nv)
-        cap *= 2;
-    int32_t *table = malloc(cap * sizeof *table);
-    if (!table)
-        return -1;
-    for (size_t i = 0; i < cap; i++)
-        table[i] = -1;
-    int32_t n = 0;
-    for (int32_t v = 0; v < nv; v++) {
-        const double *p = V + 3 * (size_t)v;
-        size_t i = (size_t)hash3(p) & (cap - 1);
-        for (;;) {
-            int32_t w = table[i];
-            if (w < 0) {
-                table[i] = v;
-                map[v] = n++;
-                break;
-            }
-            const double *q = V + 3 * (size_t)w;
-            if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) {
-                map[v] = map[w];
-                break;
-            }
-            i = (i + 1) & (cap - 1);
-        }
-    }
-    free(table);
-    return n;
-}
-
 int cli_weld(const double *V, int32_t nv, int32_t *F, int32_t nf, int32_t *map, double *W,
              int32_t *face_in, int32_t *n_welded, int32_t *n_kept)
 {
-    int32_t nw = weld_map(V, nv, map);
-    if (nw < 0)
+    int32_t nw = 0;
+    if (mfmm_weld_map(V, nv, map, &nw, NULL) != MFMM_OK)
         return -1;
-    for (int32_t v = 0; v < nv; v++)
-        memcpy(W + 3 * (size_t)map[v], V + 3 * (size_t)v, 3 * sizeof *W);
+    for (int32_t v = 0, next = 0; v < nv; v++)
+        if (map[v] == next) /* its first occurrence */
+            memcpy(W + 3 * (size_t)next++, V + 3 * (size_t)v, 3 * sizeof *W);
     int32_t kept = 0;
     for (int32_t f = 0; f < nf; f++) {
         int32_t a = map[F[3 * (size_t)f]], b = map[F[3 * (size_t)f + 1]],

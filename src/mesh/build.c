@@ -11,6 +11,7 @@
 #include "build.h"
 #include "order.h"
 #include "unfold.h"
+#include "weld.h"
 
 /* Smallest extent: lengths are squared once (1e-200 is far from
  * underflow). */
@@ -245,29 +246,13 @@ static int32_t uf_find(int32_t *parent, int32_t x)
     return x;
 }
 
-/* A position's hash: its coordinates' bits (-0.0 read as 0.0). */
-static uint64_t position_hash(const double *p)
-{
-    uint64_t h = 1469598103934665603u;
-    for (int k = 0; k < 3; k++) {
-        double x = p[k] + 0.0;
-        uint64_t bits;
-        memcpy(&bits, &x, sizeof bits);
-        h = (h ^ bits) * 1099511628211u;
-        h ^= h >> 29;
-    }
-    return h;
-}
-
 /* Referenced vertices at the position of another (texture seams, unmerged
  * STL corners): their count, and the components the surface would have
  * with each such group welded into one vertex. `parent` is the
  * union-find of the face components (build_components), reused. */
 static mfmm_status coincident_vertices(mfmm_mesh *m, int32_t *parent)
 {
-    size_t cap = 16;
-    while (cap < 2 * (size_t)m->nv)
-        cap *= 2;
+    size_t cap = mfmm_position_table_size((size_t)m->nv);
     int32_t *table = malloc(cap * sizeof *table);
     if (!table)
         return MFMM_ERR_OUT_OF_MEMORY;
@@ -278,7 +263,7 @@ static mfmm_status coincident_vertices(mfmm_mesh *m, int32_t *parent)
         if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1])
             continue; /* unreferenced: counted apart */
         const double *p = m->xyz + 3 * (size_t)v;
-        size_t i = (size_t)position_hash(p) & (cap - 1);
+        size_t i = (size_t)mfmm_position_hash(p) & (cap - 1);
         for (;;) {
             int32_t w = table[i];
             if (w < 0) {

@@ -1,4 +1,4 @@
-/* Coincident vertices in mfmm_mesh_info, farthest-point sampling against a
+/* Coincident vertices in mfmm_mesh_info and mfmm_weld_map, farthest-point sampling against a
  * loop of full solves, Voronoi labels against the argmin over single-source
  * solves, and isolines against analytic lines and each face's linear
  * interpolant. */
@@ -38,6 +38,32 @@ static void test_coincident_counts(void **state)
     assert_int_equal(info.n_coincident_vertices, 0);
     assert_int_equal(info.n_welded_components, 1);
     mfmm_mesh_destroy(mesh);
+}
+
+static void test_weld_map(void **state)
+{
+    (void)state;
+    /* the square of test_coincident_counts: 4 and 5 repeat 1 and 2 (-0.0
+     * as 0.0), 6 repeats 0 */
+    double V[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 1, 0, 0, -0.0, 1, 0, 0, 0, 0};
+    int32_t map[7], n = -1;
+    mfmm_error err;
+    assert_int_equal(mfmm_weld_map(V, 7, map, &n, &err), MFMM_OK);
+    static const int32_t want[] = {0, 1, 2, 3, 1, 2, 0};
+    assert_int_equal(n, 4);
+    assert_memory_equal(map, want, sizeof want);
+    /* nothing coincides: the numbering is kept */
+    assert_int_equal(mfmm_weld_map(V, 4, map, &n, &err), MFMM_OK);
+    assert_int_equal(n, 4);
+    for (int32_t v = 0; v < 4; v++)
+        assert_int_equal(map[v], v);
+    assert_int_equal(mfmm_weld_map(V, 0, map, &n, &err), MFMM_OK);
+    assert_int_equal(n, 0);
+    assert_int_equal(mfmm_weld_map(NULL, 7, map, &n, &err), MFMM_ERR_NULL_POINTER);
+    assert_int_equal(mfmm_weld_map(V, -1, map, &n, &err), MFMM_ERR_BAD_COUNT);
+    V[3 * 5 + 2] = NAN;
+    assert_int_equal(mfmm_weld_map(V, 7, map, &n, &err), MFMM_ERR_NONFINITE_VERTEX);
+    assert_int_equal(err.index, 5);
 }
 
 /* The reference: k full solves, the running minimum, the farthest vertex
@@ -471,6 +497,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_coincident_counts),
+        cmocka_unit_test(test_weld_map),
         cmocka_unit_test(test_fps_equals_full_solves),
         cmocka_unit_test(test_fps_errors),
         cmocka_unit_test(test_voronoi_argmin),

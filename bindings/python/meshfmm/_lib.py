@@ -467,6 +467,12 @@ mfmm_farthest_points = _proto(
     [c_void_p, c_int32, c_int32, P(mfmm_solve_options), c_void_p, c_void_p, c_void_p,
      P(mfmm_error)],
 )
+mfmm_weld_map = _proto(
+    "mfmm_weld_map",
+    c_enum,
+    # vertices (double *), nv, map (int32_t *), n_welded (int32_t *), err
+    [c_void_p, c_int32, c_void_p, P(c_int32), P(mfmm_error)],
+)
 mfmm_voronoi_labels = _proto(
     "mfmm_voronoi_labels",
     c_enum,

@@ -5,6 +5,7 @@ results (per-vertex arrays, path faces) across it."""
 
 from __future__ import annotations
 
+from ctypes import byref, c_int32
 from typing import Any, Optional, Tuple
 
 import numpy as np
@@ -36,14 +37,14 @@ class Weld:
     def __init__(self, V: np.ndarray, F: np.ndarray) -> None:
         nv, nf = V.shape[0], F.shape[0]
         self.nv_in, self.nf_in = nv, nf
-        key = V + 0.0  # -0.0 -> 0.0
-        _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
-        inverse = inverse.reshape(-1)
-        order = np.argsort(first, kind="stable")
-        rank = np.empty_like(order)
-        rank[order] = np.arange(order.shape[0])
-        self.to_welded = rank[inverse].astype(np.int32)
-        self.rep = first[order]
+        Vc = np.ascontiguousarray(V, dtype=np.float64)
+        self.to_welded = np.empty(nv, dtype=np.int32)
+        n_welded = c_int32(0)
+        err = _lib.mfmm_error()
+        status = _lib.mfmm_weld_map(_args.addr(Vc), nv, _args.addr(self.to_welded),
+                                    byref(n_welded), byref(err))
+        _lib.check(status, err)
+        self.rep = np.unique(self.to_welded, return_index=True)[1]  # each id's first vertex
         Fw = self.to_welded[F]
         ok = (Fw[:, 0] != Fw[:, 1]) & (Fw[:, 1] != Fw[:, 2]) & (Fw[:, 0] != Fw[:, 2])
         self.kept_faces = np.flatnonzero(ok)
