@@ -16,6 +16,7 @@ import os
 import platform
 import subprocess
 import sys
+import time
 from importlib import metadata
 from pathlib import Path
 
@@ -135,3 +136,14 @@ def generate(shape: str, n: int, workdir: Path):
         subprocess.run([str(CLI), "generate", shape, str(n), "-o", str(out)], check=True,
                        capture_output=True)
     return meshfmm.load_mesh(out)
+
+
+def best_of(rounds: int, fn):
+    """Runs fn `rounds` times: the least wall time in seconds, and the last
+    result."""
+    times, out = [], None
+    for _ in range(rounds):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return min(times), out

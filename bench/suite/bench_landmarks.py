@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
-from benchlib import RESULTS, compact, load_data, machine_info, versions  # noqa: E402
+from benchlib import RESULTS, best_of, compact, load_data, machine_info, versions  # noqa: E402
 
 
 def loop_fps(solve, nv: int, k: int, start: int) -> np.ndarray:
@@ -37,15 +37,6 @@ def loop_fps(solve, nv: int, k: int, start: int) -> np.ndarray:
         cand[chosen] = -1
         chosen.append(int(np.argmax(cand)))
     return np.array(chosen)
-
-
-def best_of(rounds: int, fn):
-    times, out = [], None
-    for _ in range(rounds):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), out
 
 
 def main() -> None:

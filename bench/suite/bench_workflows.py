@@ -22,22 +22,12 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # bench/
-from benchlib import RESULTS, load_data, machine_info, versions  # noqa: E402
-
-
-def best_of(rounds: int, fn):
-    times, out = [], None
-    for _ in range(rounds):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), out
+from benchlib import RESULTS, best_of, load_data, machine_info, versions  # noqa: E402
 
 
 def face_pass(d: np.ndarray, F: np.ndarray):

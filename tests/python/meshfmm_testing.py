@@ -122,3 +122,11 @@ def errors(d: np.ndarray, e: np.ndarray, diameter: float) -> tuple:
         return float("inf"), float("inf")
     mx = float(100.0 * np.max(np.abs(d[fin] - e[fin])) / diameter)
     return mean_rel_error(d, e), mx
+
+
+def write_off(path, V: np.ndarray, F: np.ndarray) -> None:
+    """Writes V, F as an OFF file, coordinates to full precision."""
+    with open(path, "w") as f:
+        f.write(f"OFF\n{V.shape[0]} {F.shape[0]} 0\n")
+        np.savetxt(f, V, fmt="%.17g")
+        np.savetxt(f, np.hstack([np.full((F.shape[0], 1), 3), F]), fmt="%d")

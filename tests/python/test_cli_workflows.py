@@ -19,6 +19,7 @@ import pytest
 import meshfmm
 from conftest import MESHES, load, mesh
 from meshfmm import SurfacePoint
+from meshfmm_testing import write_off
 from test_api import grid
 from test_workflows import split_at_x
 
@@ -41,13 +42,6 @@ def run(*args, ok=True):
 
 def py(*args, ok=True):
     return run(sys.executable, "-m", "meshfmm", *args, ok=ok)
-
-
-def write_off(path, V, F):
-    with open(path, "w") as f:
-        f.write(f"OFF\n{V.shape[0]} {F.shape[0]} 0\n")
-        np.savetxt(f, V, fmt="%.17g")
-        np.savetxt(f, np.hstack([np.full((F.shape[0], 1), 3), F]), fmt="%d")
 
 
 def plain(V, F):

@@ -14,6 +14,7 @@ import pytest
 
 import meshfmm
 from conftest import MESHES, load, mesh
+from meshfmm_testing import write_off
 from meshfmm import MeshWarning, SurfacePoint
 
 
@@ -312,13 +313,6 @@ def _cli():
     return path
 
 
-def _write_off(path, V, F):
-    with open(path, "w") as f:
-        f.write(f"OFF\n{V.shape[0]} {F.shape[0]} 0\n")
-        np.savetxt(f, V, fmt="%.17g")
-        np.savetxt(f, np.hstack([np.full((F.shape[0], 1), 3), F]), fmt="%d")
-
-
 def test_cli_info_notes_coincident_vertices(spot_split, tmp_path):
     import json
     import subprocess
@@ -326,7 +320,7 @@ def test_cli_info_notes_coincident_vertices(spot_split, tmp_path):
     cli = _cli()
     V, F, V2, F2, _ = spot_split
     off = tmp_path / "split.off"
-    _write_off(off, V2, F2)
+    write_off(off, V2, F2)
     p = subprocess.run([cli, "info", "--json", str(off)], capture_output=True, text=True)
     assert p.returncode == 0, p.stderr
     got = json.loads(p.stdout)
@@ -531,7 +525,7 @@ def test_cli_weld_writes_the_welded_mesh_and_map(spot_split, tmp_path):
     cli = _cli()
     V, F, V2, F2, orig = spot_split
     off = tmp_path / "split.off"
-    _write_off(off, V2, F2)
+    write_off(off, V2, F2)
     out, mp = tmp_path / "welded.obj", tmp_path / "map.npy"
     p = subprocess.run([cli, "weld", str(off), "-o", str(out), "--map", str(mp)],
                        capture_output=True, text=True)
