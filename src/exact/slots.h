@@ -1,0 +1,60 @@
+/* An approximate window propagation with two windows in place on each
+ * half-edge ("slots"), run in vertex order by the march's heap (internal;
+ * a prototype for issue 43, measured by bench/micro/bench_slots.c). Every
+ * value it writes is the length of a path on the surface, so never below
+ * the exact solver's beyond rounding. The design: slots.c. */
+#ifndef MFMM_EXACT_SLOTS_H
+#define MFMM_EXACT_SLOTS_H
+
+#include <stdint.h>
+
+#include "exact.h"
+
+typedef struct mfmm_slots mfmm_slots;
+
+/* A workspace on the mesh's exact tables (mfmm_exact_tables_of). */
+mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out);
+void mfmm_slots_destroy(mfmm_slots *s);
+
+/* The pass rule: bit 0 clear (default) passes the windows entering a face
+ * through an edge once both of the edge's ends have settled (each half-edge
+ * once); set, only the first such edge of each face. Bit 1 set: a window
+ * kept in a slot after its half-edge was passed is crossed at once (else it
+ * waits for nothing: it is dropped). Bit 2 set: a third window takes a
+ * slot only from a window it dominates (no longer at the slot's interval's
+ * ends and middle; the worse score where it dominates both), else the least
+ * score rank (sum of the values at the edge's ends and middle) decides.
+ * Bits 2-3 = 2: the score is that of the window's function over the whole
+ * edge (its interval ignored); = 3: the least score, and a window less than
+ * a slot's at its own interval's ends and middle takes that slot too. Bits 4-5, to measure what the parts cost:
+ * bit 4 no vertex offers but the source's (edge relaxation instead), bit 5
+ * no passes (offers and relaxation only). Bit 6: prefetch the face records
+ * of the vertex at the heap's top. Bit 7: a vertex offers windows only
+ * where needed: a saddle, a vertex at a wall, or one whose distance did not
+ * come from a window's ray (edge relaxation, a window's end). */
+void mfmm_slots_set_rule(mfmm_slots *s, int rule);
+
+/* K windows per half-edge instead of 2 (1 to 8; ranks 1 and 3 of the rule
+ * need 2, and fall back to rank 0). 0 when out of memory or K is out of
+ * range. */
+int mfmm_slots_set_k(mfmm_slots *s, int K);
+
+/* Distances from internal vertex `source` to every vertex, in internal
+ * order (out: nv, +inf where not reached). */
+void mfmm_slots_solve(mfmm_slots *s, int32_t source, double *out);
+
+/* Counters of the last solve. */
+typedef struct mfmm_slots_info {
+    int64_t crossed;   /* windows passed across a face */
+    int64_t emitted;   /* windows offered to a slot (children and vertex offers) */
+    int64_t kept;      /* of those, kept in a slot */
+    int64_t late;      /* kept in a half-edge already passed */
+    int64_t late_vertex; /* lowerings of a settled vertex */
+    int64_t settled;
+    int64_t narrow, trimmed, evicted; /* offers dropped: too narrow, trimmed away, one of three */
+    int64_t local;     /* slots taken by rank 3's local rule */
+    int64_t merged;    /* offers joined to a slot with the same pseudo-source */
+} mfmm_slots_info;
+void mfmm_slots_get_info(const mfmm_slots *s, mfmm_slots_info *info);
+
+#endif
