@@ -9,8 +9,10 @@
  * triangulated square (gen grid 24) and an obtuse lattice (stretch 3) the
  * slots' distances against the Euclidean ones.
  *
- *   bench_slots [--repeats R] [--sources S] [--k K] [--rules LIST] [MESH...]
+ *   bench_slots [--repeats R] [--sources S] [--k K] [--rules LIST] [--flat] [MESH...]
  *
+ * --flat: the flat checks only (also Delaunay triangulations of random
+ * points in a square and a disc, stretched 1, 8 and 30 times in x).
  * --k: windows per half-edge (default 2); --rules: the slot rules to run
  * (src/exact/slots.h; default 66,194,67,82,98).
  * MESH: a mesh file or gen:icosphere5 / gen:sine100; default the five real
@@ -245,13 +247,15 @@ static void bench_mesh(const char *name, const double *V, int32_t nv, const int3
 
 int main(int argc, char **argv)
 {
-    int repeats = 5, ns = 5, np = 0;
+    int repeats = 5, ns = 5, np = 0, flat_only = 0;
     const char *paths[64];
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--repeats") && i + 1 < argc)
             repeats = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--sources") && i + 1 < argc)
             ns = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--flat"))
+            flat_only = 1;
         else if (!strcmp(argv[i], "--k") && i + 1 < argc)
             slot_k = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--rules") && i + 1 < argc) {
@@ -283,6 +287,23 @@ int main(int argc, char **argv)
     g = mfmm_gen_lattice(20, 3.0);
     flat_check("lattice20x3", g);
     mfmm_gen_free(&g);
+    {
+        /* convex regions: Delaunay triangulations of random points in a
+         * square and a disc, stretched to needles and obtuse corners */
+        static const double stretch[3] = {1.0, 8.0, 30.0};
+        for (int disc = 0; disc < 2; disc++)
+            for (int si = 0; si < 3; si++)
+                for (int seed = 1; seed <= 2; seed++) {
+                    char nm[64];
+                    snprintf(nm, sizeof nm, "delaunay-%s-x%g-s%d", disc ? "disc" : "square",
+                             stretch[si], seed);
+                    g = mfmm_gen_delaunay(300, disc, stretch[si], (uint64_t)seed);
+                    flat_check(nm, g);
+                    mfmm_gen_free(&g);
+                }
+    }
+    if (flat_only)
+        return 0;
     for (int i = 0; i < np; i++) {
         if (!strncmp(paths[i], "gen:", 4)) {
             mfmm_gen_mesh q = {0};

@@ -79,9 +79,13 @@ struct mfmm_slots {
     uint8_t *passed;  /* (3 nf) */
     uint8_t *fpassed; /* (nf) a half-edge of the face has been passed (rule 1) */
     double *d;
+    uint8_t *need;    /* (nv) a vertex that may bend a path: the exact tables' pseudo-source
+                         flag, less vertices at a wall whose angle sum is pi or less */
+    uint8_t *flat;    /* (nv) rule bit 9: offers redundant after a ray (mfmm_slots_create) */
     uint8_t *ray;     /* (nv) d came from a window's straight ray (not an edge, not a
                          window's end) */
     mfmm_march_state h; /* T unused; label 0 far, 1 close, 2 settled */
+    mfmm_march_state e; /* rule bit 8: half-edges keyed by their windows' least distance */
     int rule;
     int K; /* windows per half-edge (mfmm_slots_set_k), 2 by default */
     int rank; /* 0: the least score; 1: dominance on the slot's interval; 2: the least
@@ -91,6 +95,8 @@ struct mfmm_slots {
     int prefetch; /* bit 6 of the rule: prefetch the next vertex's face records */
     int needed; /* bit 7: a vertex offers windows only where needed (sl_solve) */
     int late_mode; /* 1: a window kept after its half-edge passed is crossed at once */
+    int order;     /* bit 8: a half-edge is passed in distance order (its windows' least
+                      value), not when its ends have settled */
     mfmm_slots_info info;
 };
 
@@ -114,20 +120,63 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     s->vf_corner = t->vf_corner;
     s->face_in = t->face_in;
     s->K = 2;
+    mfmm_slots_set_rule(s, SL_RULE_MAIN);
     s->slot = malloc((2 * nh + 1) * sizeof *s->slot);
     s->n_slot = malloc(nh + 1);
     s->passed = malloc(nh + 1);
     s->fpassed = malloc(nf + 1);
     s->d = malloc((nv + 1) * sizeof *s->d);
     s->ray = malloc(nv + 1);
+    s->need = malloc(nv + 1);
+    s->flat = malloc(nv + 1);
     s->h.label = malloc(nv + 1);
     s->h.heap_key = malloc((nv + 1) * sizeof(double));
     s->h.heap_vertex = malloc((nv + 1) * sizeof(int32_t));
     s->h.heap_pos = malloc((nv + 1) * sizeof(int32_t));
-    if (!s->slot || !s->n_slot || !s->passed || !s->fpassed || !s->d || !s->ray || !s->h.label ||
+    s->e.label = malloc(nh + 1);
+    s->e.heap_key = malloc((nh + 1) * sizeof(double));
+    s->e.heap_vertex = malloc((nh + 1) * sizeof(int32_t));
+    s->e.heap_pos = malloc((nh + 1) * sizeof(int32_t));
+    if (!s->e.label || !s->e.heap_key || !s->e.heap_vertex || !s->e.heap_pos ||
+        !s->slot || !s->n_slot || !s->passed || !s->fpassed || !s->d || !s->ray || !s->need || !s->flat || !s->h.label ||
         !s->h.heap_key || !s->h.heap_vertex || !s->h.heap_pos) {
         mfmm_slots_destroy(s);
         return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    /* a vertex at a wall (two wall edges, no zero-area face or copy) whose
+     * angle sum is pi or less bends no shortest path: it needs no offers */
+    for (size_t v = 0; v < nv; v++) {
+        s->need[v] = t->pseudo[v];
+        if (!s->need[v])
+            continue;
+        double a = 0.0;
+        int walls = 0, odd = 0;
+        for (int32_t j = t->vf_offset[v]; j < t->vf_offset[v + 1]; j++) {
+            int32_t c = ex_corner(t->vf_corner, t->face_in, j);
+            const ex_face *r = t->fr + c / 3;
+            int k = c % 3;
+            odd |= r->skip != 0;
+            a += r->angle[k];
+            walls += (r->across[ex_next[k]] < 0) + (r->across[ex_prev[k]] < 0);
+        }
+        s->need[v] = odd || walls != 2 || !(a <= EX_PI * (1.0 + 1e-9));
+    }
+    /* rule bit 9: a vertex whose offers the windows beside it make
+     * redundant once a ray reaches it: one whose neighbourhood unfolds flat
+     * (an angle sum of 2 pi, no wall) or a wall's vertex of pi or less */
+    for (size_t v = 0; v < nv; v++) {
+        double a = 0.0;
+        int walls = 0, odd = 0;
+        for (int32_t j = t->vf_offset[v]; j < t->vf_offset[v + 1]; j++) {
+            int32_t c = ex_corner(t->vf_corner, t->face_in, j);
+            const ex_face *r = t->fr + c / 3;
+            int k = c % 3;
+            odd |= r->skip != 0;
+            a += r->angle[k];
+            walls += (r->across[ex_next[k]] < 0) + (r->across[ex_prev[k]] < 0);
+        }
+        s->flat[v] = !s->need[v] && !odd &&
+                     ((walls == 0 && fabs(a - EX_TWO_PI) <= 1e-9 * EX_TWO_PI) || walls == 2);
     }
     *out = s;
     return MFMM_OK;
@@ -143,10 +192,16 @@ void mfmm_slots_destroy(mfmm_slots *s)
     free(s->fpassed);
     free(s->d);
     free(s->ray);
+    free(s->need);
+    free(s->flat);
     free(s->h.label);
     free(s->h.heap_key);
     free(s->h.heap_vertex);
     free(s->h.heap_pos);
+    free(s->e.label);
+    free(s->e.heap_key);
+    free(s->e.heap_vertex);
+    free(s->e.heap_pos);
     free(s);
 }
 
@@ -158,6 +213,8 @@ void mfmm_slots_set_rule(mfmm_slots *s, int rule)
     s->ablate = (rule >> 4) & 3;
     s->prefetch = (rule >> 6) & 1;
     s->needed = (rule >> 7) & 1;
+    s->order = (rule >> 8) & 1;
+    s->needed |= (rule >> 8) & 2; /* bit 9: only flat vertices skip their offers */
 }
 
 int mfmm_slots_set_k(mfmm_slots *s, int K)
@@ -180,10 +237,16 @@ void mfmm_slots_get_info(const mfmm_slots *s, mfmm_slots_info *info)
 
 static inline void sl_update(mfmm_slots *s, int32_t v, double dist, int ray)
 {
-    if (!(dist < s->d[v]))
+    if (!(dist < s->d[v])) {
+        /* a ray as long as the value to rounding: the windows beside it
+         * carry its paths on (a wall's straight side, relaxed along) */
+        if (ray && dist <= s->d[v] + 1e-12 * s->d[v])
+            s->ray[v] = 1;
         return;
+    }
+    /* a value lower only by rounding keeps the ray it had */
+    s->ray[v] = (uint8_t)(ray | (s->ray[v] & (dist >= s->d[v] - 1e-12 * s->d[v])));
     s->d[v] = dist;
-    s->ray[v] = (uint8_t)ray;
     uint8_t lab = s->h.label[v];
     if (lab == 2) {
         s->info.late_vertex++;
@@ -231,6 +294,22 @@ static inline double sl_score(int rank, double L, double b0, double b1, double p
            sl_at(L, b0, b1, px, py, sigma);
 }
 
+/* rule bit 8: half-edge g (not passed) holds a window whose least value is
+ * sigma + the distance from (px, py) to [b0, b1]: g is passed by then */
+static inline void sl_key(mfmm_slots *s, int32_t g, double b0, double b1, double px, double py,
+                          double sigma)
+{
+    if (!s->order)
+        return;
+    double c = px < b0 ? b0 : px > b1 ? b1 : px;
+    double m = sigma + sqrt((c - px) * (c - px) + py * py);
+    uint8_t lab = s->e.label[g];
+    if (lab == 2 || (lab == 1 && !(m < s->e.heap_key[s->e.heap_pos[g]])))
+        return;
+    mfmm_heap_push_or_decrease(&s->e, g, m, lab == 1);
+    s->e.label[g] = 1;
+}
+
 /* A window leaving face h / 3 through half-edge h (in h's frame, its
  * pseudo-source (ix, iy), iy >= 0, on the face's side), interval [s0, s1]:
  * lowers the edge's ends it reaches, then is offered to the slots of the
@@ -255,8 +334,8 @@ static void sl_emit(mfmm_slots *s, int32_t h, double s0, double s1, double ix, d
     double iy2 = iy * iy;
     if (offer) {
         /* a vertex's offer: its ends at the face's edge lengths */
-        sl_update(s, va, sigma + r->len[ex_prev[k]], 0);
-        sl_update(s, vb, sigma + r->len[ex_next[k]], 0);
+        sl_update(s, va, sigma + r->len[ex_prev[k]], offer == 2);
+        sl_update(s, vb, sigma + r->len[ex_next[k]], offer == 2);
     } else {
         if (s0 <= EX_POS_TOL * L)
             sl_update(s, va, sigma + sqrt(ix * ix + iy2), 1);
@@ -293,6 +372,7 @@ static void sl_emit(mfmm_slots *s, int32_t h, double s0, double s1, double ix, d
         w[i].b1 = u1;
         w[i].score = NAN;
         s->info.merged++;
+        sl_key(s, g, b0, b1, px, py, sigma);
         if (s->passed[g] && s->late_mode) {
             s->info.late++;
             sl_win c = {b0, b1, px, py, sigma, 0.0};
@@ -355,6 +435,7 @@ static void sl_emit(mfmm_slots *s, int32_t h, double s0, double s1, double ix, d
     }
     w[at] = (sl_win){b0, b1, px, py, sigma, score};
     s->info.kept++;
+    sl_key(s, g, b0, b1, px, py, sigma);
     if (s->passed[g] && s->late_mode) {
         /* kept after its half-edge was passed: crossed at once */
         s->info.late++;
@@ -446,12 +527,22 @@ void mfmm_slots_solve(mfmm_slots *s, int32_t source, double *out)
     memset(s->passed, 0, nh);
     memset(s->fpassed, 0, (size_t)s->nf);
     memset(s->h.label, 0, nv);
+    memset(s->e.label, 0, nh);
+    s->e.heap_size = 0;
     for (size_t v = 0; v < nv; v++)
         s->d[v] = INFINITY;
     s->h.heap_size = 0;
     sl_update(s, source, 0.0, 0);
     const ex_face *fr = s->fr;
-    while (s->h.heap_size > 0) {
+    while (s->h.heap_size > 0 || s->e.heap_size > 0) {
+        if (s->e.heap_size > 0 &&
+            (s->h.heap_size == 0 || s->e.heap_key[0] <= s->h.heap_key[0])) {
+            /* rule bit 8: the half-edge whose windows come next */
+            int32_t g = mfmm_heap_pop(&s->e);
+            s->e.label[g] = 2;
+            sl_pass(s, g);
+            continue;
+        }
         int32_t v = mfmm_heap_pop(&s->h);
         s->h.label[v] = 2;
 #ifdef __GNUC__
@@ -481,7 +572,7 @@ void mfmm_slots_solve(mfmm_slots *s, int32_t source, double *out)
                 }
                 continue;
             }
-            if ((s->ablate & 1) || (s->needed && s->ray[v] && !s->t->pseudo[v])) {
+            if ((s->ablate & 1) || (s->needed && s->ray[v] && !s->need[v] && (!(s->needed & 2) || s->flat[v]))) {
                 /* no offers (ablate), or not needed: a vertex reached by a
                  * window's ray, that bends no shortest path (not a saddle,
                  * not at a wall), has the windows beside it carry its paths
@@ -491,9 +582,10 @@ void mfmm_slots_solve(mfmm_slots *s, int32_t source, double *out)
                 if (v != source)
                     continue;
             }
-            sl_emit(s, c, 0.0, r->len[k], r->cx[k], r->cy[k], dv, 1);
+            sl_emit(s, c, 0.0, r->len[k], r->cx[k], r->cy[k], dv,
+                    v == source ? 2 : 1);
         }
-        if (s->ablate & 2)
+        if ((s->ablate & 2) || s->order)
             continue;
         for (int32_t i = i0; i < i1; i++) {
             int32_t c = ex_corner(s->vf_corner, s->face_in, i);

@@ -33,6 +33,15 @@ void mfmm_slots_destroy(mfmm_slots *s);
  * where needed: a saddle, a vertex at a wall, or one whose distance did not
  * come from a window's ray (edge relaxation, a window's end). */
 void mfmm_slots_set_rule(mfmm_slots *s, int rule);
+/* Bit 8: a half-edge is passed when the front reaches its windows' least
+ * value (a second heap, of half-edges, beside the vertices'), not when its
+ * ends have settled; a window that comes later is crossed at once (bit 1).
+ * Bit 9 (with bit 7): only a vertex reached by a ray whose neighbourhood
+ * unfolds flat (angle sum 2 pi, or a wall's vertex of pi or less) skips its
+ * offers. The main rule, 834 (bits 1, 6, 7, 8, 9), set by
+ * mfmm_slots_create: exact on triangulations of convex planar regions, as
+ * accurate as rule 66 on curved meshes. */
+#define SL_RULE_MAIN 834
 
 /* K windows per half-edge instead of 2 (1 to 8; ranks 1 and 3 of the rule
  * need 2, and fall back to rank 0). 0 when out of memory or K is out of

@@ -2,8 +2,11 @@
  * a path's length (never below the exact solver's beyond 1e-9 relative) and
  * every vertex the exact solver reaches is reached, on flat, curved,
  * non-manifold and boundary meshes and under each rule measured in
- * bench/micro/bench_slots.c; with offers only where needed (rule 194) it is
- * exact on a flat triangulated square. */
+ * bench/micro/bench_slots.c. The main rule (SL_RULE_MAIN) equals the
+ * Euclidean distances on triangulations of convex planar regions (random
+ * Delaunay points in a square and a disc, stretched to needles and obtuse
+ * corners) to 1e-12 relative, and the exact solver's on the obtuse
+ * lattice, at K = 2 and 3. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -20,7 +23,7 @@
 #include "mesh/order.h"
 #include "meshfmm.h"
 
-static const int rules[] = {0, 2, 66, 194, 67, 74, 78};
+static const int rules[] = {SL_RULE_MAIN, 0, 2, 66, 194, 322, 450, 67, 74, 78};
 
 /* max |slots - exact| over three sources, with the lower-bound and reach
  * checks asserted */
@@ -65,12 +68,77 @@ static void gen_check(mfmm_gen_mesh g, int flat)
     assert_true(g.nv > 0);
     for (size_t r = 0; r < sizeof rules / sizeof *rules; r++) {
         double worst = check_mesh(g.V, g.nv, g.F, g.nf, rules[r]);
-        if (flat && rules[r] == 194 && !(worst <= 1e-12))
-            print_message("flat nv %d rule 194: max abs diff %.3e\n", (int)g.nv, worst);
-        if (flat && rules[r] == 194)
+        if (flat && (rules[r] == 194 || rules[r] == SL_RULE_MAIN) && !(worst <= 1e-12))
+            print_message("flat nv %d rule %d: max abs diff %.3e\n", (int)g.nv, rules[r], worst);
+        if (flat && (rules[r] == 194 || rules[r] == SL_RULE_MAIN))
             assert_true(worst <= 1e-12);
     }
     mfmm_gen_free(&g);
+}
+
+/* Rule SL_RULE_MAIN from five vertex sources on a planar mesh: every
+ * distance equals the Euclidean one to 1e-12 relative (convex: 1) or the
+ * exact solver's (not convex), K windows per half-edge */
+static void flat_exact(mfmm_gen_mesh g, int convex, int K)
+{
+    assert_true(g.nv > 0);
+    mfmm_mesh *mesh = NULL;
+    mfmm_exact_solver *ex = NULL;
+    mfmm_slots *sl = NULL;
+    mfmm_error err;
+    assert_int_equal(mfmm_mesh_create(g.V, g.nv, g.F, g.nf, NULL, &mesh, &err), MFMM_OK);
+    assert_int_equal(mfmm_exact_solver_create(mesh, &ex), MFMM_OK);
+    assert_int_equal(mfmm_slots_create(mesh, &sl), MFMM_OK);
+    assert_true(mfmm_slots_set_k(sl, K));
+    double *e = malloc((size_t)g.nv * sizeof *e), *d = malloc((size_t)g.nv * sizeof *d);
+    assert_non_null(e);
+    assert_non_null(d);
+    int32_t srcs[5] = {0, g.nv / 5, g.nv / 2, g.nv - 1 - g.nv / 7, g.nv - 1};
+    for (int q = 0; q < 5; q++) {
+        int32_t s = srcs[q];
+        if (!convex) {
+            mfmm_source s0 = {s, -1, {0, 0, 0}, 0.0};
+            assert_int_equal(mfmm_solve_exact(ex, &s0, 1, NULL, e, NULL, NULL), MFMM_OK);
+        }
+        mfmm_slots_solve(sl, mfmm_vertex_in(mesh, s), d);
+        for (int32_t i = 0; i < g.nv; i++) {
+            int32_t v = mfmm_vertex_out(mesh, i);
+            double ref = convex ? hypot(g.V[3 * v] - g.V[3 * s], g.V[3 * v + 1] - g.V[3 * s + 1])
+                                : e[v];
+            double tol = 1e-12 * ref + 1e-15;
+            if (!(fabs(d[i] - ref) <= tol))
+                print_message("nv %d K %d source %d vertex %d: %.17g, reference %.17g\n",
+                              (int)g.nv, K, (int)s, (int)v, d[i], ref);
+            assert_true(fabs(d[i] - ref) <= tol);
+        }
+    }
+    free(e);
+    free(d);
+    mfmm_slots_destroy(sl);
+    mfmm_exact_solver_destroy(ex);
+    mfmm_mesh_destroy(mesh);
+    mfmm_gen_free(&g);
+}
+
+/* triangulations of convex planar regions: random Delaunay points in a
+ * square and a disc, stretched 1, 8 and 30 times (needles, obtuse
+ * corners); the grid; the obtuse lattice (not convex: against the exact
+ * solver) */
+static void test_flat_exact(void **state)
+{
+    (void)state;
+    static const double stretch[3] = {1.0, 8.0, 30.0};
+    for (int K = 2; K <= 3; K++) {
+        for (int disc = 0; disc < 2; disc++)
+            for (int si = 0; si < 3; si++)
+                for (uint64_t seed = 1; seed <= 3; seed++)
+                    flat_exact(mfmm_gen_delaunay(300, disc, stretch[si], seed), 1, K);
+        flat_exact(mfmm_gen_delaunay(1500, 0, 8.0, 7), 1, K);
+        flat_exact(mfmm_gen_delaunay(1500, 1, 30.0, 7), 1, K);
+        flat_exact(mfmm_gen_grid(24), 1, K);
+        flat_exact(mfmm_gen_lattice(8, 3.0), 0, K);
+        flat_exact(mfmm_gen_lattice(20, 3.0), 0, K);
+    }
 }
 
 static void test_flat(void **state)
@@ -80,7 +148,7 @@ static void test_flat(void **state)
     gen_check(mfmm_gen_grid(7), 1);
     /* (not convex: its zigzag sides bend paths; rule 194 leaves the corner
      * (0, 0) 0.058 above the exact value from vertex 37 of lattice(8, 3),
-     * so the lower bound only) */
+     * so the lower bound only; the main rule: test_flat_exact) */
     gen_check(mfmm_gen_lattice(12, 3.0), 0);
 }
 
@@ -114,6 +182,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_flat),
+        cmocka_unit_test(test_flat_exact),
         cmocka_unit_test(test_curved),
         cmocka_unit_test(test_files),
     };
