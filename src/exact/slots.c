@@ -81,6 +81,7 @@ struct mfmm_slots {
     double *d;
     uint8_t *need;    /* (nv) a vertex that may bend a path: the exact tables' pseudo-source
                          flag, less vertices at a wall whose angle sum is pi or less */
+    uint8_t *is_src;  /* (nv) the vertex sources of the solve */
     uint8_t *flat;    /* (nv) rule bit 9: offers redundant after a ray (mfmm_slots_create) */
     uint8_t *ray;     /* (nv) d came from a window's straight ray (not an edge, not a
                          window's end) */
@@ -129,6 +130,7 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     s->ray = malloc(nv + 1);
     s->need = malloc(nv + 1);
     s->flat = malloc(nv + 1);
+    s->is_src = calloc(nv + 1, 1);
     s->h.label = malloc(nv + 1);
     s->h.heap_key = malloc((nv + 1) * sizeof(double));
     s->h.heap_vertex = malloc((nv + 1) * sizeof(int32_t));
@@ -138,7 +140,7 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     s->e.heap_vertex = malloc((nh + 1) * sizeof(int32_t));
     s->e.heap_pos = malloc((nh + 1) * sizeof(int32_t));
     if (!s->e.label || !s->e.heap_key || !s->e.heap_vertex || !s->e.heap_pos ||
-        !s->slot || !s->n_slot || !s->passed || !s->fpassed || !s->d || !s->ray || !s->need || !s->flat || !s->h.label ||
+        !s->slot || !s->n_slot || !s->passed || !s->fpassed || !s->d || !s->ray || !s->need || !s->flat || !s->is_src || !s->h.label ||
         !s->h.heap_key || !s->h.heap_vertex || !s->h.heap_pos) {
         mfmm_slots_destroy(s);
         return MFMM_ERR_OUT_OF_MEMORY;
@@ -194,6 +196,7 @@ void mfmm_slots_destroy(mfmm_slots *s)
     free(s->ray);
     free(s->need);
     free(s->flat);
+    free(s->is_src);
     free(s->h.label);
     free(s->h.heap_key);
     free(s->h.heap_vertex);
@@ -519,7 +522,7 @@ static void sl_pass(mfmm_slots *s, int32_t h)
     }
 }
 
-void mfmm_slots_solve(mfmm_slots *s, int32_t source, double *out)
+static void sl_reset(mfmm_slots *s)
 {
     size_t nv = (size_t)s->nv, nh = 3 * (size_t)s->nf;
     memset(&s->info, 0, sizeof s->info);
@@ -532,7 +535,12 @@ void mfmm_slots_solve(mfmm_slots *s, int32_t source, double *out)
     for (size_t v = 0; v < nv; v++)
         s->d[v] = INFINITY;
     s->h.heap_size = 0;
-    sl_update(s, source, 0.0, 0);
+}
+
+/* the march, from the sources seeded (is_src marks the vertex sources) */
+static void sl_run(mfmm_slots *s, double *out)
+{
+    size_t nv = (size_t)s->nv;
     const ex_face *fr = s->fr;
     while (s->h.heap_size > 0 || s->e.heap_size > 0) {
         if (s->e.heap_size > 0 &&
@@ -579,11 +587,11 @@ void mfmm_slots_solve(mfmm_slots *s, int32_t source, double *out)
                  * on; the edges only */
                 sl_update(s, r->v[ex_next[k]], dv + r->len[ex_prev[k]], 0);
                 sl_update(s, r->v[ex_prev[k]], dv + r->len[ex_next[k]], 0);
-                if (v != source)
+                if (!s->is_src[v])
                     continue;
             }
             sl_emit(s, c, 0.0, r->len[k], r->cx[k], r->cy[k], dv,
-                    v == source ? 2 : 1);
+                    s->is_src[v] ? 2 : 1);
         }
         if ((s->ablate & 2) || s->order)
             continue;
@@ -603,4 +611,49 @@ void mfmm_slots_solve(mfmm_slots *s, int32_t source, double *out)
     }
     for (size_t v = 0; v < nv; v++)
         out[v] = s->d[v];
+}
+
+void mfmm_slots_solve(mfmm_slots *s, int32_t source, double *out)
+{
+    mfmm_slots_solve_multi(s, 1, &source, NULL, out);
+}
+
+void mfmm_slots_solve_multi(mfmm_slots *s, int32_t n, const int32_t *src, const double *value,
+                            double *out)
+{
+    sl_reset(s);
+    for (int32_t i = 0; i < n; i++) {
+        sl_update(s, src[i], value ? value[i] : 0.0, 0);
+        s->is_src[src[i]] = 1;
+    }
+    sl_run(s, out);
+    for (int32_t i = 0; i < n; i++)
+        s->is_src[src[i]] = 0;
+}
+
+void mfmm_slots_solve_face(mfmm_slots *s, int32_t f, const int32_t fv[3], const double w[3],
+                           double *out)
+{
+    sl_reset(s);
+    const ex_face *r = s->fr + f;
+    double b[3] = {0.0, 0.0, 0.0};
+    for (int k = 0; k < 3; k++)
+        for (int j = 0; j < 3; j++)
+            if (fv[j] == r->v[k])
+                b[k] = w[j];
+    double sum = b[0] + b[1] + b[2];
+    if (r->skip || !(sum > 0.0)) {
+        /* a face with no area (or no weights): nothing reached */
+        sl_run(s, out);
+        return;
+    }
+    for (int k = 0; k < 3; k++) {
+        /* the point in half-edge 3f+k's frame (corner k+1 at 0, k+2 at L,
+         * corner k at (cx, cy)): a window of the whole edge, sigma 0, that
+         * also sets the edge's ends to their straight distances */
+        double bk = b[k] / sum, b2 = b[ex_prev[k]] / sum, L = r->len[k];
+        double ix = bk * r->cx[k] + b2 * L, iy = bk * r->cy[k];
+        sl_emit(s, 3 * f + k, 0.0, L, ix, iy, 0.0, 0);
+    }
+    sl_run(s, out);
 }

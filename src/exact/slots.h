@@ -52,6 +52,18 @@ int mfmm_slots_set_k(mfmm_slots *s, int K);
  * order (out: nv, +inf where not reached). */
 void mfmm_slots_solve(mfmm_slots *s, int32_t source, double *out);
 
+/* Several vertex sources (internal ids), each with its value (value NULL:
+ * all 0); out as mfmm_slots_solve. */
+void mfmm_slots_solve_multi(mfmm_slots *s, int32_t n, const int32_t *src, const double *value,
+                            double *out);
+
+/* A point in internal face f: w[j] the barycentric weight of internal
+ * vertex fv[j] (fv: f's corners in any order). Its corners get their
+ * straight distances and its edges windows of the point. A face with no
+ * area (or weights summing to 0 or less) reaches nothing: all +inf. */
+void mfmm_slots_solve_face(mfmm_slots *s, int32_t f, const int32_t fv[3], const double w[3],
+                           double *out);
+
 /* Counters of the last solve. */
 typedef struct mfmm_slots_info {
     int64_t crossed;   /* windows passed across a face */

@@ -141,6 +141,109 @@ static void test_flat_exact(void **state)
     }
 }
 
+/* Three vertex sources with values, and a point in a face: on a planar
+ * convex mesh (flat 1) the Euclidean distances to 1e-12 relative (the
+ * multi-source field also equals the min of the single-source ones plus
+ * their values); on any mesh never below the exact solver's. */
+static void sources_check(mfmm_gen_mesh g, int flat)
+{
+    assert_true(g.nv > 0);
+    mfmm_mesh *mesh = NULL;
+    mfmm_exact_solver *ex = NULL;
+    mfmm_slots *sl = NULL;
+    mfmm_error err;
+    assert_int_equal(mfmm_mesh_create(g.V, g.nv, g.F, g.nf, NULL, &mesh, &err), MFMM_OK);
+    assert_int_equal(mfmm_exact_solver_create(mesh, &ex), MFMM_OK);
+    assert_int_equal(mfmm_slots_create(mesh, &sl), MFMM_OK);
+    size_t nv = (size_t)g.nv;
+    double *e = malloc(nv * sizeof *e), *d = malloc(nv * sizeof *d), *m = malloc(nv * sizeof *m);
+    double *one = malloc(nv * sizeof *one);
+    assert_non_null(e);
+    assert_non_null(d);
+    assert_non_null(m);
+    assert_non_null(one);
+    int32_t src[3] = {g.nv / 9, g.nv / 2, g.nv - 1 - g.nv / 5}, in[3];
+    double val[3] = {0.0, 0.1, 0.35};
+    mfmm_source es[3];
+    for (int q = 0; q < 3; q++) {
+        in[q] = mfmm_vertex_in(mesh, src[q]);
+        es[q] = (mfmm_source){src[q], -1, {0, 0, 0}, val[q]};
+    }
+    /* vertex sources */
+    for (size_t i = 0; i < nv; i++)
+        m[i] = INFINITY;
+    for (int q = 0; q < 3; q++) {
+        mfmm_slots_solve(sl, in[q], one);
+        for (size_t i = 0; i < nv; i++)
+            m[i] = fmin(m[i], val[q] + one[i]);
+    }
+    mfmm_slots_solve_multi(sl, 3, in, val, d);
+    assert_int_equal(mfmm_solve_exact(ex, es, 3, NULL, e, NULL, NULL), MFMM_OK);
+    for (int32_t i = 0; i < g.nv; i++) {
+        int32_t v = mfmm_vertex_out(mesh, i);
+        assert_true(d[i] >= e[v] - 1e-9 * e[v]);
+        if (!flat)
+            continue;
+        double ref = INFINITY;
+        for (int q = 0; q < 3; q++)
+            ref = fmin(ref, val[q] + hypot(g.V[3 * v] - g.V[3 * src[q]],
+                                           g.V[3 * v + 1] - g.V[3 * src[q] + 1]));
+        assert_true(fabs(d[i] - ref) <= 1e-12 * ref);
+        assert_true(fabs(d[i] - m[i]) <= 1e-12 * ref);
+    }
+    /* a point in a face */
+    for (int32_t fi = 0; fi < g.nf; fi += g.nf / 3 + 1) {
+        double w[3] = {0.2, 0.5, 0.3};
+        mfmm_source fs = {-1, fi, {w[0], w[1], w[2]}, 0.0};
+        int32_t f = mfmm_face_in(mesh, fi), fv[3];
+        for (int j = 0; j < 3; j++)
+            fv[j] = mfmm_vertex_in(mesh, g.F[3 * fi + j]);
+        mfmm_slots_solve_face(sl, f, fv, w, d);
+        assert_int_equal(mfmm_solve_exact(ex, &fs, 1, NULL, e, NULL, NULL), MFMM_OK);
+        double p[2] = {0.0, 0.0};
+        for (int j = 0; j < 3; j++) {
+            p[0] += w[j] * g.V[3 * g.F[3 * fi + j]];
+            p[1] += w[j] * g.V[3 * g.F[3 * fi + j] + 1];
+        }
+        for (int32_t i = 0; i < g.nv; i++) {
+            int32_t v = mfmm_vertex_out(mesh, i);
+            if (!isfinite(e[v]))
+                continue;
+            assert_true(isfinite(d[i]));
+            assert_true(d[i] >= e[v] - 1e-9 * e[v]);
+            if (!flat)
+                continue;
+            double ref = hypot(g.V[3 * v] - p[0], g.V[3 * v + 1] - p[1]);
+            if (!(fabs(d[i] - ref) <= 1e-12 * ref))
+                print_message("face %d vertex %d: %.17g, euclid %.17g\n", (int)fi, (int)v, d[i],
+                              ref);
+            assert_true(fabs(d[i] - ref) <= 1e-12 * ref);
+        }
+    }
+    free(e);
+    free(d);
+    free(m);
+    free(one);
+    mfmm_slots_destroy(sl);
+    mfmm_exact_solver_destroy(ex);
+    mfmm_mesh_destroy(mesh);
+    mfmm_gen_free(&g);
+}
+
+static void test_sources(void **state)
+{
+    (void)state;
+    for (uint64_t seed = 1; seed <= 3; seed++) {
+        sources_check(mfmm_gen_delaunay(300, 0, 1.0, seed), 1);
+        sources_check(mfmm_gen_delaunay(300, 1, 8.0, seed), 1);
+        sources_check(mfmm_gen_delaunay(300, 0, 30.0, seed), 1);
+    }
+    sources_check(mfmm_gen_grid(16), 1);
+    sources_check(mfmm_gen_icosphere(3), 0);
+    sources_check(mfmm_gen_sine(24), 0);
+    sources_check(mfmm_gen_torus(24, 12, 1.0, 0.3), 0);
+}
+
 static void test_flat(void **state)
 {
     (void)state;
@@ -183,6 +286,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_flat),
         cmocka_unit_test(test_flat_exact),
+        cmocka_unit_test(test_sources),
         cmocka_unit_test(test_curved),
         cmocka_unit_test(test_files),
     };
