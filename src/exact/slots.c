@@ -10,26 +10,40 @@
  *   sigma and the interval [b0, b1] of the edge its rays cross (the same
  *   fields as the exact solver's queue entries). No queue entry per window.
  * - Order. A heap of vertices keyed by their current distance (the march's
- *   heap, march/march.h). When a vertex v settles:
+ *   heap, march/march.h) and, with bit 8 of the rule (the main rule,
+ *   SL_RULE_MAIN = 834), a heap of half-edges keyed by the least value of
+ *   the windows they hold (sigma + the distance to the interval); the lower
+ *   top is taken first. When a vertex v settles:
  *   (1) it offers a window to the opposite edge of each face f around it:
  *       itself as pseudo-source, sigma = d(v), the whole edge; the offer
  *       lowers the edge's ends to d(v) + |edge| (the edge relaxation, so
  *       every reached vertex has a path) and goes into the slots of the
  *       half-edge across (the face beyond f);
- *   (2) for each face f at v and each edge of f from v to a corner u that
- *       settled before, the windows in that half-edge's slots are passed
- *       across f (rule 0: every half-edge once, when its second end
- *       settles; rule 1: only the first edge of each face to have both ends
- *       settled). A pass lowers the far corner where the window sees it
- *       (or grazes it, over the window's end, as ex_propagate) and offers
+ *   (2) without bit 8: for each face f at v and each edge of f from v to a
+ *       corner u that settled before, the windows in that half-edge's slots
+ *       are passed across f (rule 0: every half-edge once, when its second
+ *       end settles; rule 1: only the first edge of each face to have both
+ *       ends settled). With bit 8 a half-edge is passed when it comes off
+ *       its heap: the window that reaches a face's far corner is crossed
+ *       before that corner settles even where the corner is nearer than the
+ *       edge's ends (an obtuse face: in vertex order the corner settled on
+ *       an edge-relaxed value, offered windows that were not paths' ends
+ *       and these took the source's pieces' slots; a flat mesh stretched 8x
+ *       was 0.33 off). A pass lowers the far corner where the window sees
+ *       it (or grazes it, over the window's end, as ex_propagate) and offers
  *       its children on f's other two edges to the half-edges across them.
  *   A window kept in a half-edge already passed is dropped, or with bit 1
  *   of the rule crossed at once (counted as late). A settled vertex can
  *   still be lowered by a later pass (its output is then lower; what it
  *   offered used the old value). With bit 7 a vertex offers only where
- *   needed: a saddle, a vertex at a wall, or one whose distance came from
- *   an edge or a window's end, not a window's ray (the windows beside a
- *   ray-reached convex vertex carry its paths on).
+ *   needed: a saddle, a vertex at a wall with an angle sum over pi, or one
+ *   whose distance came from an edge or a window's end, not a window's ray
+ *   (the windows beside a ray-reached vertex carry its paths on); bit 9
+ *   narrows the vertices that skip their offers to the flat ones (angle
+ *   sum 2 pi, or a wall's vertex of pi or less): on a curved mesh the
+ *   offers of convex vertices make up for windows lost to the slots. A ray
+ *   wins a tie (1e-12) with the value a vertex has: a straight wall is
+ *   reached by a window's end and the edge relaxation at once.
  * - Same pseudo-source: an offer whose pseudo-source and sigma equal a
  *   slot's to SL_SAME is merged into it (the union of the intervals): the
  *   two pieces of one window that crossed the face behind by both edges.
@@ -41,7 +55,9 @@
  *   two least scores are kept (scores are taken only when a third window
  *   comes). Other ranks (bits 2-3 of the rule, slots.h) were measured and
  *   are worse on curved meshes.
- * - Measured (bench/micro/bench_slots.c, the commit that added this file):
+ * - Measured (bench/micro/bench_slots.c): rule 834, K = 2, 0.10-0.18 %
+ *   mean error at 3-11x the default's time, exact (1e-12) on
+ *   triangulations of convex planar regions. The commit that added this file:
  *   rule 66 (each half-edge passed once, late windows crossed, prefetch)
  *   0.10-0.20 % mean error at 2.7-9x the default's time; rule 194 (offers
  *   only where needed) 0.13-0.37 %, exact on a flat square. The time goes
