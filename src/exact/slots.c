@@ -79,6 +79,8 @@
 /* pseudo-sources this close (relative to the edge, its distance and
  * sigma) are the same */
 #define SL_SAME 1e-9
+/* rule bit 10: the points of an edge (ends included) its windows are weighed at */
+#define SL_NS 9
 
 typedef struct sl_win {
     double b0, b1, px, py, sigma, score;
@@ -114,6 +116,7 @@ struct mfmm_slots {
     int late_mode; /* 1: a window kept after its half-edge passed is crossed at once */
     int order;     /* bit 8: a half-edge is passed in distance order (its windows' least
                       value), not when its ends have settled */
+    int env;       /* bit 10: a window over K is weighed by the envelope (sl_emit) */
     mfmm_slots_info info;
 };
 
@@ -234,6 +237,7 @@ void mfmm_slots_set_rule(mfmm_slots *s, int rule)
     s->needed = (rule >> 7) & 1;
     s->order = (rule >> 8) & 1;
     s->needed |= (rule >> 8) & 2; /* bit 9: only flat vertices skip their offers */
+    s->env = (rule >> 10) & 1;
 }
 
 int mfmm_slots_set_k(mfmm_slots *s, int K)
@@ -403,6 +407,36 @@ static void sl_emit(mfmm_slots *s, int32_t h, double s0, double s1, double ix, d
     if (n < s->K) {
         at = n;
         s->n_slot[g] = (uint8_t)(n + 1);
+    } else if (s->env) {
+        /* rule bit 10, the envelope: of the K + 1 windows (the new one
+         * included) drop the one whose loss raises the least least, the
+         * sum over SL_NS points of the edge of the lowest value there */
+        double val[SL_NS][9];
+        for (int j = 0; j < SL_NS; j++) {
+            double x = L * j / (SL_NS - 1);
+            for (int i = 0; i < n; i++)
+                val[j][i] = sl_at(x, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma);
+            val[j][n] = sl_at(x, b0, b1, px, py, sigma);
+        }
+        double best = INFINITY;
+        at = n;
+        for (int q = n; q >= 0; q--) {
+            double sum = 0.0;
+            for (int j = 0; j < SL_NS; j++) {
+                double lo = INFINITY;
+                for (int i = 0; i <= n; i++)
+                    if (i != q && val[j][i] < lo)
+                        lo = val[j][i];
+                sum += lo;
+            }
+            if (sum < best) {
+                best = sum;
+                at = q;
+            }
+        }
+        s->info.evicted++;
+        if (at == n)
+            return;
     } else {
         score = sl_score(s->rank, L, b0, b1, px, py, sigma);
         at = 0;
