@@ -1,0 +1,709 @@
+/* Two windows in place per half-edge, propagated in vertex order (slots.h).
+ *
+ * The design (a prototype for issue 43; docs: the commit message and the
+ * report in bench/micro/bench_slots.c's header):
+ *
+ * - Slots. Half-edge h = 3f+k (the edge opposite corner k of face f, in the
+ *   exact tables' frame: corner k+1 at 0, k+2 at L, corner k at (cx, cy),
+ *   cy > 0) holds at most two windows entering f through that edge: a
+ *   pseudo-source (px, py), py <= 0, unfolded into h's frame, its distance
+ *   sigma and the interval [b0, b1] of the edge its rays cross (the same
+ *   fields as the exact solver's queue entries). No queue entry per window.
+ * - Order. A heap of vertices keyed by their current distance (the march's
+ *   heap, march/march.h) and, with bit 8 of the rule (the main rule,
+ *   SL_RULE_MAIN = 834), a heap of half-edges keyed by the least value of
+ *   the windows they hold (sigma + the distance to the interval); the lower
+ *   top is taken first. When a vertex v settles:
+ *   (1) it offers a window to the opposite edge of each face f around it:
+ *       itself as pseudo-source, sigma = d(v), the whole edge; the offer
+ *       lowers the edge's ends to d(v) + |edge| (the edge relaxation, so
+ *       every reached vertex has a path) and goes into the slots of the
+ *       half-edge across (the face beyond f);
+ *   (2) without bit 8: for each face f at v and each edge of f from v to a
+ *       corner u that settled before, the windows in that half-edge's slots
+ *       are passed across f (rule 0: every half-edge once, when its second
+ *       end settles; rule 1: only the first edge of each face to have both
+ *       ends settled). With bit 8 a half-edge is passed when it comes off
+ *       its heap: the window that reaches a face's far corner is crossed
+ *       before that corner settles even where the corner is nearer than the
+ *       edge's ends (an obtuse face: in vertex order the corner settled on
+ *       an edge-relaxed value, offered windows that were not paths' ends
+ *       and these took the source's pieces' slots; a flat mesh stretched 8x
+ *       was 0.33 off). A pass lowers the far corner where the window sees
+ *       it (or grazes it, over the window's end, as ex_propagate) and offers
+ *       its children on f's other two edges to the half-edges across them.
+ *   A window kept in a half-edge already passed is dropped, or with bit 1
+ *   of the rule crossed at once (counted as late). A settled vertex can
+ *   still be lowered by a later pass (its output is then lower; what it
+ *   offered used the old value). With bit 7 a vertex offers only where
+ *   needed: a saddle, a vertex at a wall with an angle sum over pi, or one
+ *   whose distance came from an edge or a window's end, not a window's ray
+ *   (the windows beside a ray-reached vertex carry its paths on); bit 9
+ *   narrows the vertices that skip their offers to the flat ones (angle
+ *   sum 2 pi, or a wall's vertex of pi or less): on a curved mesh the
+ *   offers of convex vertices make up for windows lost to the slots. A ray
+ *   wins a tie (1e-12) with the value a vertex has: a straight wall is
+ *   reached by a window's end and the edge relaxation at once.
+ * - Same pseudo-source: an offer whose pseudo-source and sigma equal a
+ *   slot's to SL_SAME is merged into it (the union of the intervals): the
+ *   two pieces of one window that crossed the face behind by both edges.
+ * - An offer to a half-edge is trimmed against the current distances of
+ *   the edge's ends as the exact solver trims (ex_trim; ties kept within
+ *   EX_TIE), then ranked by its score: the sum of the distances it gives at
+ *   the edge's ends and midpoint (outside its interval: to the nearer end
+ *   of the interval, then along the edge, the length of a real path). The
+ *   two least scores are kept (scores are taken only when a third window
+ *   comes). Other ranks (bits 2-3 of the rule, slots.h) were measured and
+ *   are worse on curved meshes.
+ * - Measured (bench/micro/bench_slots.c): rule 834, K = 2, 0.10-0.18 %
+ *   mean error at 3-11x the default's time, exact (1e-12) on
+ *   triangulations of convex planar regions. The commit that added this file:
+ *   rule 66 (each half-edge passed once, late windows crossed, prefetch)
+ *   0.10-0.20 % mean error at 2.7-9x the default's time; rule 194 (offers
+ *   only where needed) 0.13-0.37 %, exact on a flat square. The time goes
+ *   to first reads of the face records and slots (memory) and ~14 offers
+ *   per vertex.
+ * - Every value is sigma + a straight segment in a strip unfolded through
+ *   the faces the window crossed, sigma itself a value, or d(u) + |uv|:
+ *   the length of a path on the surface.
+ * - Walls, zero-area faces and non-manifold edges: windows stop there (the
+ *   edge relaxation of the offers goes on); copies are skipped. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "slots.h"
+#include "state.h"
+#include "march/march.h"
+
+/* pseudo-sources this close (relative to the edge, its distance and
+ * sigma) are the same */
+#define SL_SAME 1e-9
+/* rule bit 10: the points of an edge (ends included) its windows are weighed at */
+#define SL_NS 9
+
+typedef struct sl_win {
+    double b0, b1, px, py, sigma, score;
+} sl_win;
+
+struct mfmm_slots {
+    const mfmm_exact_tables *t;
+    const mfmm_mesh *mesh;
+    int32_t nv, nf;
+    const ex_face *fr;
+    const int32_t *vf_offset, *vf_corner, *face_in;
+    sl_win *slot;     /* (2 * 3 nf) */
+    uint8_t *n_slot;  /* (3 nf) windows held */
+    uint8_t *passed;  /* (3 nf) */
+    uint8_t *fpassed; /* (nf) a half-edge of the face has been passed (rule 1) */
+    double *d;
+    uint8_t *need;    /* (nv) a vertex that may bend a path: the exact tables' pseudo-source
+                         flag, less vertices at a wall whose angle sum is pi or less */
+    uint8_t *is_src;  /* (nv) the vertex sources of the solve */
+    uint8_t *flat;    /* (nv) rule bit 9: offers redundant after a ray (mfmm_slots_create) */
+    uint8_t *ray;     /* (nv) d came from a window's straight ray (not an edge, not a
+                         window's end) */
+    mfmm_march_state h; /* T unused; label 0 far, 1 close, 2 settled */
+    mfmm_march_state e; /* rule bit 8: half-edges keyed by their windows' least distance */
+    int rule;
+    int K; /* windows per half-edge (mfmm_slots_set_k), 2 by default */
+    int rank; /* 0: the least score; 1: dominance on the slot's interval; 2: the least
+                 score of the window's function over the whole edge; 3: 0, or less at
+                 its own interval's ends and middle */
+    int ablate; /* for measurements: bit 0 no vertex offers but the source's, bit 1 no passes */
+    int prefetch; /* bit 6 of the rule: prefetch the next vertex's face records */
+    int needed; /* bit 7: a vertex offers windows only where needed (sl_solve) */
+    int late_mode; /* 1: a window kept after its half-edge passed is crossed at once */
+    int order;     /* bit 8: a half-edge is passed in distance order (its windows' least
+                      value), not when its ends have settled */
+    int env;       /* bit 10: a window over K is weighed by the envelope (sl_emit) */
+    mfmm_slots_info info;
+};
+
+mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
+{
+    const mfmm_exact_tables *t = NULL;
+    *out = NULL;
+    mfmm_status st = mfmm_exact_tables_of(mesh, &t);
+    if (st != MFMM_OK)
+        return st;
+    mfmm_slots *s = calloc(1, sizeof *s);
+    if (!s)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    size_t nv = (size_t)t->nv, nf = (size_t)t->nf, nh = 3 * nf;
+    s->t = t;
+    s->mesh = mesh;
+    s->nv = t->nv;
+    s->nf = t->nf;
+    s->fr = t->fr;
+    s->vf_offset = t->vf_offset;
+    s->vf_corner = t->vf_corner;
+    s->face_in = t->face_in;
+    s->K = 2;
+    mfmm_slots_set_rule(s, SL_RULE_MAIN);
+    s->slot = malloc((2 * nh + 1) * sizeof *s->slot);
+    s->n_slot = malloc(nh + 1);
+    s->passed = malloc(nh + 1);
+    s->fpassed = malloc(nf + 1);
+    s->d = malloc((nv + 1) * sizeof *s->d);
+    s->ray = malloc(nv + 1);
+    s->need = malloc(nv + 1);
+    s->flat = malloc(nv + 1);
+    s->is_src = calloc(nv + 1, 1);
+    s->h.label = malloc(nv + 1);
+    s->h.heap_key = malloc((nv + 1) * sizeof(double));
+    s->h.heap_vertex = malloc((nv + 1) * sizeof(int32_t));
+    s->h.heap_pos = malloc((nv + 1) * sizeof(int32_t));
+    s->e.label = malloc(nh + 1);
+    s->e.heap_key = malloc((nh + 1) * sizeof(double));
+    s->e.heap_vertex = malloc((nh + 1) * sizeof(int32_t));
+    s->e.heap_pos = malloc((nh + 1) * sizeof(int32_t));
+    if (!s->e.label || !s->e.heap_key || !s->e.heap_vertex || !s->e.heap_pos ||
+        !s->slot || !s->n_slot || !s->passed || !s->fpassed || !s->d || !s->ray || !s->need || !s->flat || !s->is_src || !s->h.label ||
+        !s->h.heap_key || !s->h.heap_vertex || !s->h.heap_pos) {
+        mfmm_slots_destroy(s);
+        return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    /* a vertex at a wall (two wall edges, no zero-area face or copy) whose
+     * angle sum is pi or less bends no shortest path: it needs no offers */
+    for (size_t v = 0; v < nv; v++) {
+        s->need[v] = t->pseudo[v];
+        if (!s->need[v])
+            continue;
+        double a = 0.0;
+        int walls = 0, odd = 0;
+        for (int32_t j = t->vf_offset[v]; j < t->vf_offset[v + 1]; j++) {
+            int32_t c = ex_corner(t->vf_corner, t->face_in, j);
+            const ex_face *r = t->fr + c / 3;
+            int k = c % 3;
+            odd |= r->skip != 0;
+            a += r->angle[k];
+            walls += (r->across[ex_next[k]] < 0) + (r->across[ex_prev[k]] < 0);
+        }
+        s->need[v] = odd || walls != 2 || !(a <= EX_PI * (1.0 + 1e-9));
+    }
+    /* rule bit 9: a vertex whose offers the windows beside it make
+     * redundant once a ray reaches it: one whose neighbourhood unfolds flat
+     * (an angle sum of 2 pi, no wall) or a wall's vertex of pi or less */
+    for (size_t v = 0; v < nv; v++) {
+        double a = 0.0;
+        int walls = 0, odd = 0;
+        for (int32_t j = t->vf_offset[v]; j < t->vf_offset[v + 1]; j++) {
+            int32_t c = ex_corner(t->vf_corner, t->face_in, j);
+            const ex_face *r = t->fr + c / 3;
+            int k = c % 3;
+            odd |= r->skip != 0;
+            a += r->angle[k];
+            walls += (r->across[ex_next[k]] < 0) + (r->across[ex_prev[k]] < 0);
+        }
+        s->flat[v] = !s->need[v] && !odd &&
+                     ((walls == 0 && fabs(a - EX_TWO_PI) <= 1e-9 * EX_TWO_PI) || walls == 2);
+    }
+    *out = s;
+    return MFMM_OK;
+}
+
+void mfmm_slots_destroy(mfmm_slots *s)
+{
+    if (!s)
+        return;
+    free(s->slot);
+    free(s->n_slot);
+    free(s->passed);
+    free(s->fpassed);
+    free(s->d);
+    free(s->ray);
+    free(s->need);
+    free(s->flat);
+    free(s->is_src);
+    free(s->h.label);
+    free(s->h.heap_key);
+    free(s->h.heap_vertex);
+    free(s->h.heap_pos);
+    free(s->e.label);
+    free(s->e.heap_key);
+    free(s->e.heap_vertex);
+    free(s->e.heap_pos);
+    free(s);
+}
+
+void mfmm_slots_set_rule(mfmm_slots *s, int rule)
+{
+    s->rule = rule & 1;
+    s->late_mode = (rule >> 1) & 1;
+    s->rank = (rule >> 2) & 3;
+    s->ablate = (rule >> 4) & 3;
+    s->prefetch = (rule >> 6) & 1;
+    s->needed = (rule >> 7) & 1;
+    s->order = (rule >> 8) & 1;
+    s->needed |= (rule >> 8) & 2; /* bit 9: only flat vertices skip their offers */
+    s->env = (rule >> 10) & 1;
+}
+
+int mfmm_slots_set_k(mfmm_slots *s, int K)
+{
+    if (K < 1 || K > 8)
+        return 0;
+    sl_win *w = malloc(((size_t)K * 3 * (size_t)s->nf + 1) * sizeof *w);
+    if (!w)
+        return 0;
+    free(s->slot);
+    s->slot = w;
+    s->K = K;
+    return 1;
+}
+
+void mfmm_slots_get_info(const mfmm_slots *s, mfmm_slots_info *info)
+{
+    *info = s->info;
+}
+
+static inline void sl_update(mfmm_slots *s, int32_t v, double dist, int ray)
+{
+    if (!(dist < s->d[v])) {
+        /* a ray as long as the value to rounding: the windows beside it
+         * carry its paths on (a wall's straight side, relaxed along) */
+        if (ray && dist <= s->d[v] + 1e-12 * s->d[v])
+            s->ray[v] = 1;
+        return;
+    }
+    /* a value lower only by rounding keeps the ray it had */
+    s->ray[v] = (uint8_t)(ray | (s->ray[v] & (dist >= s->d[v] - 1e-12 * s->d[v])));
+    s->d[v] = dist;
+    uint8_t lab = s->h.label[v];
+    if (lab == 2) {
+        s->info.late_vertex++;
+        return;
+    }
+    mfmm_heap_push_or_decrease(&s->h, v, dist, lab == 1);
+    s->h.label[v] = 1;
+}
+
+/* ex_trim (propagate.c) */
+static inline int sl_trim(double px, double py, double sigma, double L, double dA, double dB,
+                          double *b0, double *b1)
+{
+    double py2 = py * py;
+    double a = dA - sigma, qx = L - px, c = dB - sigma;
+    int ok = !(px + a <= 0.0) & !(qx + c <= 0.0);
+    double t0 = (px * px + py2 - a * a) / (2.0 * (px + a));
+    double t1 = L - (qx * qx + py2 - c * c) / (2.0 * (qx + c));
+    double s0 = t0 > *b0 ? t0 : *b0, s1 = t1 < *b1 ? t1 : *b1;
+    *b0 = s0;
+    *b1 = s1;
+    return ok & (s1 - s0 > EX_MIN_WIDTH * L);
+}
+
+/* the distance a window gives at x of its edge: over the nearer end of its
+ * interval, then along the edge, outside it */
+static inline double sl_at(double x, double b0, double b1, double px, double py, double sigma)
+{
+    double c = x < b0 ? b0 : x > b1 ? b1 : x;
+    return sigma + sqrt((c - px) * (c - px) + py * py) + fabs(x - c);
+}
+
+/* The rank of a window on an edge of length L: the sum of its values at
+ * the edge's ends and middle; rank 2: of its function sigma + |P X| there,
+ * as if its interval were the whole edge (pieces of one window's rays
+ * that cover little of the edge are not then given up to worse ones). */
+static inline double sl_score(int rank, double L, double b0, double b1, double px, double py,
+                              double sigma)
+{
+    if (rank == 2) {
+        b0 = 0.0;
+        b1 = L;
+    }
+    return sl_at(0.0, b0, b1, px, py, sigma) + sl_at(0.5 * L, b0, b1, px, py, sigma) +
+           sl_at(L, b0, b1, px, py, sigma);
+}
+
+/* rule bit 8: half-edge g (not passed) holds a window whose least value is
+ * sigma + the distance from (px, py) to [b0, b1]: g is passed by then */
+static inline void sl_key(mfmm_slots *s, int32_t g, double b0, double b1, double px, double py,
+                          double sigma)
+{
+    if (!s->order)
+        return;
+    double c = px < b0 ? b0 : px > b1 ? b1 : px;
+    double m = sigma + sqrt((c - px) * (c - px) + py * py);
+    uint8_t lab = s->e.label[g];
+    if (lab == 2 || (lab == 1 && !(m < s->e.heap_key[s->e.heap_pos[g]])))
+        return;
+    mfmm_heap_push_or_decrease(&s->e, g, m, lab == 1);
+    s->e.label[g] = 1;
+}
+
+/* A window leaving face h / 3 through half-edge h (in h's frame, its
+ * pseudo-source (ix, iy), iy >= 0, on the face's side), interval [s0, s1]:
+ * lowers the edge's ends it reaches, then is offered to the slots of the
+ * half-edge across. */
+static void sl_cross(mfmm_slots *s, int32_t h, const sl_win *w);
+
+static void sl_emit(mfmm_slots *s, int32_t h, double s0, double s1, double ix, double iy,
+                    double sigma, int offer)
+{
+    const ex_face *r = s->fr + h / 3;
+    int k = h % 3;
+    int32_t va = r->v[ex_next[k]], vb = r->v[ex_prev[k]];
+    double L = r->len[k];
+    if (s0 < 0.0)
+        s0 = 0.0;
+    if (s1 > L)
+        s1 = L;
+    if (!(s1 - s0 > EX_MIN_WIDTH * L)) {
+        s->info.narrow++;
+        return;
+    }
+    double iy2 = iy * iy;
+    if (offer) {
+        /* a vertex's offer: its ends at the face's edge lengths */
+        sl_update(s, va, sigma + r->len[ex_prev[k]], offer == 2);
+        sl_update(s, vb, sigma + r->len[ex_next[k]], offer == 2);
+    } else {
+        if (s0 <= EX_POS_TOL * L)
+            sl_update(s, va, sigma + sqrt(ix * ix + iy2), 1);
+        if (s1 >= L - EX_POS_TOL * L)
+            sl_update(s, vb, sigma + sqrt((ix - L) * (ix - L) + iy2), 1);
+    }
+    int32_t g = r->across[k];
+    if (g < 0)
+        return;
+    s->info.emitted++;
+    double da = s->d[va], db = s->d[vb];
+    da += EX_TIE * da;
+    db += EX_TIE * db;
+    if (!sl_trim(ix, -iy, sigma, L, da, db, &s0, &s1)) {
+        s->info.trimmed++;
+        return;
+    }
+    int fl = r->flip[k];
+    double b0 = fl ? L - s1 : s0, b1 = fl ? L - s0 : s1, px = fl ? L - ix : ix, py = -iy;
+    sl_win *w = s->slot + (size_t)s->K * g;
+    int n = s->n_slot[g], at;
+    /* the same pseudo-source (to rounding) as a slot's: the pieces of one
+     * window that crossed the face behind by its two edges; their union is
+     * one window (gaps between them are rays of the same source) */
+    double tol = SL_SAME * (L + fabs(px) - py + sigma);
+    for (int i = 0; i < n; i++) {
+        if (fabs(w[i].px - px) > tol || fabs(w[i].py - py) > tol ||
+            fabs(w[i].sigma - sigma) > tol)
+            continue;
+        if (b0 >= w[i].b0 - tol && b1 <= w[i].b1 + tol)
+            return; /* nothing new */
+        double u0 = fmin(b0, w[i].b0), u1 = fmax(b1, w[i].b1);
+        w[i].b0 = u0;
+        w[i].b1 = u1;
+        w[i].score = NAN;
+        s->info.merged++;
+        sl_key(s, g, b0, b1, px, py, sigma);
+        if (s->passed[g] && s->late_mode) {
+            s->info.late++;
+            sl_win c = {b0, b1, px, py, sigma, 0.0};
+            sl_cross(s, g, &c);
+        }
+        return;
+    }
+    double score = NAN; /* taken when a third window comes (lazy) */
+    if (n < s->K) {
+        at = n;
+        s->n_slot[g] = (uint8_t)(n + 1);
+    } else if (s->env) {
+        /* rule bit 10, the envelope: of the K + 1 windows (the new one
+         * included) drop the one whose loss raises the least least, the
+         * sum over SL_NS points of the edge of the lowest value there */
+        double val[SL_NS][9];
+        for (int j = 0; j < SL_NS; j++) {
+            double x = L * j / (SL_NS - 1);
+            for (int i = 0; i < n; i++)
+                val[j][i] = sl_at(x, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma);
+            val[j][n] = sl_at(x, b0, b1, px, py, sigma);
+        }
+        double best = INFINITY;
+        at = n;
+        for (int q = n; q >= 0; q--) {
+            double sum = 0.0;
+            for (int j = 0; j < SL_NS; j++) {
+                double lo = INFINITY;
+                for (int i = 0; i <= n; i++)
+                    if (i != q && val[j][i] < lo)
+                        lo = val[j][i];
+                sum += lo;
+            }
+            if (sum < best) {
+                best = sum;
+                at = q;
+            }
+        }
+        s->info.evicted++;
+        if (at == n)
+            return;
+    } else {
+        score = sl_score(s->rank, L, b0, b1, px, py, sigma);
+        at = 0;
+        for (int i = 0; i < n; i++) {
+            if (w[i].score != w[i].score)
+                w[i].score = sl_score(s->rank, L, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma);
+            if (w[i].score > w[at].score)
+                at = i;
+        }
+        s->info.evicted++;
+        if (s->rank == 1 && s->K == 2) {
+            /* dominance: a slot is given up only to a window at least as
+             * short at its own interval's ends and middle */
+            int dom[2];
+            for (int i = 0; i < 2; i++) {
+                double u0 = w[i].b0, u1 = w[i].b1, um = 0.5 * (u0 + u1);
+                dom[i] = sl_at(u0, b0, b1, px, py, sigma) <=
+                             sl_at(u0, u0, u1, w[i].px, w[i].py, w[i].sigma) &&
+                         sl_at(um, b0, b1, px, py, sigma) <=
+                             sl_at(um, u0, u1, w[i].px, w[i].py, w[i].sigma) &&
+                         sl_at(u1, b0, b1, px, py, sigma) <=
+                             sl_at(u1, u0, u1, w[i].px, w[i].py, w[i].sigma);
+            }
+            if (dom[0] && dom[1])
+                ; /* the worse score */
+            else if (dom[0] || dom[1])
+                at = dom[0] ? 0 : 1;
+            else
+                return;
+        } else if (!(score < w[at].score)) {
+            if (s->rank != 3 || s->K != 2)
+                return;
+            /* rank 3: a window less than a slot's at its own interval's
+             * ends and middle takes that slot (the worse score of two) */
+            int loc[2];
+            double um = 0.5 * (b0 + b1);
+            double n0 = sl_at(b0, b0, b1, px, py, sigma), nm = sl_at(um, b0, b1, px, py, sigma),
+                   n1 = sl_at(b1, b0, b1, px, py, sigma);
+            for (int i = 0; i < 2; i++)
+                loc[i] = n0 < sl_at(b0, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma) &&
+                         nm < sl_at(um, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma) &&
+                         n1 < sl_at(b1, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma);
+            if (!loc[0] && !loc[1])
+                return;
+            if (!(loc[0] && loc[1]))
+                at = loc[0] ? 0 : 1;
+            s->info.local++;
+        }
+    }
+    w[at] = (sl_win){b0, b1, px, py, sigma, score};
+    s->info.kept++;
+    sl_key(s, g, b0, b1, px, py, sigma);
+    if (s->passed[g] && s->late_mode) {
+        /* kept after its half-edge was passed: crossed at once */
+        s->info.late++;
+        sl_win c = w[at];
+        sl_cross(s, g, &c);
+    }
+}
+
+/* ex_hit (propagate.c): where the line from I through (x, 0) meets O + s u */
+static inline double sl_hit(double ox, double oy, double ux, double uy, double ix, double iy,
+                            double x, double len)
+{
+    double xx = x - ox, xy = -oy, jx = ix - ox, jy = iy - oy;
+    double num = xx * jy - xy * jx;
+    double den = (xx - jx) * uy - (xy - jy) * ux;
+    double t = num / den;
+    if (!(t >= 0.0))
+        t = 0.0;
+    if (!(t <= len))
+        t = len;
+    return t;
+}
+
+/* A window entering face h / 3 through h crosses it (ex_propagate). */
+static void sl_cross(mfmm_slots *s, int32_t h, const sl_win *w)
+{
+    int32_t f = h / 3;
+    int m = h % 3;
+    const ex_face *r = s->fr + f;
+    int32_t vc = r->v[m];
+    double L = r->len[m], cx = r->cx[m], cy = r->cy[m];
+    double b0 = w->b0, b1 = w->b1, px = w->px, py = w->py, sigma = w->sigma;
+    s->info.crossed++;
+    double tc = px + (cx - px) * (-py) / (cy - py);
+    double tol = EX_POS_TOL * L;
+    if (tc >= b0 - tol && tc <= b1 + tol) {
+        double ex = cx - px, ey = cy - py;
+        sl_update(s, vc, sigma + sqrt(ex * ex + ey * ey), 1);
+    } else if (tc >= b0 - EX_GRAZE * L && tc <= b1 + EX_GRAZE * L) {
+        double e = tc < b0 ? b0 : b1;
+        double ie = sqrt((e - px) * (e - px) + py * py), ec = sqrt((cx - e) * (cx - e) + cy * cy);
+        sl_update(s, vc, sigma + ie + ec, 0);
+    }
+    int m1 = ex_next[m], m2 = ex_prev[m];
+    if (b0 < tc) {
+        int32_t hl = 3 * f + m2;
+        double lac = r->len[m2], il = 1.0 / (lac < EX_SHORT_CHILD * L ? hypot(cx, cy) : lac);
+        double ux = -cx * il, uy = -cy * il;
+        double s_hi = b0 <= 0.0 ? lac : sl_hit(cx, cy, ux, uy, px, py, b0, lac);
+        double s_lo = tc <= b1 ? 0.0 : sl_hit(cx, cy, ux, uy, px, py, b1, lac);
+        double qx = px - cx, qy = py - cy;
+        double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
+        sl_emit(s, hl, s_lo, s_hi, ix, iy > 0.0 ? iy : 0.0, sigma, 0);
+    }
+    if (b1 > tc) {
+        int32_t hr = 3 * f + m1;
+        double lbc = r->len[m1], il = 1.0 / (lbc < EX_SHORT_CHILD * L ? hypot(cx - L, cy) : lbc);
+        double ux = (cx - L) * il, uy = cy * il;
+        double s_lo = b1 >= L ? 0.0 : sl_hit(L, 0.0, ux, uy, px, py, b1, lbc);
+        double s_hi = tc >= b0 ? lbc : sl_hit(L, 0.0, ux, uy, px, py, b0, lbc);
+        double qx = px - L, qy = py;
+        double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
+        sl_emit(s, hr, s_lo, s_hi, ix, iy > 0.0 ? iy : 0.0, sigma, 0);
+    }
+}
+
+static void sl_pass(mfmm_slots *s, int32_t h)
+{
+    if (s->passed[h])
+        return;
+    if (s->rule == 1 && s->fpassed[h / 3])
+        return;
+    s->passed[h] = 1;
+    s->fpassed[h / 3] = 1;
+    int n = s->n_slot[h];
+    /* (a window kept while another is crossed cannot land in the same slot:
+     * the children go to the face's other edges) */
+    for (int i = 0; i < n; i++) {
+        sl_win w = s->slot[(size_t)s->K * h + i];
+        sl_cross(s, h, &w);
+    }
+}
+
+static void sl_reset(mfmm_slots *s)
+{
+    size_t nv = (size_t)s->nv, nh = 3 * (size_t)s->nf;
+    memset(&s->info, 0, sizeof s->info);
+    memset(s->n_slot, 0, nh);
+    memset(s->passed, 0, nh);
+    memset(s->fpassed, 0, (size_t)s->nf);
+    memset(s->h.label, 0, nv);
+    memset(s->e.label, 0, nh);
+    s->e.heap_size = 0;
+    for (size_t v = 0; v < nv; v++)
+        s->d[v] = INFINITY;
+    s->h.heap_size = 0;
+}
+
+/* the march, from the sources seeded (is_src marks the vertex sources) */
+static void sl_run(mfmm_slots *s, double *out)
+{
+    size_t nv = (size_t)s->nv;
+    const ex_face *fr = s->fr;
+    while (s->h.heap_size > 0 || s->e.heap_size > 0) {
+        if (s->e.heap_size > 0 &&
+            (s->h.heap_size == 0 || s->e.heap_key[0] <= s->h.heap_key[0])) {
+            /* rule bit 8: the half-edge whose windows come next */
+            int32_t g = mfmm_heap_pop(&s->e);
+            s->e.label[g] = 2;
+            sl_pass(s, g);
+            continue;
+        }
+        int32_t v = mfmm_heap_pop(&s->h);
+        s->h.label[v] = 2;
+#ifdef __GNUC__
+        if (s->prefetch && s->h.heap_size > 0) {
+            /* the face records of the vertex likely to settle next: they
+             * are the solve's misses (a record is first read when a corner
+             * settles) */
+            int32_t nx = s->h.heap_vertex[0];
+            for (int32_t i = s->vf_offset[nx]; i < s->vf_offset[nx + 1]; i++) {
+                const char *p = (const char *)(fr + ex_corner(s->vf_corner, s->face_in, i) / 3);
+                __builtin_prefetch(p);
+                __builtin_prefetch(p + 64);
+            }
+        }
+#endif
+        s->info.settled++;
+        double dv = s->d[v];
+        int32_t i0 = s->vf_offset[v], i1 = s->vf_offset[v + 1];
+        for (int32_t i = i0; i < i1; i++) {
+            int32_t c = ex_corner(s->vf_corner, s->face_in, i);
+            const ex_face *r = fr + c / 3;
+            int k = c % 3;
+            if (r->skip) {
+                if (r->skip == 1) { /* zero-area: the edges only */
+                    sl_update(s, r->v[ex_next[k]], dv + r->len[ex_prev[k]], 0);
+                    sl_update(s, r->v[ex_prev[k]], dv + r->len[ex_next[k]], 0);
+                }
+                continue;
+            }
+            if ((s->ablate & 1) || (s->needed && s->ray[v] && !s->need[v] && (!(s->needed & 2) || s->flat[v]))) {
+                /* no offers (ablate), or not needed: a vertex reached by a
+                 * window's ray, that bends no shortest path (not a saddle,
+                 * not at a wall), has the windows beside it carry its paths
+                 * on; the edges only */
+                sl_update(s, r->v[ex_next[k]], dv + r->len[ex_prev[k]], 0);
+                sl_update(s, r->v[ex_prev[k]], dv + r->len[ex_next[k]], 0);
+                if (!s->is_src[v])
+                    continue;
+            }
+            sl_emit(s, c, 0.0, r->len[k], r->cx[k], r->cy[k], dv,
+                    s->is_src[v] ? 2 : 1);
+        }
+        if ((s->ablate & 2) || s->order)
+            continue;
+        for (int32_t i = i0; i < i1; i++) {
+            int32_t c = ex_corner(s->vf_corner, s->face_in, i);
+            const ex_face *r = fr + c / 3;
+            int k = c % 3;
+            if (r->skip)
+                continue;
+            int32_t f3 = c - k;
+            /* edge v - v[k+2] is half-edge k+1; edge v - v[k+1] is k+2 */
+            if (s->h.label[r->v[ex_prev[k]]] == 2)
+                sl_pass(s, f3 + ex_next[k]);
+            if (s->h.label[r->v[ex_next[k]]] == 2)
+                sl_pass(s, f3 + ex_prev[k]);
+        }
+    }
+    for (size_t v = 0; v < nv; v++)
+        out[v] = s->d[v];
+}
+
+void mfmm_slots_solve(mfmm_slots *s, int32_t source, double *out)
+{
+    mfmm_slots_solve_multi(s, 1, &source, NULL, out);
+}
+
+void mfmm_slots_solve_multi(mfmm_slots *s, int32_t n, const int32_t *src, const double *value,
+                            double *out)
+{
+    sl_reset(s);
+    for (int32_t i = 0; i < n; i++) {
+        sl_update(s, src[i], value ? value[i] : 0.0, 0);
+        s->is_src[src[i]] = 1;
+    }
+    sl_run(s, out);
+    for (int32_t i = 0; i < n; i++)
+        s->is_src[src[i]] = 0;
+}
+
+void mfmm_slots_solve_face(mfmm_slots *s, int32_t f, const int32_t fv[3], const double w[3],
+                           double *out)
+{
+    sl_reset(s);
+    const ex_face *r = s->fr + f;
+    double b[3] = {0.0, 0.0, 0.0};
+    for (int k = 0; k < 3; k++)
+        for (int j = 0; j < 3; j++)
+            if (fv[j] == r->v[k])
+                b[k] = w[j];
+    double sum = b[0] + b[1] + b[2];
+    if (r->skip || !(sum > 0.0)) {
+        /* a face with no area (or no weights): nothing reached */
+        sl_run(s, out);
+        return;
+    }
+    for (int k = 0; k < 3; k++) {
+        /* the point in half-edge 3f+k's frame (corner k+1 at 0, k+2 at L,
+         * corner k at (cx, cy)): a window of the whole edge, sigma 0, that
+         * also sets the edge's ends to their straight distances */
+        double bk = b[k] / sum, b2 = b[ex_prev[k]] / sum, L = r->len[k];
+        double ix = bk * r->cx[k] + b2 * L, iy = bk * r->cy[k];
+        sl_emit(s, 3 * f + k, 0.0, L, ix, iy, 0.0, 0);
+    }
+    sl_run(s, out);
+}
