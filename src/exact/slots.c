@@ -79,6 +79,9 @@
 /* pseudo-sources this close (relative to the edge, its distance and
  * sigma) are the same */
 #define SL_SAME 1e-9
+/* the run goes on past a stop's level by this much (relative), so that
+ * every value written is as final as in a full solve (mfmm_slots_run) */
+#define SL_STOP 1e-10
 /* rule bit 10: the points of an edge (ends included) its windows are weighed at */
 #define SL_NS 9
 
@@ -100,6 +103,7 @@ struct mfmm_slots {
     uint8_t *need;    /* (nv) a vertex that may bend a path: the exact tables' pseudo-source
                          flag, less vertices at a wall whose angle sum is pi or less */
     uint8_t *is_src;  /* (nv) the vertex sources of the solve */
+    uint8_t *is_tgt;  /* (nv) targets of mfmm_slots_run not yet settled */
     uint8_t *flat;    /* (nv) rule bit 9: offers redundant after a ray (mfmm_slots_create) */
     uint8_t *ray;     /* (nv) d came from a window's straight ray (not an edge, not a
                          window's end) */
@@ -117,6 +121,7 @@ struct mfmm_slots {
     int order;     /* bit 8: a half-edge is passed in distance order (its windows' least
                       value), not when its ends have settled */
     int env;       /* bit 10: a window over K is weighed by the envelope (sl_emit) */
+    double tgt_level; /* the largest value of the targets settled (sl_loop) */
     mfmm_slots_info info;
 };
 
@@ -150,6 +155,7 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     s->need = malloc(nv + 1);
     s->flat = malloc(nv + 1);
     s->is_src = calloc(nv + 1, 1);
+    s->is_tgt = calloc(nv + 1, 1);
     s->h.label = malloc(nv + 1);
     s->h.heap_key = malloc((nv + 1) * sizeof(double));
     s->h.heap_vertex = malloc((nv + 1) * sizeof(int32_t));
@@ -159,7 +165,7 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     s->e.heap_vertex = malloc((nh + 1) * sizeof(int32_t));
     s->e.heap_pos = malloc((nh + 1) * sizeof(int32_t));
     if (!s->e.label || !s->e.heap_key || !s->e.heap_vertex || !s->e.heap_pos ||
-        !s->slot || !s->n_slot || !s->passed || !s->fpassed || !s->d || !s->ray || !s->need || !s->flat || !s->is_src || !s->h.label ||
+        !s->slot || !s->n_slot || !s->passed || !s->fpassed || !s->d || !s->ray || !s->need || !s->flat || !s->is_src || !s->is_tgt || !s->h.label ||
         !s->h.heap_key || !s->h.heap_vertex || !s->h.heap_pos) {
         mfmm_slots_destroy(s);
         return MFMM_ERR_OUT_OF_MEMORY;
@@ -203,6 +209,14 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     return MFMM_OK;
 }
 
+size_t mfmm_slots_bytes(const mfmm_mesh *mesh)
+{
+    size_t nv = (size_t)mesh->nv, nh = 3 * (size_t)mesh->nf;
+    /* slots and per-half-edge flags and heap; distances, flags and heap per vertex */
+    return nh * (2 * sizeof(sl_win) + 3 + 1 + sizeof(double) + 2 * sizeof(int32_t)) +
+           nv * (sizeof(double) + 6 + sizeof(double) + 2 * sizeof(int32_t));
+}
+
 void mfmm_slots_destroy(mfmm_slots *s)
 {
     if (!s)
@@ -216,6 +230,7 @@ void mfmm_slots_destroy(mfmm_slots *s)
     free(s->need);
     free(s->flat);
     free(s->is_src);
+    free(s->is_tgt);
     free(s->h.label);
     free(s->h.heap_key);
     free(s->h.heap_vertex);
@@ -587,12 +602,20 @@ static void sl_reset(mfmm_slots *s)
     s->h.heap_size = 0;
 }
 
-/* the march, from the sources seeded (is_src marks the vertex sources) */
-static void sl_run(mfmm_slots *s, double *out)
+/* The propagation from the sources seeded (is_src marks the vertex
+ * sources) until both heaps are empty or their least key passes `level`;
+ * n_tgt targets (is_tgt) left: once the last settles, the level comes down
+ * to the largest target value (SL_STOP above). */
+static void sl_loop(mfmm_slots *s, double level, int32_t n_tgt)
 {
-    size_t nv = (size_t)s->nv;
     const ex_face *fr = s->fr;
+    double stop = level * (1.0 + SL_STOP);
     while (s->h.heap_size > 0 || s->e.heap_size > 0) {
+        double top = s->h.heap_size > 0 ? s->h.heap_key[0] : INFINITY;
+        if (s->e.heap_size > 0 && s->e.heap_key[0] < top)
+            top = s->e.heap_key[0];
+        if (top > stop)
+            break;
         if (s->e.heap_size > 0 &&
             (s->h.heap_size == 0 || s->e.heap_key[0] <= s->h.heap_key[0])) {
             /* rule bit 8: the half-edge whose windows come next */
@@ -618,6 +641,13 @@ static void sl_run(mfmm_slots *s, double *out)
 #endif
         s->info.settled++;
         double dv = s->d[v];
+        if (s->is_tgt[v]) {
+            s->is_tgt[v] = 0;
+            if (dv > s->tgt_level)
+                s->tgt_level = dv;
+            if (--n_tgt == 0 && s->tgt_level < level)
+                stop = s->tgt_level * (1.0 + SL_STOP);
+        }
         int32_t i0 = s->vf_offset[v], i1 = s->vf_offset[v + 1];
         for (int32_t i = i0; i < i1; i++) {
             int32_t c = ex_corner(s->vf_corner, s->face_in, i);
@@ -659,7 +689,13 @@ static void sl_run(mfmm_slots *s, double *out)
                 sl_pass(s, f3 + ex_prev[k]);
         }
     }
-    for (size_t v = 0; v < nv; v++)
+}
+
+/* the propagation to its end, every vertex's value to out */
+static void sl_run(mfmm_slots *s, double *out)
+{
+    sl_loop(s, INFINITY, 0);
+    for (size_t v = 0; v < (size_t)s->nv; v++)
         out[v] = s->d[v];
 }
 
@@ -706,4 +742,87 @@ void mfmm_slots_solve_face(mfmm_slots *s, int32_t f, const int32_t fv[3], const 
         sl_emit(s, 3 * f + k, 0.0, L, ix, iy, 0.0, 0);
     }
     sl_run(s, out);
+}
+
+/* A point in face record r at weights b (r's corners, summing to 1, none
+ * 1): each edge gets a window of the whole edge from the point, which also
+ * sets the edge's ends to their straight distances. */
+static void sl_start_face(mfmm_slots *s, int32_t r_id, const double b[3], double value)
+{
+    const ex_face *r = s->fr + r_id;
+    for (int k = 0; k < 3; k++) {
+        /* the point in half-edge 3f+k's frame (corner k+1 at 0, k+2 at L,
+         * corner k at (cx, cy)) */
+        double L = r->len[k];
+        double ix = b[k] * r->cx[k] + b[ex_prev[k]] * L, iy = b[k] * r->cy[k];
+        sl_emit(s, 3 * r_id + k, 0.0, L, ix, iy, value, 0);
+    }
+}
+
+int32_t mfmm_slots_run(mfmm_slots *s, const mfmm_source *sources, int32_t n_sources,
+                       double max_distance, const int32_t *targets, int32_t n_targets,
+                       double *T, int32_t *settled)
+{
+    const mfmm_mesh *mesh = s->mesh;
+    sl_reset(s);
+    s->tgt_level = -INFINITY;
+    int32_t n_tgt = 0;
+    for (int32_t i = 0; i < n_targets; i++)
+        if (!s->is_tgt[targets[i]]) {
+            s->is_tgt[targets[i]] = 1;
+            n_tgt++;
+        }
+    for (int32_t i = 0; i < n_sources; i++) {
+        const mfmm_source *src = sources + i;
+        if (src->face < 0) {
+            sl_update(s, src->vertex, src->value, 0);
+            s->is_src[src->vertex] = 1;
+            continue;
+        }
+        /* a point of a copy is that point of its original; weights in the
+         * record's corner order */
+        int32_t face = mfmm_mesh_original(mesh, src->face);
+        const ex_face *r = s->fr + s->face_in[face];
+        const int32_t *sv = mesh->face_records[src->face].v;
+        double b[3], sum = 0.0;
+        for (int k = 0; k < 3; k++) {
+            int j = sv[0] == r->v[k] ? 0 : sv[1] == r->v[k] ? 1 : 2;
+            b[k] = src->bary[j] > 0.0 ? src->bary[j] : 0.0;
+            sum += b[k];
+        }
+        int corner = -1;
+        for (int k = 0; k < 3; k++) {
+            b[k] /= sum;
+            if (b[k] >= 1.0 - 1e-12)
+                corner = k;
+        }
+        if (corner >= 0) {
+            /* at a corner: a vertex source, offset by the (tiny) distance */
+            double p[3], w[3];
+            for (int k = 0; k < 3; k++) {
+                const int32_t *fv = mesh->face_records[face].v;
+                int j = fv[0] == r->v[k] ? 0 : fv[1] == r->v[k] ? 1 : 2;
+                w[j] = b[k];
+            }
+            mfmm_bary_to_xyz(mesh, face, w, p);
+            int32_t v = r->v[corner];
+            sl_update(s, v, src->value + vdist(p, mesh->xyz + 3 * (size_t)v), 0);
+            s->is_src[v] = 1;
+            continue;
+        }
+        sl_start_face(s, s->face_in[face], b, src->value);
+    }
+    sl_loop(s, max_distance, n_tgt);
+    int32_t n = 0;
+    for (int32_t v = 0; v < s->nv; v++) {
+        s->is_src[v] = 0;
+        s->is_tgt[v] = 0;
+        if (s->h.label[v] == 2 && s->d[v] <= max_distance) {
+            T[v] = s->d[v];
+            if (settled)
+                settled[n] = v;
+            n++;
+        }
+    }
+    return n;
 }

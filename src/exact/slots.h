@@ -15,6 +15,8 @@ typedef struct mfmm_slots mfmm_slots;
 /* A workspace on the mesh's exact tables (mfmm_exact_tables_of). */
 mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out);
 void mfmm_slots_destroy(mfmm_slots *s);
+/* About the bytes a workspace holds on `mesh` (K = 2), its tables apart. */
+size_t mfmm_slots_bytes(const mfmm_mesh *mesh);
 
 /* The pass rule: bit 0 clear (default) passes the windows entering a face
  * through an edge once both of the edge's ends have settled (each half-edge
@@ -77,6 +79,20 @@ void mfmm_slots_solve_multi(mfmm_slots *s, int32_t n, const int32_t *src, const 
  * area (or weights summing to 0 or less) reaches nothing: all +inf. */
 void mfmm_slots_solve_face(mfmm_slots *s, int32_t f, const int32_t fv[3], const double w[3],
                            double *out);
+
+/* The solve behind MFMM_METHOD_WINDOWS: sources as for mfmm_solve, in
+ * internal ids (vertex sources, points in faces, each with its value),
+ * stopped once the front passes max_distance (+inf: none) or, with
+ * n_targets > 0, once every internal vertex of `targets` has settled and the
+ * front has passed the largest of their values. T: (nv,) +inf on entry; the
+ * values of the vertices settled by then are written (those within
+ * max_distance), the same bits as a solve without the stops (values after
+ * a vertex settles only lower it by rounding, 1e-13 relative, and the run
+ * goes on past the stop by SL_STOP relative). settled: (nv,) out, may be
+ * NULL: the vertices written. Returns how many. */
+int32_t mfmm_slots_run(mfmm_slots *s, const mfmm_source *sources, int32_t n_sources,
+                       double max_distance, const int32_t *targets, int32_t n_targets,
+                       double *T, int32_t *settled);
 
 /* Counters of the last solve. */
 typedef struct mfmm_slots_info {
