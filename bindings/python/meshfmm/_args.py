@@ -313,6 +313,15 @@ def matrix_dtype(dtype: Any) -> Tuple[np.dtype, int]:
     raise ValueError(f"dtype must be float32 or float64, got {dt}")
 
 
+def method(name: Any, exact: bool = True) -> int:
+    """A method name -> the C mfmm_method ("fmm", "windows"); "exact" (where
+    the caller takes it: exact=True) -> -1."""
+    names = ["fmm", "windows"] + (["exact"] if exact else [])
+    if not isinstance(name, str) or name not in names:
+        raise ValueError(f"method must be one of {names}, not {name!r}")
+    return -1 if name == "exact" else _lib.METHODS[name]
+
+
 def backend(name: Any) -> int:
     """A backend name ("auto", "serial", "threads", "opencl"; any case) -> the
     C mfmm_backend."""
