@@ -661,7 +661,9 @@ def exact_start_section():
                 D.append(f"| {r['n']} | {r['n_vertices']} | " +
                          " | ".join(f"{r[k]:.4f}" for k in keys) +
                          f" | {r[keys[1]] / r[keys[0]]:.2f}x |")
-            D.append("| fitted order | | " + " | ".join(f"{fam['order'][k]:.2f}" for k in keys) + " | |")
+            D.append("| fitted order | | " + " | ".join(
+                "exact" if fam["order"][k] is None else f"{fam['order'][k]:.2f}" for k in keys) +
+                " | |")
             D.append("")
     return D
 
