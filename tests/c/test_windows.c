@@ -3,7 +3,7 @@
  * exact solver's (1e-9 relative) and reaching what it reaches, with its mean
  * error bounded; several sources within 5e-4 relative of the least
  * single-source value (windows of one source can lose their slots to
- * another's); stops
+ * another's); paths traced on its values; stops
  * (max_distance, targets) write a full solve's values bit for bit; matrix
  * rows on the serial and threads backends equal mfmm_solve's bit for bit;
  * a cost, an unknown method and OpenCL are refused with a message. */
@@ -200,6 +200,51 @@ static void test_stops(void **state)
     mfmm_gen_free(&g);
 }
 
+/* Paths traced on its distances: each reaches the source, no shorter than
+ * the exact distance, no longer than the distance it was traced on beyond
+ * the tracer's 1e-3 (measured: 4e-4 on wingnut, 7e-16 on spot). */
+static void test_paths(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh g = mfmm_gen_torus(48, 20, 1.0, 0.4);
+    mfmm_mesh *mesh = tm_make(&g);
+    mfmm_solver *s = NULL;
+    mfmm_exact_solver *ex = NULL;
+    assert_int_equal(mfmm_solver_create(mesh, &s), MFMM_OK);
+    assert_int_equal(mfmm_exact_solver_create(mesh, &ex), MFMM_OK);
+    mfmm_source src = tm_vertex_source(5);
+    mfmm_solve_options o = windows_options();
+    double *d = solve(s, &src, 1, &o, g.nv), *e = malloc((size_t)g.nv * sizeof *e);
+    assert_non_null(e);
+    assert_int_equal(mfmm_solve_exact(ex, &src, 1, NULL, e, NULL, NULL), MFMM_OK);
+    mfmm_path_options po;
+    mfmm_path_options_init(&po);
+    po.sources = &src;
+    po.n_sources = 1;
+    enum { CAP = 4096 };
+    mfmm_surface_point *pts = malloc(CAP * sizeof *pts);
+    assert_non_null(pts);
+    for (int32_t t = 0; t < g.nv; t += 37) {
+        if (t == src.vertex)
+            continue;
+        mfmm_source target = tm_vertex_source(t);
+        int32_t n = 0;
+        double len = 0.0;
+        mfmm_error err;
+        assert_int_equal(mfmm_trace_path(mesh, d, &target, &po, pts, CAP, &n, &len, &err),
+                         MFMM_OK);
+        assert_true(len >= e[t] * (1.0 - 1e-9));
+        assert_true(len <= d[t] * (1.0 + 1e-3));
+    }
+    free(pts);
+    free(d);
+    free(e);
+    mfmm_exact_solver_destroy(ex);
+    mfmm_solver_destroy(s);
+    mfmm_mesh_destroy(mesh);
+    mfmm_gen_free(&g);
+}
+
 /* Matrix rows on the serial and threads backends are mfmm_solve's. */
 static void test_matrix_rows(void **state)
 {
@@ -284,7 +329,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_flat_euclidean), cmocka_unit_test(test_lower_bound),
-        cmocka_unit_test(test_stops),          cmocka_unit_test(test_matrix_rows),
+        cmocka_unit_test(test_stops),          cmocka_unit_test(test_paths),
+        cmocka_unit_test(test_matrix_rows),
         cmocka_unit_test(test_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
