@@ -811,6 +811,19 @@ int32_t mfmm_slots_run(mfmm_slots *s, const mfmm_source *sources, int32_t n_sour
             continue;
         }
         sl_start_face(s, s->face_in[face], b, src->value);
+        if (mesh->piece_next) {
+            /* a face cut at T-junctions: the segments from the point to
+             * every piece's corners lie in the face as given (the edges
+             * between pieces may be non-manifold, where windows stop) */
+            double p[3];
+            mfmm_bary_to_xyz(mesh, src->face, src->bary, p);
+            for (int32_t q = mesh->face_to_internal[mesh->face_to_external[src->face]]; q >= 0;
+                 q = mesh->piece_next[q])
+                for (int k = 0; k < 3; k++) {
+                    int32_t c = mesh->face_records[q].v[k];
+                    sl_update(s, c, src->value + vdist(p, mesh->xyz + 3 * (size_t)c), 0);
+                }
+        }
     }
     sl_loop(s, max_distance, n_tgt);
     int32_t n = 0;

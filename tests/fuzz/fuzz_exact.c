@@ -32,6 +32,8 @@
  * from two sources with values a triangle's planar update may be below the
  * Euclidean distance from either (the lower bound, a minimum of two cones, is
  * not convex). bench/studies/oracle_sweep.py holds the default march to 1e-8.
+ * The window method (MFMM_METHOD_WINDOWS) must meet both bounds to rounding
+ * and never fall below the exact solve (1e-9 relative).
  *
  * Input layout (all optional past the end: zeros):
  *   byte 0: nv - 3 (3..66)      byte 1: nf - 1 (1..128)
@@ -325,6 +327,31 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (!within(d, lo, hi, nv, n_src == 1 ? MARCH_UNDER_REL : -1.0, BOUND_REL, INFINITY,
                         btol))
                 abort();
+        }
+        /* the window method: paths' lengths, so both bounds to rounding and
+         * never below the exact solve (unless that fell back to walls, whose
+         * values are upper bounds); a stop at max_distance writes the full
+         * solve's bits */
+        mfmm_solve_options_init(&so);
+        so.method = MFMM_METHOD_WINDOWS;
+        st = mfmm_solve(solver, src, n_src, &so, d, &err);
+        if (st == MFMM_OK) {
+            if (!within(d, lo, hi, nv, BOUND_REL, BOUND_REL, INFINITY, btol))
+                abort();
+            for (int32_t v = 0; v < nv; v++)
+                if (!info.nonmanifold_walls && isfinite(e[v]) && !(flags & 2) &&
+                    !(d[v] >= e[v] * (1.0 - 1e-9) - btol))
+                    abort();
+            if (flags & 2) {
+                so.max_distance = eo.max_distance;
+                if (mfmm_solve(solver, src, n_src, &so, e, &err) != MFMM_OK)
+                    abort();
+                for (int32_t v = 0; v < nv; v++)
+                    if (d[v] <= so.max_distance ? e[v] != d[v] : e[v] != INFINITY)
+                        abort();
+            }
+        } else if (st != MFMM_ERR_DEGENERATE_SOURCE && st != MFMM_ERR_BAD_BARYCENTRIC) {
+            abort();
         }
         mfmm_solver_destroy(solver);
     }
