@@ -491,11 +491,12 @@ class Mesh:
             vertices as faces.
         method : {"fmm", "windows", "exact"}
             "fmm" (default): the Fast Marching Method from the exact start.
-            "windows": window propagation keeping two windows per edge
-            (``MFMM_METHOD_WINDOWS``): several times more accurate than
-            "fmm", never below the geodesic distance, exact on flat
-            regions, at several times its time; no cost (unfolding and
-            exact_start do not apply). "exact": exact polyhedral geodesic
+            "windows": window propagation keeping two windows per
+            half-edge (``MFMM_METHOD_WINDOWS``; the documentation's page
+            "The windows method"): more accurate than "fmm", never below
+            the geodesic distance, exact where the surface unfolds flat, at
+            several times its time; no cost (unfolding and exact_start do
+            not apply). "exact": exact polyhedral geodesic
             distances by window propagation (``mfmm_solve_exact``), without
             cost, targets, unfolding or exact_start options.
         exact_start : bool, "auto" or float
