@@ -108,6 +108,41 @@ def test_exact_on_developable_surfaces(V, F, sources):
         assert w[s] == 0.0
 
 
+@pytest.mark.parametrize("pages", [2, 3, 4])
+def test_books(pages):
+    """Flat pages sharing one spine edge (tests/python/oracles.py's book
+    oracle, clean pages): two pages unfold into the plane and the values
+    are exact (1e-12 relative; measured 8e-16); three or four make the
+    spine non-manifold, where windows stop and paths go on along edges:
+    the values stay finite and never below the geodesic distance."""
+    from oracles import random_book, reference
+
+    rng = np.random.default_rng(100 + pages)
+    for _ in range(12):
+        case = random_book(rng, n_pages=pages, clean=True)
+        if not case.known:
+            continue
+        m = meshfmm.Mesh(case.V, case.F)
+        s = int(rng.integers(len(case.V)))
+        ref, w = reference(case, s), m.distance(s, method="windows")
+        pos = ref > 0
+        rel = (w[pos] - ref[pos]) / ref[pos]
+        assert np.all(np.isfinite(w)) and rel.min() >= -BELOW
+        if pages == 2:
+            assert rel.max() <= 1e-12
+
+
+def test_beetle_non_manifold_never_below_the_exact_solver():
+    """beetle has 47 non-manifold edges: windows stop there, the values
+    are still paths' lengths (measured least (d - e)/e: -1.9e-15)."""
+    m = mesh("beetle.obj")
+    for s in (10, 500, 900):
+        w, e = m.distance(s, method="windows"), m.distance(s, method="exact")
+        pos = np.isfinite(e) & (e > 0)
+        assert np.array_equal(np.isfinite(w), np.isfinite(e))
+        assert np.min((w[pos] - e[pos]) / e[pos]) >= -BELOW
+
+
 @pytest.fixture(scope="module")
 def spot():
     return mesh("spot.obj")
