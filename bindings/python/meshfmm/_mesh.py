@@ -491,11 +491,12 @@ class Mesh:
             vertices as faces.
         method : {"fmm", "windows", "exact"}
             "fmm" (default): the Fast Marching Method from the exact start.
-            "windows": window propagation keeping two windows per edge
-            (``MFMM_METHOD_WINDOWS``): several times more accurate than
-            "fmm", never below the geodesic distance, exact on flat
-            regions, at several times its time; no cost (unfolding and
-            exact_start do not apply). "exact": exact polyhedral geodesic
+            "windows": window propagation keeping two windows per
+            half-edge (``MFMM_METHOD_WINDOWS``; the documentation's page
+            "The windows method"): more accurate than "fmm", never below
+            the geodesic distance, exact where the surface unfolds flat, at
+            several times its time; no cost (unfolding and exact_start do
+            not apply). "exact": exact polyhedral geodesic
             distances by window propagation (``mfmm_solve_exact``), without
             cost, targets, unfolding or exact_start options.
         exact_start : bool, "auto" or float
@@ -798,8 +799,9 @@ class Mesh:
         ----------
         source, target : int or SurfacePoint
             Vertex ids or points inside faces.
-        method : {"fmm", "exact"}
-            The distances the path descends (:meth:`distance`).
+        method : {"fmm", "windows", "exact"}
+            The distances the path descends (:meth:`distance`; "windows"
+            and "exact" take no cost).
         cost, cost_location, exact_start
             As in :meth:`distance`.
         max_points, straighten
@@ -835,6 +837,7 @@ class Mesh:
         cost_location: Optional[str] = None,
         unfolding: bool = True,
         exact_start: Any = True,
+        method: str = "fmm",
         return_radii: bool = False,
         return_distances: bool = False,
     ) -> Any:
@@ -858,6 +861,11 @@ class Mesh:
             The first point, a vertex in a face.
         cost, cost_location, unfolding, exact_start
             As in :meth:`distance`.
+        method : {"fmm", "windows"}
+            The solve of each point (:meth:`distance`): "fmm" (default) or
+            "windows" (no cost; unfolding and exact_start do not apply).
+            The points equal those of a loop of ``distance(...,
+            method=method)`` solves. "exact" is not offered here.
         return_radii : bool
             Also return float64 (k,): each point's distance to the points
             before it when chosen (+inf for the first): the covering radius
@@ -877,8 +885,10 @@ class Mesh:
         Raises
         ------
         ValueError
-            k out of range, a start out of range or in no face, a bad cost.
+            k out of range, a start out of range or in no face, a bad cost,
+            a method other than "fmm" or "windows", a cost with "windows".
         """
+        m = _args.solve_method(method, cost, "farthest_point_sampling")
         k = _args.index(k, "k")
         start = _args.index(start, "start")
         if not (0 <= start < self.n_vertices):
@@ -898,6 +908,7 @@ class Mesh:
         radius = _args.exact_start_radius(exact_start)
         if radius is not None:
             opts.exact_start_radius = radius
+        opts.method = m
         if k < 1:
             raise ValueError(f"k must be >= 1, got {k}")
         points = np.empty(k, dtype=np.int32)
@@ -949,7 +960,8 @@ class Mesh:
             The distances from these sources (:meth:`distance` with the same
             sources); None solves them.
         **kwargs
-            :meth:`distance`'s options for that solve (cost, method, ...).
+            :meth:`distance`'s options for that solve (cost, method: "fmm",
+            "windows" or "exact", ...).
 
         Returns
         -------
@@ -1044,6 +1056,7 @@ class Mesh:
         cost_location: Optional[str] = None,
         unfolding: bool = True,
         exact_start: Any = True,
+        method: str = "fmm",
         n_threads: int = 0,
         memory_limit: int = 0,
         progress: Any = None,
@@ -1076,6 +1089,15 @@ class Mesh:
         max_distance, cost, cost_location, unfolding, exact_start
             As in :meth:`distance`. Every backend starts each row alike;
             OpenCL rows equal the serial rows bit for bit.
+        method : {"fmm", "windows"}
+            As in :meth:`distance`: "fmm" (default) on every backend;
+            "windows" (no cost) on "serial" and "threads" ("auto" runs
+            threads and says why in :class:`MatrixInfo`; "opencl" refuses
+            it with a ValueError). Rows equal ``distance(source,
+            method=method)`` bit for bit in float64, with targets,
+            max_distance and sparse rows alike. "exact" is not a matrix
+            method (a ValueError): solve each row with
+            ``distance(method="exact")``.
         n_threads : int
             Threads of the threads backend; 0 for all cores.
         memory_limit : int
@@ -1137,6 +1159,7 @@ class Mesh:
             The dense result would not fit the memory available
             (``size_check``).
         """
+        _args.solve_method(method, cost, "distance_matrix")
         pts = None
         if targets is not None and _has_surface_point(targets):
             pts = Points.parse(targets, "target", self.n_vertices, self.n_faces)
@@ -1150,8 +1173,8 @@ class Mesh:
             cost, cost_location = w.cost(cost, cost_location)
         progress, bar = _guards.progress_callback(progress, "distance matrix")
         kw = dict(max_distance=max_distance, cost=cost, cost_location=cost_location,
-                  unfolding=unfolding, exact_start=exact_start, n_threads=n_threads,
-                  memory_limit=memory_limit, progress=progress,
+                  unfolding=unfolding, exact_start=exact_start, method=method,
+                  n_threads=n_threads, memory_limit=memory_limit, progress=progress,
                   size_check=_args.flag(size_check, "size_check"))
         info = None
         try:
@@ -1219,7 +1242,7 @@ class Mesh:
             Most rows per block, >= 1.
         **kwargs
             :meth:`distance_matrix`'s keyword options (backend, dtype,
-            targets, max_distance, cost, ...) except ``sparse``,
+            targets, max_distance, cost, method, ...) except ``sparse``,
             ``symmetric`` and ``out``. ``progress`` is called as
             ``progress(rows_done, S)`` over the whole job;
             ``return_info=True`` adds each block's :class:`MatrixInfo`.
