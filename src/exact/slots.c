@@ -85,8 +85,12 @@
 /* rule bit 10: the points of an edge (ends included) its windows are weighed at */
 #define SL_NS 9
 
+/* A window: rays from pseudo-source (px, py) at distance sigma across
+ * [b0, b1] of its edge; [g0, g1] (containing [b0, b1]) the rays traced
+ * through the same faces, those the trims cut included: pieces of one
+ * window join only where these meet (sl_keep). */
 typedef struct sl_win {
-    double b0, b1, px, py, sigma, score;
+    double b0, b1, px, py, sigma, score, g0, g1;
 } sl_win;
 
 struct mfmm_slots {
@@ -348,61 +352,31 @@ static inline void sl_key(mfmm_slots *s, int32_t g, double b0, double b1, double
     s->e.label[g] = 1;
 }
 
-/* A window leaving face h / 3 through half-edge h (in h's frame, its
- * pseudo-source (ix, iy), iy >= 0, on the face's side), interval [s0, s1]:
- * lowers the edge's ends it reaches, then is offered to the slots of the
- * half-edge across. */
+/* (sl_cross, below: a window entering face h / 3 through h crosses it) */
 static void sl_cross(mfmm_slots *s, int32_t h, const sl_win *w);
 
-static void sl_emit(mfmm_slots *s, int32_t h, double s0, double s1, double ix, double iy,
-                    double sigma, int offer)
+/* Window [s0, s1] from pseudo-source (ix, iy) (the frame of the half-edge
+ * it leaves through, iy >= 0 on the face's side) into the slots of half-edge
+ * g across the edge, whose frame runs the other way when fl is set. */
+static void sl_keep(mfmm_slots *s, int32_t g, int fl, double L, double s0, double s1, double t0,
+                    double t1, double ix, double iy, double sigma)
 {
-    const ex_face *r = s->fr + h / 3;
-    int k = h % 3;
-    int32_t va = r->v[ex_next[k]], vb = r->v[ex_prev[k]];
-    double L = r->len[k];
-    if (s0 < 0.0)
-        s0 = 0.0;
-    if (s1 > L)
-        s1 = L;
-    if (!(s1 - s0 > EX_MIN_WIDTH * L)) {
-        s->info.narrow++;
-        return;
-    }
-    double iy2 = iy * iy;
-    if (offer) {
-        /* a vertex's offer: its ends at the face's edge lengths */
-        sl_update(s, va, sigma + r->len[ex_prev[k]], offer == 2);
-        sl_update(s, vb, sigma + r->len[ex_next[k]], offer == 2);
-    } else {
-        if (s0 <= EX_POS_TOL * L)
-            sl_update(s, va, sigma + sqrt(ix * ix + iy2), 1);
-        if (s1 >= L - EX_POS_TOL * L)
-            sl_update(s, vb, sigma + sqrt((ix - L) * (ix - L) + iy2), 1);
-    }
-    int32_t g = r->across[k];
-    if (g < 0)
-        return;
-    s->info.emitted++;
-    double da = s->d[va], db = s->d[vb];
-    da += EX_TIE * da;
-    db += EX_TIE * db;
-    if (!sl_trim(ix, -iy, sigma, L, da, db, &s0, &s1)) {
-        s->info.trimmed++;
-        return;
-    }
-    int fl = r->flip[k];
     double b0 = fl ? L - s1 : s0, b1 = fl ? L - s0 : s1, px = fl ? L - ix : ix, py = -iy;
+    double g0 = fl ? L - t1 : t0, g1 = fl ? L - t0 : t1;
     sl_win *w = s->slot + (size_t)s->K * g;
     int n = s->n_slot[g], at;
-    /* the same pseudo-source (to rounding) as a slot's: the pieces of one
-     * window that crossed the face behind by its two edges; their union is
-     * one window (gaps between them are rays of the same source) */
+    /* the same pseudo-source (to rounding) as a slot's, with traced rays
+     * that meet the slot's: the pieces of one window that went round a
+     * vertex by its two sides, one window together (the rays between them,
+     * cut by trims, are paths too). Pieces whose traced rays do not meet
+     * stay apart: they may have come round a hole, whose rays are no paths. */
     double tol = SL_SAME * (L + fabs(px) - py + sigma);
     for (int i = 0; i < n; i++) {
         if (fabs(w[i].px - px) > tol || fabs(w[i].py - py) > tol ||
-            fabs(w[i].sigma - sigma) > tol)
+            fabs(w[i].sigma - sigma) > tol || g0 > w[i].g1 + tol || g1 < w[i].g0 - tol)
             continue;
+        w[i].g0 = fmin(g0, w[i].g0);
+        w[i].g1 = fmax(g1, w[i].g1);
         if (b0 >= w[i].b0 - tol && b1 <= w[i].b1 + tol)
             return; /* nothing new */
         double u0 = fmin(b0, w[i].b0), u1 = fmax(b1, w[i].b1);
@@ -413,7 +387,7 @@ static void sl_emit(mfmm_slots *s, int32_t h, double s0, double s1, double ix, d
         sl_key(s, g, b0, b1, px, py, sigma);
         if (s->passed[g] && s->late_mode) {
             s->info.late++;
-            sl_win c = {b0, b1, px, py, sigma, 0.0};
+            sl_win c = {b0, b1, px, py, sigma, 0.0, g0, g1};
             sl_cross(s, g, &c);
         }
         return;
@@ -501,7 +475,7 @@ static void sl_emit(mfmm_slots *s, int32_t h, double s0, double s1, double ix, d
             s->info.local++;
         }
     }
-    w[at] = (sl_win){b0, b1, px, py, sigma, score};
+    w[at] = (sl_win){b0, b1, px, py, sigma, score, g0, g1};
     s->info.kept++;
     sl_key(s, g, b0, b1, px, py, sigma);
     if (s->passed[g] && s->late_mode) {
@@ -509,6 +483,88 @@ static void sl_emit(mfmm_slots *s, int32_t h, double s0, double s1, double ix, d
         s->info.late++;
         sl_win c = w[at];
         sl_cross(s, g, &c);
+    }
+}
+
+/* the index of half-edge g in the non-manifold lists (tables' nm_he), -1 if
+ * it is on none */
+static int32_t sl_nm_slot(const mfmm_exact_tables *t, int32_t g)
+{
+    int32_t lo = 0, hi = t->n_nm - 1;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (t->nm_he[mid] < g)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return t->n_nm > 0 && t->nm_he[lo] == g ? lo : -1;
+}
+
+/* A window leaving face h / 3 through half-edge h: rays across [s0, s1]
+ * of the edge, traced across [t0, t1] (sl_win), from (ix, iy) in h's frame
+ * (iy >= 0, on the face's side); offer: 0 a window's child, 1 a vertex's
+ * offer, 2 a vertex source's. Lowers the edge's ends it reaches, then goes
+ * into the slots of the half-edge(s) across. */
+static void sl_emit(mfmm_slots *s, int32_t h, double s0, double s1, double t0, double t1,
+                    double ix, double iy, double sigma, int offer)
+{
+    const ex_face *r = s->fr + h / 3;
+    int k = h % 3;
+    int32_t va = r->v[ex_next[k]], vb = r->v[ex_prev[k]];
+    double L = r->len[k];
+    if (s0 < 0.0)
+        s0 = 0.0;
+    if (s1 > L)
+        s1 = L;
+    t0 = fmax(0.0, fmin(t0, s0));
+    t1 = fmin(L, fmax(t1, s1));
+    if (!(s1 - s0 > EX_MIN_WIDTH * L)) {
+        s->info.narrow++;
+        return;
+    }
+    double iy2 = iy * iy;
+    if (offer) {
+        /* a vertex's offer: its ends at the face's edge lengths */
+        sl_update(s, va, sigma + r->len[ex_prev[k]], offer == 2);
+        sl_update(s, vb, sigma + r->len[ex_next[k]], offer == 2);
+    } else {
+        if (s0 <= EX_POS_TOL * L)
+            sl_update(s, va, sigma + sqrt(ix * ix + iy2), 1);
+        if (s1 >= L - EX_POS_TOL * L)
+            sl_update(s, vb, sigma + sqrt((ix - L) * (ix - L) + iy2), 1);
+    }
+    int32_t g = r->across[k];
+    if (g < 0 && r->flip[k] != 2)
+        return; /* a wall, or a zero-area face (its edges relax; windows stop) */
+    s->info.emitted++;
+    double da = s->d[va], db = s->d[vb];
+    da += EX_TIE * da;
+    db += EX_TIE * db;
+    if (!sl_trim(ix, -iy, sigma, L, da, db, &s0, &s1)) {
+        s->info.trimmed++;
+        return;
+    }
+    if (g >= 0) {
+        sl_keep(s, g, r->flip[k], L, s0, s1, t0, t1, ix, iy, sigma);
+        return;
+    }
+    /* a non-manifold edge: on into every other face on it, each unfolded
+     * across the edge (as the exact solver's ex_fan_out); a pseudo-source
+     * on an end of the edge sends its rays along it, into no face */
+    double tol = EX_POS_TOL * L;
+    if (iy <= tol && (fabs(ix) <= tol || fabs(ix - L) <= tol))
+        return;
+    const mfmm_exact_tables *t = s->t;
+    int32_t i = sl_nm_slot(t, h);
+    for (int32_t n = 0; i >= 0 && n < t->n_nm; n++) {
+        int32_t q = t->nm_next[i];
+        if (q == h)
+            return;
+        i = sl_nm_slot(t, q);
+        const ex_face *rq = s->fr + q / 3;
+        if (!rq->skip)
+            sl_keep(s, q, rq->v[ex_next[q % 3]] != va, L, s0, s1, t0, t1, ix, iy, sigma);
     }
 }
 
@@ -536,6 +592,7 @@ static void sl_cross(mfmm_slots *s, int32_t h, const sl_win *w)
     int32_t vc = r->v[m];
     double L = r->len[m], cx = r->cx[m], cy = r->cy[m];
     double b0 = w->b0, b1 = w->b1, px = w->px, py = w->py, sigma = w->sigma;
+    double g0 = w->g0, g1 = w->g1;
     s->info.crossed++;
     double tc = px + (cx - px) * (-py) / (cy - py);
     double tol = EX_POS_TOL * L;
@@ -554,9 +611,11 @@ static void sl_cross(mfmm_slots *s, int32_t h, const sl_win *w)
         double ux = -cx * il, uy = -cy * il;
         double s_hi = b0 <= 0.0 ? lac : sl_hit(cx, cy, ux, uy, px, py, b0, lac);
         double s_lo = tc <= b1 ? 0.0 : sl_hit(cx, cy, ux, uy, px, py, b1, lac);
+        double t_hi = g0 <= 0.0 ? lac : sl_hit(cx, cy, ux, uy, px, py, g0, lac);
+        double t_lo = tc <= g1 ? 0.0 : sl_hit(cx, cy, ux, uy, px, py, g1, lac);
         double qx = px - cx, qy = py - cy;
         double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
-        sl_emit(s, hl, s_lo, s_hi, ix, iy > 0.0 ? iy : 0.0, sigma, 0);
+        sl_emit(s, hl, s_lo, s_hi, t_lo, t_hi, ix, iy > 0.0 ? iy : 0.0, sigma, 0);
     }
     if (b1 > tc) {
         int32_t hr = 3 * f + m1;
@@ -564,9 +623,11 @@ static void sl_cross(mfmm_slots *s, int32_t h, const sl_win *w)
         double ux = (cx - L) * il, uy = cy * il;
         double s_lo = b1 >= L ? 0.0 : sl_hit(L, 0.0, ux, uy, px, py, b1, lbc);
         double s_hi = tc >= b0 ? lbc : sl_hit(L, 0.0, ux, uy, px, py, b0, lbc);
+        double t_lo = g1 >= L ? 0.0 : sl_hit(L, 0.0, ux, uy, px, py, g1, lbc);
+        double t_hi = tc >= g0 ? lbc : sl_hit(L, 0.0, ux, uy, px, py, g0, lbc);
         double qx = px - L, qy = py;
         double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
-        sl_emit(s, hr, s_lo, s_hi, ix, iy > 0.0 ? iy : 0.0, sigma, 0);
+        sl_emit(s, hr, s_lo, s_hi, t_lo, t_hi, ix, iy > 0.0 ? iy : 0.0, sigma, 0);
     }
 }
 
@@ -670,7 +731,7 @@ static void sl_loop(mfmm_slots *s, double level, int32_t n_tgt)
                 if (!s->is_src[v])
                     continue;
             }
-            sl_emit(s, c, 0.0, r->len[k], r->cx[k], r->cy[k], dv,
+            sl_emit(s, c, 0.0, r->len[k], 0.0, r->len[k], r->cx[k], r->cy[k], dv,
                     s->is_src[v] ? 2 : 1);
         }
         if ((s->ablate & 2) || s->order)
@@ -739,7 +800,7 @@ void mfmm_slots_solve_face(mfmm_slots *s, int32_t f, const int32_t fv[3], const 
          * also sets the edge's ends to their straight distances */
         double bk = b[k] / sum, b2 = b[ex_prev[k]] / sum, L = r->len[k];
         double ix = bk * r->cx[k] + b2 * L, iy = bk * r->cy[k];
-        sl_emit(s, 3 * f + k, 0.0, L, ix, iy, 0.0, 0);
+        sl_emit(s, 3 * f + k, 0.0, L, 0.0, L, ix, iy, 0.0, 0);
     }
     sl_run(s, out);
 }
@@ -755,7 +816,7 @@ static void sl_start_face(mfmm_slots *s, int32_t r_id, const double b[3], double
          * corner k at (cx, cy)) */
         double L = r->len[k];
         double ix = b[k] * r->cx[k] + b[ex_prev[k]] * L, iy = b[k] * r->cy[k];
-        sl_emit(s, 3 * r_id + k, 0.0, L, ix, iy, value, 0);
+        sl_emit(s, 3 * r_id + k, 0.0, L, 0.0, L, ix, iy, value, 0);
     }
 }
 
