@@ -117,6 +117,8 @@ struct mfmm_slots {
     int order;     /* bit 8: a half-edge is passed in distance order (its windows' least
                       value), not when its ends have settled */
     int env;       /* bit 10: a window over K is weighed by the envelope (sl_emit) */
+    int endpath;   /* bit 11: a window lowers the far corner of the face it crosses over
+                      its interval's nearer end, however far (sl_cross) */
     mfmm_slots_info info;
 };
 
@@ -238,6 +240,7 @@ void mfmm_slots_set_rule(mfmm_slots *s, int rule)
     s->order = (rule >> 8) & 1;
     s->needed |= (rule >> 8) & 2; /* bit 9: only flat vertices skip their offers */
     s->env = (rule >> 10) & 1;
+    s->endpath = (rule >> 11) & 1;
 }
 
 int mfmm_slots_set_k(mfmm_slots *s, int K)
@@ -527,7 +530,11 @@ static void sl_cross(mfmm_slots *s, int32_t h, const sl_win *w)
     if (tc >= b0 - tol && tc <= b1 + tol) {
         double ex = cx - px, ey = cy - py;
         sl_update(s, vc, sigma + sqrt(ex * ex + ey * ey), 1);
-    } else if (tc >= b0 - EX_GRAZE * L && tc <= b1 + EX_GRAZE * L) {
+    } else if (s->endpath || (tc >= b0 - EX_GRAZE * L && tc <= b1 + EX_GRAZE * L)) {
+        /* C beside the window: the ray to the interval's nearer end, then
+         * straight across the face (a path; with bit 11 wherever C is, else
+         * at a graze): a vertex at the tip of thin faces otherwise gets only
+         * the edge relaxation, an edge's length off */
         double e = tc < b0 ? b0 : b1;
         double ie = sqrt((e - px) * (e - px) + py * py), ec = sqrt((cx - e) * (cx - e) + cy * cy);
         sl_update(s, vc, sigma + ie + ec, 0);

@@ -57,6 +57,11 @@ void mfmm_slots_set_rule(mfmm_slots *s, int rule);
  * shadow between two pieces of the source's window) is no better on the
  * edge where it is dropped, by either weighing. */
 
+/* Bit 11: a window crossing a face lowers the far corner, where the
+ * corner is beside the window's interval, over the interval's nearer end
+ * (the ray to it, then straight across the face: a path), not only at a
+ * graze; the corner offers (it was not reached by a ray). */
+
 /* K windows per half-edge instead of 2 (1 to 8; ranks 1 and 3 of the rule
  * need 2, and fall back to rank 0). 0 when out of memory or K is out of
  * range. */
