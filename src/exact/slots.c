@@ -10,8 +10,8 @@
  *   sigma and the interval [b0, b1] of the edge its rays cross (the same
  *   fields as the exact solver's queue entries). No queue entry per window.
  * - Order. A heap of vertices keyed by their current distance (the march's
- *   heap, march/march.h) and, with bit 8 of the rule (the main rule,
- *   SL_RULE_MAIN = 834), a heap of half-edges keyed by the least value of
+ *   heap, march/march.h) and, with bit 8 of the rule (in the main rule,
+ *   SL_RULE_MAIN = 3906), a heap of half-edges keyed by the least value of
  *   the windows they hold (sigma + the distance to the interval); the lower
  *   top is taken first. When a vertex v settles:
  *   (1) it offers a window to the opposite edge of each face f around it:
@@ -54,15 +54,19 @@
  *   of the interval, then along the edge, the length of a real path). The
  *   two least scores are kept (scores are taken only when a third window
  *   comes). Other ranks (bits 2-3 of the rule, slots.h) were measured and
- *   are worse on curved meshes.
- * - Measured (bench/micro/bench_slots.c): rule 834, K = 2, 0.10-0.18 %
- *   mean error at 3-11x the default's time, exact (1e-12) on
- *   triangulations of convex planar regions. The commit that added this file:
- *   rule 66 (each half-edge passed once, late windows crossed, prefetch)
- *   0.10-0.20 % mean error at 2.7-9x the default's time; rule 194 (offers
- *   only where needed) 0.13-0.37 %, exact on a flat square. The time goes
- *   to first reads of the face records and slots (memory) and ~14 offers
- *   per vertex.
+ *   are worse on curved meshes. With bit 10 (the main rule) the window
+ *   dropped is instead the one whose loss raises the least the lowest
+ *   value at 9 points of the edge (the envelope).
+ * - A window crossing a face lowers the far corner by its ray where the
+ *   corner is in its interval; with bit 11 (the main rule) elsewhere over
+ *   the interval's nearer end (the ray to it, then across the face): at
+ *   the tip of thin faces the edge relaxation alone is an edge's length
+ *   off.
+ * - Measured (bench/micro/bench_slots.c; figures in the commit messages):
+ *   the main rule at K = 2 below the default solve's max error on every
+ *   mesh there, exact (1e-12) on triangulations of convex planar regions.
+ *   The time goes to first reads of the face records and slots (memory)
+ *   and ~14 offers per vertex.
  * - Every value is sigma + a straight segment in a strip unfolded through
  *   the faces the window crossed, sigma itself a value, or d(u) + |uv|:
  *   the length of a path on the surface.

@@ -27,7 +27,7 @@
 
 #define TS_PI 3.14159265358979323846
 
-static const int rules[] = {SL_RULE_MAIN, 0, 2, 66, 194, 322, 450, 67, 74, 78};
+static const int rules[] = {SL_RULE_MAIN, 834, 0, 2, 66, 194, 322, 450, 67, 74, 78};
 
 /* max |slots - exact| over three sources, with the lower-bound and reach
  * checks asserted */
