@@ -14,7 +14,7 @@
  * --flat: the flat checks only (also Delaunay triangulations of random
  * points in a square and a disc, stretched 1, 8 and 30 times in x).
  * --k: windows per half-edge (default 2); --rules: the slot rules to run
- * (src/exact/slots.h; default 834,66,194,67,82,98; 834 is SL_RULE_MAIN).
+ * (src/exact/slots.h; default 3906,834,2882,1858,66,194; 3906 is SL_RULE_MAIN).
  * MESH: a mesh file or gen:icosphere5 / gen:sine100; default the five real
  * meshes of docs/virtual-sources.md (branch wincap) and gen:icosphere5. */
 #include <math.h>
@@ -31,7 +31,7 @@
 #include "meshfmm.h"
 
 #define MAXMETH 10 /* default, exact, then slots with the rules below */
-static int rules[MAXMETH - 2] = {834, 66, 194, 67, 82, 98};
+static int rules[MAXMETH - 2] = {SL_RULE_MAIN, 834, 2882, 1858, 66, 194};
 static int NMETH = 8, slot_k = 2;
 
 static void slots_row(mfmm_slots *sl, const mfmm_mesh *mesh, int32_t v, double *tmp, double *d)

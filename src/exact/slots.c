@@ -10,8 +10,8 @@
  *   sigma and the interval [b0, b1] of the edge its rays cross (the same
  *   fields as the exact solver's queue entries). No queue entry per window.
  * - Order. A heap of vertices keyed by their current distance (the march's
- *   heap, march/march.h) and, with bit 8 of the rule (the main rule,
- *   SL_RULE_MAIN = 834), a heap of half-edges keyed by the least value of
+ *   heap, march/march.h) and, with bit 8 of the rule (in the main rule,
+ *   SL_RULE_MAIN = 3906), a heap of half-edges keyed by the least value of
  *   the windows they hold (sigma + the distance to the interval); the lower
  *   top is taken first. When a vertex v settles:
  *   (1) it offers a window to the opposite edge of each face f around it:
@@ -54,15 +54,19 @@
  *   of the interval, then along the edge, the length of a real path). The
  *   two least scores are kept (scores are taken only when a third window
  *   comes). Other ranks (bits 2-3 of the rule, slots.h) were measured and
- *   are worse on curved meshes.
- * - Measured (bench/micro/bench_slots.c): rule 834, K = 2, 0.10-0.18 %
- *   mean error at 3-11x the default's time, exact (1e-12) on
- *   triangulations of convex planar regions. The commit that added this file:
- *   rule 66 (each half-edge passed once, late windows crossed, prefetch)
- *   0.10-0.20 % mean error at 2.7-9x the default's time; rule 194 (offers
- *   only where needed) 0.13-0.37 %, exact on a flat square. The time goes
- *   to first reads of the face records and slots (memory) and ~14 offers
- *   per vertex.
+ *   are worse on curved meshes. With bit 10 (the main rule) the window
+ *   dropped is instead the one whose loss raises the least the lowest
+ *   value at 9 points of the edge (the envelope).
+ * - A window crossing a face lowers the far corner by its ray where the
+ *   corner is in its interval; with bit 11 (the main rule) elsewhere over
+ *   the interval's nearer end (the ray to it, then across the face): at
+ *   the tip of thin faces the edge relaxation alone is an edge's length
+ *   off.
+ * - Measured (bench/micro/bench_slots.c; figures in the commit messages):
+ *   the main rule at K = 2 below the default solve's max error on every
+ *   mesh there, exact (1e-12) on triangulations of convex planar regions.
+ *   The time goes to first reads of the face records and slots (memory)
+ *   and ~14 offers per vertex.
  * - Every value is sigma + a straight segment in a strip unfolded through
  *   the faces the window crossed, sigma itself a value, or d(u) + |uv|:
  *   the length of a path on the surface.
@@ -126,6 +130,8 @@ struct mfmm_slots {
                       value), not when its ends have settled */
     int env;       /* bit 10: a window over K is weighed by the envelope (sl_emit) */
     double tgt_level; /* the largest value of the targets settled (sl_loop) */
+    int endpath;   /* bit 11: a window lowers the far corner of the face it crosses over
+                      its interval's nearer end, however far (sl_cross) */
     mfmm_slots_info info;
 };
 
@@ -257,6 +263,7 @@ void mfmm_slots_set_rule(mfmm_slots *s, int rule)
     s->order = (rule >> 8) & 1;
     s->needed |= (rule >> 8) & 2; /* bit 9: only flat vertices skip their offers */
     s->env = (rule >> 10) & 1;
+    s->endpath = (rule >> 11) & 1;
 }
 
 int mfmm_slots_set_k(mfmm_slots *s, int K)
@@ -599,7 +606,11 @@ static void sl_cross(mfmm_slots *s, int32_t h, const sl_win *w)
     if (tc >= b0 - tol && tc <= b1 + tol) {
         double ex = cx - px, ey = cy - py;
         sl_update(s, vc, sigma + sqrt(ex * ex + ey * ey), 1);
-    } else if (tc >= b0 - EX_GRAZE * L && tc <= b1 + EX_GRAZE * L) {
+    } else if (s->endpath || (tc >= b0 - EX_GRAZE * L && tc <= b1 + EX_GRAZE * L)) {
+        /* C beside the window: the ray to the interval's nearer end, then
+         * straight across the face (a path; with bit 11 wherever C is, else
+         * at a graze): a vertex at the tip of thin faces otherwise gets only
+         * the edge relaxation, an edge's length off */
         double e = tc < b0 ? b0 : b1;
         double ie = sqrt((e - px) * (e - px) + py * py), ec = sqrt((cx - e) * (cx - e) + cy * cy);
         sl_update(s, vc, sigma + ie + ec, 0);

@@ -40,24 +40,18 @@ void mfmm_slots_set_rule(mfmm_slots *s, int rule);
  * ends have settled; a window that comes later is crossed at once (bit 1).
  * Bit 9 (with bit 7): only a vertex reached by a ray whose neighbourhood
  * unfolds flat (angle sum 2 pi, or a wall's vertex of pi or less) skips its
- * offers. The main rule, 834 (bits 1, 6, 7, 8, 9), set by
- * mfmm_slots_create: exact on triangulations of convex planar regions, as
- * accurate as rule 66 on curved meshes. */
-#define SL_RULE_MAIN 834
-/* Bit 10 (measured, not in the main rule): a window over K on a half-edge
- * drops, of the K + 1, the one whose loss raises the least the sum over 9
- * points of the edge of the lowest value there (the envelope), not the worst
- * score. 834 -> 1858 at K = 2, mean % / max % diag: wingnut 0.266 / 1.93 ->
- * 0.173 / 1.83; hand 0.097 / 1.16 -> 0.145 / 1.71, spot 0.146 / 0.54 ->
- * 0.132 / 0.75, camelhead 0.178 / 0.78 -> 0.108 / 0.91, nefertiti 0.138 /
- * 0.44 -> 0.103 / 0.89, bunny 0.153 / 0.34 -> 0.102 / 0.38, icosphere5
- * 0.109 / 0.23 -> 0.066 / 0.24; beetle 0.272 / 1.91 -> 0.181 / 1.94,
- * fertility 0.172 / 1.00 -> 0.147 / 1.74, decimated-max 0.243 / 1.29 ->
- * 0.173 / 1.36, igea 0.133 / 0.23 -> 0.076 / 0.20, sine100 0.191 / 0.78
- * -> 0.155 / 0.79; ~25 % more time; flat checks as 834, never below exact.
- * Mean down, max mostly up: a window whose worth is downstream (a saddle's
- * shadow between two pieces of the source's window) is no better on the
- * edge where it is dropped, by either weighing. */
+ * offers. Bit 10: a window over K on a half-edge drops, of the K + 1, the
+ * one whose loss raises the least the sum over 9 points of the edge of the
+ * lowest value there (the envelope), not the worst score. Bit 11: a window crossing a face lowers the far corner, where the
+ * corner is beside the window's interval, over the interval's nearer end
+ * (the ray to it, then straight across the face: a path), not only at a
+ * graze; the corner offers (it was not reached by a ray). The main rule,
+ * 3906 (bits 1, 6-11), set by mfmm_slots_create: exact on triangulations
+ * of convex planar regions and on developable surfaces (cylinders, a
+ * cube), at K = 2 below the default solve's max error on the meshes of
+ * bench/micro/bench_slots.c. Rule 834 (bits 1, 6-9): the same without
+ * bits 10 and 11, a baseline for measurements. */
+#define SL_RULE_MAIN 3906
 
 /* K windows per half-edge instead of 2 (1 to 8; ranks 1 and 3 of the rule
  * need 2, and fall back to rank 0). 0 when out of memory or K is out of
