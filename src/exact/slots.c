@@ -1,77 +1,53 @@
-/* Two windows in place per half-edge, propagated in vertex order (slots.h).
- *
- * The design (a prototype for issue 43; docs: the commit message and the
- * report in bench/micro/bench_slots.c's header):
+/* The window method (MFMM_METHOD_WINDOWS): window propagation keeping K
+ * windows (2 by default) in place on each half-edge, in distance order
+ * (slots.h; docs/windows.md).
  *
  * - Slots. Half-edge h = 3f+k (the edge opposite corner k of face f, in the
  *   exact tables' frame: corner k+1 at 0, k+2 at L, corner k at (cx, cy),
- *   cy > 0) holds at most two windows entering f through that edge: a
+ *   cy > 0) holds at most K windows entering f through that edge: a
  *   pseudo-source (px, py), py <= 0, unfolded into h's frame, its distance
- *   sigma and the interval [b0, b1] of the edge its rays cross (the same
- *   fields as the exact solver's queue entries). No queue entry per window.
+ *   sigma, the interval [b0, b1] of the edge its rays cross (the exact
+ *   solver's fields) and the interval [g0, g1] of the rays traced with it.
+ *   No queue entry per window.
  * - Order. A heap of vertices keyed by their current distance (the march's
- *   heap, march/march.h) and, with bit 8 of the rule (in the main rule,
- *   SL_RULE_MAIN = 3906), a heap of half-edges keyed by the least value of
- *   the windows they hold (sigma + the distance to the interval); the lower
- *   top is taken first. When a vertex v settles:
- *   (1) it offers a window to the opposite edge of each face f around it:
- *       itself as pseudo-source, sigma = d(v), the whole edge; the offer
- *       lowers the edge's ends to d(v) + |edge| (the edge relaxation, so
- *       every reached vertex has a path) and goes into the slots of the
- *       half-edge across (the face beyond f);
- *   (2) without bit 8: for each face f at v and each edge of f from v to a
- *       corner u that settled before, the windows in that half-edge's slots
- *       are passed across f (rule 0: every half-edge once, when its second
- *       end settles; rule 1: only the first edge of each face to have both
- *       ends settled). With bit 8 a half-edge is passed when it comes off
- *       its heap: the window that reaches a face's far corner is crossed
- *       before that corner settles even where the corner is nearer than the
- *       edge's ends (an obtuse face: in vertex order the corner settled on
- *       an edge-relaxed value, offered windows that were not paths' ends
- *       and these took the source's pieces' slots; a flat mesh stretched 8x
- *       was 0.33 off). A pass lowers the far corner where the window sees
- *       it (or grazes it, over the window's end, as ex_propagate) and offers
- *       its children on f's other two edges to the half-edges across them.
- *   A window kept in a half-edge already passed is dropped, or with bit 1
- *   of the rule crossed at once (counted as late). A settled vertex can
- *   still be lowered by a later pass (its output is then lower; what it
- *   offered used the old value). With bit 7 a vertex offers only where
- *   needed: a saddle, a vertex at a wall with an angle sum over pi, or one
- *   whose distance came from an edge or a window's end, not a window's ray
- *   (the windows beside a ray-reached vertex carry its paths on); bit 9
- *   narrows the vertices that skip their offers to the flat ones (angle
- *   sum 2 pi, or a wall's vertex of pi or less): on a curved mesh the
- *   offers of convex vertices make up for windows lost to the slots. A ray
- *   wins a tie (1e-12) with the value a vertex has: a straight wall is
- *   reached by a window's end and the edge relaxation at once.
- * - Same pseudo-source: an offer whose pseudo-source and sigma equal a
- *   slot's to SL_SAME is merged into it (the union of the intervals): the
- *   two pieces of one window that crossed the face behind by both edges.
- * - An offer to a half-edge is trimmed against the current distances of
- *   the edge's ends as the exact solver trims (ex_trim; ties kept within
- *   EX_TIE), then ranked by its score: the sum of the distances it gives at
- *   the edge's ends and midpoint (outside its interval: to the nearer end
- *   of the interval, then along the edge, the length of a real path). The
- *   two least scores are kept (scores are taken only when a third window
- *   comes). Other ranks (bits 2-3 of the rule, slots.h) were measured and
- *   are worse on curved meshes. With bit 10 (the main rule) the window
- *   dropped is instead the one whose loss raises the least the lowest
- *   value at 9 points of the edge (the envelope).
- * - A window crossing a face lowers the far corner by its ray where the
- *   corner is in its interval; with bit 11 (the main rule) elsewhere over
- *   the interval's nearer end (the ray to it, then across the face): at
- *   the tip of thin faces the edge relaxation alone is an edge's length
- *   off.
- * - Measured (bench/micro/bench_slots.c; figures in the commit messages):
- *   the main rule at K = 2 below the default solve's max error on every
- *   mesh there, exact (1e-12) on triangulations of convex planar regions.
- *   The time goes to first reads of the face records and slots (memory)
- *   and ~14 offers per vertex.
+ *   heap, march/march.h) and a heap of half-edges keyed by the least value
+ *   of the windows they hold; the lower top goes first. A vertex that
+ *   settles offers a window to the opposite edge of each of its faces
+ *   (itself as pseudo-source, sigma = d(v), the whole edge), which also
+ *   lowers the edge's ends to d(v) + |edge| (so every reached vertex has a
+ *   path). A half-edge that comes off its heap passes its windows across
+ *   its face: each lowers the far corner (by its ray where the corner is in
+ *   its interval, else over the interval's nearer end and across the face)
+ *   and offers its children to the half-edges across the face's other two
+ *   edges. Passing half-edges by their windows' least value, not when their
+ *   ends settle, crosses a window before an obtuse face's far corner
+ *   settles on an edge-relaxed value whose offers would evict it. A window
+ *   kept in a half-edge already passed is crossed at once.
+ * - Offers where needed. A vertex reached by a window's ray whose
+ *   neighbourhood unfolds flat (angle sum 2 pi, or a wall's vertex of pi or
+ *   less) offers nothing: the windows beside it carry its paths on. Saddles,
+ *   wall vertices and convex vertices offer (on curved meshes the convex
+ *   vertices' offers make up for windows lost to the slots). A ray wins a
+ *   tie (1e-12) with a vertex's value: a straight wall is reached by a
+ *   window's end and by the edge relaxation at once.
+ * - Joining. An offer with a slot's pseudo-source and sigma (to SL_SAME)
+ *   whose traced rays meet the slot's is joined to it: the pieces of one
+ *   window that went round a vertex by both sides. Pieces whose traced
+ *   rays do not meet stay apart (they may have passed a hole on both
+ *   sides; the rays between would cross it).
+ * - Keeping K. An offer is trimmed against the current distances of the
+ *   edge's ends as the exact solver trims (ex_trim; ties kept within
+ *   EX_TIE). When K + 1 windows compete, the one whose loss raises the
+ *   least the lower envelope (the least value at SL_NS points of the edge,
+ *   summed) is dropped. Other rules (slots.h, for measurements) weigh by a
+ *   score of the window alone.
  * - Every value is sigma + a straight segment in a strip unfolded through
- *   the faces the window crossed, sigma itself a value, or d(u) + |uv|:
- *   the length of a path on the surface.
- * - Walls, zero-area faces and non-manifold edges: windows stop there (the
- *   edge relaxation of the offers goes on); copies are skipped. */
+ *   the faces the window crossed (possibly ending with a segment from the
+ *   interval's end across one face), sigma itself a value, or d(u) + |uv|:
+ *   the length of a path on the surface, never below the geodesic distance.
+ * - Walls and zero-area faces stop windows (the edge relaxation goes on);
+ *   at a non-manifold edge a window goes on into every other face on it
+ *   (as the exact solver's ex_fan_out); copies of a face are skipped. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

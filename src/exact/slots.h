@@ -1,8 +1,8 @@
-/* An approximate window propagation with two windows in place on each
- * half-edge ("slots"), run in vertex order by the march's heap (internal;
- * a prototype for issue 43, measured by bench/micro/bench_slots.c). Every
- * value it writes is the length of a path on the surface, so never below
- * the exact solver's beyond rounding. The design: slots.c. */
+/* The window method behind MFMM_METHOD_WINDOWS (internal): window
+ * propagation keeping K windows in place on each half-edge ("slots"), in
+ * distance order. Every value it writes is the length of a path on the
+ * surface, so never below the exact solver's beyond rounding. The design:
+ * slots.c; the rules below are kept for bench/micro/bench_slots.c. */
 #ifndef MFMM_EXACT_SLOTS_H
 #define MFMM_EXACT_SLOTS_H
 
@@ -48,9 +48,7 @@ void mfmm_slots_set_rule(mfmm_slots *s, int rule);
  * graze; the corner offers (it was not reached by a ray). The main rule,
  * 3906 (bits 1, 6-11), set by mfmm_slots_create: exact on triangulations
  * of convex planar regions and on developable surfaces (cylinders, a
- * cube), at K = 2 below the default solve's max error on the meshes of
- * bench/micro/bench_slots.c. Rule 834 (bits 1, 6-9): the same without
- * bits 10 and 11, a baseline for measurements. */
+ * cube). Rule 834 (bits 1, 6-9): the same without bits 10 and 11. */
 #define SL_RULE_MAIN 3906
 
 /* K windows per half-edge instead of 2 (1 to 8; ranks 1 and 3 of the rule

@@ -30,18 +30,18 @@ from meshfmm_testing import mean_rel_error
 BELOW = 1e-9
 
 # Mean relative error in percent, the largest of the three stored sources
-# (measured: hand 0.168, spot 0.167, wingnut 0.334, fertility 0.190,
-# decimated-max 0.253, camelhead 0.179, nefertiti 0.156, bunny 0.156;
+# (measured: hand 0.050, spot 0.133, wingnut 0.136, fertility 0.141,
+# decimated-max 0.151, camelhead 0.119, nefertiti 0.098, bunny 0.097;
 # the march's from the same sources: 0.36-0.81).
 MEAN_ERROR_PCT = {
-    "hand_lowres.obj": 0.19,
-    "spot.obj": 0.19,
-    "wingnut.obj": 0.37,
-    "fertility_FE_10k.off": 0.21,
-    "decimated-max.obj": 0.28,
-    "camelhead.off": 0.20,
-    "nefertiti-lowres.obj": 0.18,
-    "stanford-bunny.obj": 0.18,
+    "hand_lowres.obj": 0.06,
+    "spot.obj": 0.15,
+    "wingnut.obj": 0.15,
+    "fertility_FE_10k.off": 0.16,
+    "decimated-max.obj": 0.17,
+    "camelhead.off": 0.13,
+    "nefertiti-lowres.obj": 0.11,
+    "stanford-bunny.obj": 0.11,
 }
 
 
