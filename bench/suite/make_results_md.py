@@ -607,7 +607,7 @@ def methods_section():
     D = ["## Methods: fmm and windows", "",
          f"**Machine:** {machine_line(mj)}.", "",
          "`method=\"fmm\"` (the default: the march from the exact start) against "
-         "`method=\"windows\"` (window propagation, three windows per half-edge) on the cases "
+         "`method=\"windows\"` (window propagation, two windows per half-edge) on the cases "
          "of the exact start's table (`bench/suite/bench_methods.py`, 3 sources each). Mean "
          "relative error % / max error % of the diagonal; least: the least (d - exact) / exact "
          "over the vertices (below 0: a value under the geodesic distance; on the spheres the "
