@@ -353,8 +353,9 @@ MFMM_API mfmm_status mfmm_solver_get_info(const mfmm_solver *solver, mfmm_solve_
  *   solver:    from mfmm_solver_create.
  *   start:     the first vertex, in a face.
  *   k:         points to choose, 1 <= k <= the vertices in faces.
- *   options:   NULL for defaults; cost, unfolding and exact_start_radius
- *              as for mfmm_solve; max_distance must be +inf and n_targets 0.
+ *   options:   NULL for defaults; cost, unfolding, exact_start_radius and
+ *              method as for mfmm_solve; max_distance must be +inf and
+ *              n_targets 0.
  *   points:    (k,) int32 out: the vertex ids in the order chosen.
  *   radii:     (k,) float64 out, may be NULL: radii[i] is points[i]'s
  *              distance to points[0..i-1] when chosen (+inf for i = 0):
@@ -364,7 +365,7 @@ MFMM_API mfmm_status mfmm_solver_get_info(const mfmm_solver *solver, mfmm_solve_
  *              components without a point).
  * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_COUNT (k); MFMM_ERR_BAD_SOURCE
  * (start out of range or in no face); MFMM_ERR_BAD_COST; MFMM_ERR_BAD_ARGUMENT
- * (max_distance, targets, exact_start_radius, struct_size);
+ * (max_distance, targets, exact_start_radius, method, struct_size);
  * MFMM_ERR_OUT_OF_MEMORY.
  * Thread safety: one call at a time per solver. */
 MFMM_API mfmm_status mfmm_farthest_points(mfmm_solver *solver, int32_t start, int32_t k,
