@@ -259,6 +259,21 @@ MFMM_API void mfmm_solver_destroy(mfmm_solver *solver);
  * (MFMM_EXACT_START_RADIUS, section 10). */
 #define MFMM_EXACT_START_AUTO (-1.0)
 
+/* How mfmm_solve computes distances (docs/methods.md compares them). */
+typedef enum mfmm_method {
+    /* The paper's march (section 2) from the exact start: any cost; its
+     * first-order error over-estimates along each path. */
+    MFMM_METHOD_FMM = 0,
+    /* Window propagation keeping two windows per half-edge: each value is
+     * a straight segment from a source or a vertex where geodesics bend,
+     * unfolded through the faces it crosses: several times more accurate
+     * than the march, never below the geodesic distance beyond rounding,
+     * exact on flat regions, several times the march's time. Geodesic
+     * distance only (no cost); unfolding and exact_start_radius do not
+     * apply. */
+    MFMM_METHOD_WINDOWS = 1
+} mfmm_method;
+
 typedef struct mfmm_solve_options {
     size_t struct_size;              /* set by mfmm_solve_options_init */
     const double *cost;              /* NULL (default): F = 1. Finite and > 0, and its
@@ -282,15 +297,17 @@ typedef struct mfmm_solve_options {
      * source starts plainly). MFMM_EXACT_START_AUTO (default), or finite and
      * >= 0; 0: the plain start of the paper. */
     double exact_start_radius;
+    mfmm_method method;              /* default MFMM_METHOD_FMM */
 } mfmm_solve_options;
 
 /* Fills `options` with the defaults: no cost, no limit, no targets,
- * unfolding on, exact_start_radius MFMM_EXACT_START_AUTO. NULL is a no-op. */
+ * unfolding on, exact_start_radius MFMM_EXACT_START_AUTO, MFMM_METHOD_FMM.
+ * NULL is a no-op. */
 MFMM_API void mfmm_solve_options_init(mfmm_solve_options *options);
 
-/* Marches from the sources and writes T for every vertex: the paper's
+/* Computes T from the sources for every vertex: by default the paper's
  * march (section 2), with section 4.1's local update (Eq. 4-5) and, when
- * unfolding is on, section 4.2's virtual edges.
+ * unfolding is on, section 4.2's virtual edges; options->method chooses.
  *   solver:    from mfmm_solver_create.
  *   sources:   (n_sources,) n_sources >= 1.
  *   options:   NULL for defaults.
@@ -301,7 +318,8 @@ MFMM_API void mfmm_solve_options_init(mfmm_solve_options *options);
  * source); MFMM_ERR_BAD_COST (err->index: the entry); MFMM_ERR_BAD_ARGUMENT
  * (max_distance NaN or < 0; n_targets < 0, or > 0 with targets NULL; a
  * target out of range, err->index: its position; exact_start_radius;
- * struct_size); MFMM_ERR_OUT_OF_MEMORY.
+ * method unknown, or MFMM_METHOD_WINDOWS with a cost; struct_size);
+ * MFMM_ERR_OUT_OF_MEMORY.
  * Thread safety: one call at a time per solver. */
 MFMM_API mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources,
                                 int32_t n_sources, const mfmm_solve_options *options,
@@ -335,8 +353,9 @@ MFMM_API mfmm_status mfmm_solver_get_info(const mfmm_solver *solver, mfmm_solve_
  *   solver:    from mfmm_solver_create.
  *   start:     the first vertex, in a face.
  *   k:         points to choose, 1 <= k <= the vertices in faces.
- *   options:   NULL for defaults; cost, unfolding and exact_start_radius
- *              as for mfmm_solve; max_distance must be +inf and n_targets 0.
+ *   options:   NULL for defaults; cost, unfolding, exact_start_radius and
+ *              method as for mfmm_solve; max_distance must be +inf and
+ *              n_targets 0.
  *   points:    (k,) int32 out: the vertex ids in the order chosen.
  *   radii:     (k,) float64 out, may be NULL: radii[i] is points[i]'s
  *              distance to points[0..i-1] when chosen (+inf for i = 0):
@@ -346,7 +365,7 @@ MFMM_API mfmm_status mfmm_solver_get_info(const mfmm_solver *solver, mfmm_solve_
  *              components without a point).
  * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_COUNT (k); MFMM_ERR_BAD_SOURCE
  * (start out of range or in no face); MFMM_ERR_BAD_COST; MFMM_ERR_BAD_ARGUMENT
- * (max_distance, targets, exact_start_radius, struct_size);
+ * (max_distance, targets, exact_start_radius, method, struct_size);
  * MFMM_ERR_OUT_OF_MEMORY.
  * Thread safety: one call at a time per solver. */
 MFMM_API mfmm_status mfmm_farthest_points(mfmm_solver *solver, int32_t start, int32_t k,
@@ -633,11 +652,14 @@ typedef struct mfmm_matrix_options {
                                         for the call */
     const mfmm_opencl_options *opencl_options; /* how to make the call's context when
                                         opencl is NULL; NULL: defaults */
+    mfmm_method method;              /* as in mfmm_solve_options (default
+                                        MFMM_METHOD_FMM); MFMM_METHOD_WINDOWS runs on
+                                        the serial and threads backends only */
 } mfmm_matrix_options;
 
 /* Fills `options` with the defaults (auto backend, float32, no cost, no limit,
  * every vertex a column, unfolding on, MFMM_EXACT_START_AUTO, all cores, no
- * output). NULL is a no-op. */
+ * output, MFMM_METHOD_FMM). NULL is a no-op. */
 MFMM_API void mfmm_matrix_options_init(mfmm_matrix_options *options);
 
 /* What one mfmm_distance_matrix call did (an output struct: set
@@ -666,13 +688,14 @@ typedef struct mfmm_matrix_info {
  * of OpenCL (from the first row not yet delivered) when OpenCL fails, when
  * the device is a CPU the caller did not name, when a batch would not keep
  * every compute unit busy within memory_limit, and for sparse rows
- * (info->backend_reason says why). Float64 rows equal mfmm_solve's bit for
- * bit on every backend.
+ * and for MFMM_METHOD_WINDOWS (info->backend_reason says why). Float64 rows
+ * equal mfmm_solve's bit for bit on every backend.
  * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_BAD_COUNT (n_sources, n_targets);
  * MFMM_ERR_BAD_SOURCE (err->index: the row); MFMM_ERR_BAD_COST;
  * MFMM_ERR_BAD_ARGUMENT (no output, sparse with dense or on OPENCL, a
  * target out of range, dtype, backend, max_distance, exact_start_radius,
- * n_threads < 0, float32 range, struct_size);
+ * method as for mfmm_solve or MFMM_METHOD_WINDOWS on OPENCL, n_threads < 0,
+ * float32 range, struct_size);
  * MFMM_ERR_CANCELLED; MFMM_ERR_NO_OPENCL, MFMM_ERR_OPENCL_BUILD,
  * MFMM_ERR_OPENCL_RUNTIME (backend OPENCL); MFMM_ERR_OUT_OF_MEMORY.
  * Thread-safe (calls on one mesh may run at once; callbacks run on the

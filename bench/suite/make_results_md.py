@@ -597,6 +597,35 @@ def plan_section(pl, cl, co):
 
 
 # ---------------------------------------------------------------- document
+def methods_section():
+    """The solve methods side by side, from bench/results/methods.json
+    (bench/suite/bench_methods.py)."""
+    path = bl.RESULTS / "methods.json"
+    if not path.is_file():
+        return []
+    mj = json.loads(path.read_text())
+    D = ["## Methods: fmm and windows", "",
+         f"**Machine:** {machine_line(mj)}.", "",
+         "`method=\"fmm\"` (the default: the march from the exact start) against "
+         "`method=\"windows\"` (window propagation, two windows per half-edge) on the cases "
+         "of the exact start's table (`bench/suite/bench_methods.py`, 3 sources each). Mean "
+         "relative error % / max error % of the diagonal; least: the least (d - exact) / exact "
+         "over the vertices (below 0: a value under the geodesic distance; on the spheres the "
+         "reference is the great circle, not the polyhedral distance). Time per source: the "
+         f"least of {mj['rounds']} rounds, the methods alternating.", "",
+         "| case | nv | fmm | fmm least | windows | windows least | time fmm | time windows | "
+         "windows / fmm |", "|" + "---|" * 9]
+    for c in mj["cases"]:
+        f, w = c["methods"]["fmm"], c["methods"]["windows"]
+        D.append(f"| {c['name']} | {c['n_vertices']} | {fnum(f['mre_pct'])} / "
+                 f"{fnum(f['max_pct'])} | {f['least_rel']:.1e} | {fnum(w['mre_pct'])} / "
+                 f"{fnum(w['max_pct'])} | {w['least_rel']:.1e} | "
+                 f"{1e3 * f['time_per_source_s']:.2f} ms | {1e3 * w['time_per_source_s']:.2f} ms | "
+                 f"{c['time_ratio']:.1f}x |")
+    D.append("")
+    return D
+
+
 def exact_start_section():
     """The exact start, from bench/results/exact_start.json and
     convergence.json (bench/suite/bench_exact_start.py, convergence_exact_start.py)."""
@@ -661,7 +690,9 @@ def exact_start_section():
                 D.append(f"| {r['n']} | {r['n_vertices']} | " +
                          " | ".join(f"{r[k]:.4f}" for k in keys) +
                          f" | {r[keys[1]] / r[keys[0]]:.2f}x |")
-            D.append("| fitted order | | " + " | ".join(f"{fam['order'][k]:.2f}" for k in keys) + " | |")
+            D.append("| fitted order | | " + " | ".join(
+                "exact" if fam["order"][k] is None else f"{fam['order'][k]:.2f}" for k in keys) +
+                " | |")
             D.append("")
     return D
 
@@ -711,6 +742,7 @@ def main():
     if fl:
         D += ["Refusals:", ""] + fl + [""]
     D += exact_start_section()
+    D += methods_section()
     D += ["![convergence](../docs/images/convergence.png)", "",
           "![scaling](../docs/images/scaling.png)", ""]
     if allp:

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The whole comparison against the peers, from one command:
-#   bash bench/suite/run_all.sh      # about 10 minutes on a 2-core machine
+#   bash bench/suite/run_all.sh      # about 16 minutes on a 2-core machine
 # (bench/README.md: what each step takes.) Sets everything up first
 # (scripts/setup.sh --bench: Debian packages, .venv with requirements-dev.txt
 # and the peers of bench/requirements.txt, the build), then writes
@@ -23,6 +23,7 @@ MESHFMM_ACCURACY_JSON="$PWD/bench/results/accuracy_python.json" "$py" -m pytest 
 step "per-source accuracy and time against the peers"
 "$py" bench/suite/compare_peers.py
 "$py" bench/suite/bench_exact_start.py   # the exact start: radii, robust heat, time per source
+"$py" bench/suite/bench_methods.py       # method="windows" beside the default
 "$py" bench/suite/convergence_exact_start.py
 step "all pairs"
 "$py" bench/suite/compare_allpairs.py

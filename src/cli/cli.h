@@ -113,7 +113,7 @@ enum {
     OPT_NO_UNFOLDING, OPT_EXACT, OPT_TARGET, OPT_TARGET_FACE, OPT_MAX_POINTS, OPT_NO_STRAIGHTEN,
     OPT_JSON, OPT_MAX_UNFOLD_STEPS, OPT_STRETCH, OPT_RADII, OPT_DTYPE, OPT_BACKEND,
     OPT_SOURCES, OPT_THREADS, OPT_MEMORY, OPT_TARGETS, OPT_PLAIN_START, OPT_EXACT_START_RADIUS,
-    OPT_NO_SPOKES, OPT_START, OPT_NO_SIZE_CHECK, OPT_MAP, OPT_WELD, OPT_DISTANCES
+    OPT_NO_SPOKES, OPT_START, OPT_NO_SIZE_CHECK, OPT_MAP, OPT_WELD, OPT_DISTANCES, OPT_METHOD
 };
 /* Refuses a value option given a second time, which getopt_long would let
  * win silently (`-o a.npy -o b.npy`): call it with every code getopt_long
@@ -201,6 +201,8 @@ typedef struct cli_sources_and_cost {
     double *cost;     /* loaded by cli_sources_and_cost_load */
     double exact_start_radius; /* --exact-start-radius R, --plain-start (0) */
     int start_given;  /* 1: --plain-start, 2: --exact-start-radius (both: an error) */
+    mfmm_method method; /* --method fmm|windows (default fmm) */
+    int method_given; /* --method was given */
 } cli_sources_and_cost;
 
 /* The shared options, for a command's getopt_long table. */
@@ -212,7 +214,8 @@ typedef struct cli_sources_and_cost {
         {"cost-per-face", no_argument, NULL, OPT_COST_PER_FACE},                             \
         {"plain-start", no_argument, NULL, OPT_PLAIN_START},                                 \
         {"exact-start-radius", required_argument, NULL, OPT_EXACT_START_RADIUS},            \
-        {"weld", no_argument, NULL, OPT_WELD}
+        {"weld", no_argument, NULL, OPT_WELD},                                               \
+        {"method", required_argument, NULL, OPT_METHOD}
 /* The help line of --weld. */
 #define CLI_WELD_HELP                                                                        \
     "  --weld                  weld vertices at the same position (texture seams,\n"        \
@@ -238,6 +241,22 @@ int cli_parse_start_radius(const char *sub, const char *arg, double *radius);
  * CLI_OK, or CLI_USAGE with the error printed when the other one was given too. */
 int cli_start_option(const char *sub, int which, int *given);
 #define CLI_SHARED_SHORT_OPTIONS ":ho:"
+/* The help lines of --method (distance, path, voronoi, landmarks; allpairs
+ * words its own for its narrower column). */
+#define CLI_METHOD_HELP                                                                      \
+    "  --method M              fmm (default): Fast Marching; windows: window\n"              \
+    "                          propagation keeping two windows per half-edge, never\n"      \
+    "                          below the geodesic distance, several times as accurate\n"   \
+    "                          and several times the time; no --cost (the start\n"         \
+    "                          options do not apply to it)\n"
+/* --method's value: "fmm" or "windows" into *method. CLI_OK, or CLI_USAGE
+ * with the error printed. */
+int cli_parse_method(const char *sub, const char *arg, mfmm_method *method);
+/* The method options together: --exact (exact != 0) with --method
+ * (method_given), and --method windows with a cost file, are usage errors.
+ * CLI_OK, or CLI_USAGE with the error printed. */
+int cli_check_method(const char *sub, mfmm_method method, int method_given, int exact,
+                     int has_cost);
 
 /* 0, or -1 with "out of memory" printed. argc: the subcommand's. */
 int cli_sources_and_cost_init(cli_sources_and_cost *o, const char *sub, void (*help)(FILE *out),

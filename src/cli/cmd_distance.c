@@ -13,13 +13,14 @@ static void help(FILE *out)
             "                        [--face-source F W0 W1 W2 ...] [--max-distance X]\n"
             "                        [--no-unfolding] [--cost FILE [--cost-per-face]]\n"
             "                        [--exact-start-radius R | --plain-start]\n"
-            "                        [--exact] [--weld] -o OUT\n\n"
+            "                        [--method fmm|windows | --exact] [--weld] -o OUT\n\n"
             "Geodesic distance (Fast Marching) from the sources to every vertex of MESH.\n\n"
             "  --source I              a vertex source (0-based id); repeatable\n"
             "  --face-source F W0 W1 W2  a point in face F with barycentric coordinates\n"
             "  --max-distance X        stop past X; farther vertices get inf\n"
             "  --no-unfolding          plain stencils at obtuse corners (for comparison)\n"
             CLI_START_HELP
+            CLI_METHOD_HELP
             "  --exact                 exact polyhedral geodesic distance (window\n"
             "                          propagation) instead of Fast Marching; no --cost\n"
             CLI_WELD_HELP
@@ -70,6 +71,9 @@ int cmd_distance(int argc, char **argv)
             goto done;
         }
     }
+    if ((rc = cli_check_method("distance", o.method, o.method_given, exact,
+                               o.cost_path != NULL)) != CLI_OK)
+        goto done;
     if (exact && (o.cost_path || !opt.unfolding || o.start_given)) {
         rc = cli_usage_error("distance", "--exact computes geodesic distance: it takes no "
                                          "--cost, --no-unfolding, --plain-start or "

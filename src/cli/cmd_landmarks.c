@@ -10,8 +10,8 @@ static void help(FILE *out)
 {
     fprintf(out,
             "usage: meshfmm landmarks MESH -k K [--start V] [--no-unfolding]\n"
-            "                         [--exact-start-radius R | --plain-start] [--weld]\n"
-            "                         -o OUT\n\n"
+            "                         [--exact-start-radius R | --plain-start]\n"
+            "                         [--method fmm|windows] [--weld] -o OUT\n\n"
             "Geodesic farthest-point sampling (mfmm_farthest_points): K vertex ids of MESH,\n"
             "the first V, each next the vertex farthest from those chosen (ties to the\n"
             "lowest id). One march per point, each stopped at the farthest distance so\n"
@@ -23,6 +23,7 @@ static void help(FILE *out)
             "  --start V               the first landmark, a vertex id (default 0)\n"
             "  --no-unfolding          plain stencils at obtuse corners (for comparison)\n"
             CLI_START_HELP_NO_LIMIT
+            CLI_METHOD_HELP
             "  --weld                  weld vertices at the same position (texture seams,\n"
             "                          unmerged corners) first, as `meshfmm weld` does; the\n"
             "                          start and the landmarks are the file's ids (of\n"
@@ -45,6 +46,7 @@ int cmd_landmarks(int argc, char **argv)
         {"plain-start", no_argument, NULL, OPT_PLAIN_START},
         {"exact-start-radius", required_argument, NULL, OPT_EXACT_START_RADIUS},
         {"weld", no_argument, NULL, OPT_WELD},
+        {"method", required_argument, NULL, OPT_METHOD},
         {NULL, 0, NULL, 0}};
     const char *mesh_path = NULL, *out_path = NULL;
     int32_t k = -1, start = 0;
@@ -72,6 +74,9 @@ int cmd_landmarks(int argc, char **argv)
             opt.unfolding = 0;
         } else if (c == OPT_WELD) {
             weld = 1;
+        } else if (c == OPT_METHOD) {
+            if ((rc = cli_parse_method("landmarks", optarg, &opt.method)) != CLI_OK)
+                return rc;
         } else if (c == OPT_PLAIN_START) {
             if ((rc = cli_start_option("landmarks", 1, &start_given)) != CLI_OK)
                 return rc;

@@ -15,10 +15,11 @@ static void help(FILE *out)
             "usage: meshfmm path MESH --source I [--source J ...] [--face-source F W0 W1 W2 ...]\n"
             "                    (--target J | --target-face F W0 W1 W2)\n"
             "                    [--cost FILE [--cost-per-face]] [--max-points N] [--no-straighten]\n"
-            "                    [--exact-start-radius R | --plain-start] [--weld]\n"
-            "                    -o OUT\n\n"
+            "                    [--exact-start-radius R | --plain-start]\n"
+            "                    [--method fmm|windows] [--weld] -o OUT\n\n"
             "The minimal geodesic from the nearest source to the target: distances by Fast\n"
-            "Marching, then backtracking from the target along -grad T (Heun's method).\n"
+            "Marching (or --method windows), then backtracking from the target along\n"
+            "-grad T (Heun's method).\n"
             "The path is written from the source (first point) to the target (last), as\n"
             "Python's Mesh.path(source, target). Prints the path's length on stdout (with\n"
             "--cost: the length and the cost-weighted length).\n\n"
@@ -30,6 +31,7 @@ static void help(FILE *out)
             "                          face (--cost-per-face)\n"
             "  --max-points N          most points the path may have (default 100000)\n"
             CLI_START_HELP_NO_LIMIT
+            CLI_METHOD_HELP
             "  --no-straighten         keep the traced path of section 5 (by default it is\n"
             "                          straightened inside the strip of faces it crossed)\n"
             CLI_WELD_HELP

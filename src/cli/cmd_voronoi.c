@@ -14,8 +14,9 @@ static void help(FILE *out)
             "usage: meshfmm voronoi MESH (--source I ... | --face-source F W0 W1 W2 ... |\n"
             "                       --sources FILE) [--max-distance X] [--no-unfolding]\n"
             "                       [--cost FILE [--cost-per-face]]\n"
-            "                       [--exact-start-radius R | --plain-start] [--exact]\n"
-            "                       [--weld] [--distances OUT] -o OUT\n\n"
+            "                       [--exact-start-radius R | --plain-start]\n"
+            "                       [--method fmm|windows | --exact] [--weld]\n"
+            "                       [--distances OUT] -o OUT\n\n"
             "Geodesic Voronoi labels: one solve from all the sources, then one pass over\n"
             "the vertices' edges (mfmm_voronoi_labels) telling which source each vertex's\n"
             "distance comes from. Labels index the sources in the order given (--source\n"
@@ -32,6 +33,7 @@ static void help(FILE *out)
             "  --max-distance X        stop past X; farther vertices get the label -1\n"
             "  --no-unfolding          plain stencils at obtuse corners (for comparison)\n"
             CLI_START_HELP
+            CLI_METHOD_HELP
             "  --exact                 exact polyhedral distances (as distance --exact); no\n"
             "                          --cost\n"
             "  --cost FILE             slowness F (.npy float64/float32 or .txt), one value\n"
@@ -117,6 +119,9 @@ int cmd_voronoi(int argc, char **argv)
             goto done;
         }
     }
+    if ((rc = cli_check_method("voronoi", o.method, o.method_given, exact,
+                               o.cost_path != NULL)) != CLI_OK)
+        goto done;
     if (exact && (o.cost_path || !opt.unfolding || o.start_given)) {
         rc = cli_usage_error("voronoi", "--exact computes geodesic distance: it takes no "
                                         "--cost, --no-unfolding, --plain-start or "

@@ -1,6 +1,6 @@
 /* Options shared by `distance`, `path` and `voronoi`: the mesh, the
- * sources, the cost file, --weld and the output; their checks, the loader
- * of the mesh and the cost, and the solves. */
+ * sources, the cost file, --weld, --method and the output; their checks,
+ * the loader of the mesh and the cost, and the solves. */
 #include <getopt.h>
 #include <math.h>
 #include <stdlib.h>
@@ -73,6 +73,9 @@ int cli_sources_and_cost_opt(cli_sources_and_cost *o, int c, int argc, char **ar
     case OPT_WELD:
         o->weld = 1;
         return CLI_OK;
+    case OPT_METHOD:
+        o->method_given = 1;
+        return cli_parse_method(o->sub, optarg, &o->method);
     case 'o':
         o->out_path = optarg;
         return CLI_OK;
@@ -105,7 +108,7 @@ int cli_sources_and_cost_check_inputs(const cli_sources_and_cost *o)
         return cli_usage_error(o->sub, "no mesh file given");
     if (o->n_src == 0)
         return cli_usage_error(o->sub, "no source given (--source or --face-source)");
-    return CLI_OK;
+    return cli_check_method(o->sub, o->method, o->method_given, 0, o->cost_path != NULL);
 }
 
 int cli_sources_and_cost_check_output(const cli_sources_and_cost *o, const char *ext0,
@@ -195,6 +198,7 @@ double *cli_solve_distances(const mfmm_mesh *mesh, const cli_sources_and_cost *o
     else
         mfmm_solve_options_init(&so);
     so.exact_start_radius = o->exact_start_radius;
+    so.method = o->method;
     st = mfmm_solve(solver, o->src, o->n_src, &so, dist, &err);
     mfmm_solver_destroy(solver);
     if (st != MFMM_OK) {
@@ -250,6 +254,29 @@ int cli_parse_start_radius(const char *sub, const char *arg, double *radius)
         return cli_usage_error(sub,
                                "--exact-start-radius needs 'auto' or a finite number >= 0, not '%s'",
                                arg);
+    return CLI_OK;
+}
+
+int cli_parse_method(const char *sub, const char *arg, mfmm_method *method)
+{
+    if (strcmp(arg, "fmm") == 0)
+        *method = MFMM_METHOD_FMM;
+    else if (strcmp(arg, "windows") == 0)
+        *method = MFMM_METHOD_WINDOWS;
+    else
+        return cli_usage_error(sub, "--method is fmm or windows, not '%s'", arg);
+    return CLI_OK;
+}
+
+int cli_check_method(const char *sub, mfmm_method method, int method_given, int exact,
+                     int has_cost)
+{
+    if (exact && method_given)
+        return cli_usage_error(sub, "--exact and --method are two methods; give one (--exact: "
+                                    "exact distances; --method fmm or windows)");
+    if (method == MFMM_METHOD_WINDOWS && has_cost)
+        return cli_usage_error(sub, "--method windows computes geodesic distance: it takes no "
+                                    "--cost (use --method fmm)");
     return CLI_OK;
 }
 

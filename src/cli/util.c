@@ -89,6 +89,7 @@ int cli_once(const char *sub, int c, uint32_t *seen)
                 {OPT_START, "--start"},
                 {OPT_MAP, "--map"},
                 {OPT_DISTANCES, "--distances"},
+                {OPT_METHOD, "--method"},
                 {'k', "-k/--count"}};
     for (unsigned i = 0; i < sizeof once / sizeof once[0]; i++) {
         if (once[i].code != c)

@@ -239,3 +239,146 @@ mfmm_gen_mesh mfmm_gen_icosphere(int level)
     free(em.vals);
     return m;
 }
+
+/* xorshift64*: the random points of mfmm_gen_delaunay */
+static double gen_rand(uint64_t *s)
+{
+    *s ^= *s >> 12;
+    *s ^= *s << 25;
+    *s ^= *s >> 27;
+    return (double)((*s * 2685821657736338717ull) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* whether p lies strictly inside the circumcircle of the counter-clockwise
+ * triangle (a, b, c) */
+static int gen_incircle(const double *a, const double *b, const double *c, const double *p)
+{
+    double ax = a[0] - p[0], ay = a[1] - p[1], bx = b[0] - p[0], by = b[1] - p[1];
+    double cx = c[0] - p[0], cy = c[1] - p[1];
+    double det = (ax * ax + ay * ay) * (bx * cy - cx * by) -
+                 (bx * bx + by * by) * (ax * cy - cx * ay) +
+                 (cx * cx + cy * cy) * (ax * by - bx * ay);
+    return det > 0.0;
+}
+
+mfmm_gen_mesh mfmm_gen_delaunay(int n, int disc, double stretch, uint64_t seed)
+{
+    mfmm_gen_mesh m = {0, 0, NULL, NULL};
+    if (n < 4 || n > 20000 || !(stretch > 0.0) || !isfinite(stretch))
+        return m;
+    uint64_t st = seed * 0x9E3779B97F4A7C15ull + 1;
+    int nb = disc ? (int)(2.0 * sqrt((double)n)) + 6 : 4 * ((int)sqrt((double)n) / 2 + 1);
+    if (nb > n)
+        nb = n;
+    /* points, then three far corners of a triangle around them */
+    double *P = malloc(((size_t)n + 3) * 2 * sizeof *P);
+    int32_t cap = 2 * (n + 3) + 8;
+    int32_t *T = malloc((size_t)cap * 3 * sizeof *T);
+    int32_t *E = malloc((size_t)cap * 3 * 2 * sizeof *E);
+    uint8_t *dead = malloc((size_t)cap);
+    if (!P || !T || !E || !dead)
+        goto done;
+    for (int i = 0; i < nb; i++) {
+        /* the boundary: on the circle, or around the square's sides */
+        if (disc) {
+            /* r = 1 + cos(3a) / 20: convex, and no four points on a
+             * circle (the insertion needs none) */
+            double a = 2.0 * PI * (i + 0.3 * gen_rand(&st)) / nb, r = 1.0 + 0.05 * cos(3.0 * a);
+            P[2 * i] = r * cos(a);
+            P[2 * i + 1] = r * sin(a);
+        } else {
+            int side = i % 4, q = i / 4, per = nb / 4;
+            double u = (double)q / per;
+            double xy[4][2] = {{u, 0.0}, {1.0, u}, {1.0 - u, 1.0}, {0.0, 1.0 - u}};
+            P[2 * i] = xy[side][0];
+            P[2 * i + 1] = xy[side][1];
+        }
+    }
+    for (int i = nb; i < n; i++) {
+        double x, y;
+        do {
+            x = gen_rand(&st);
+            y = gen_rand(&st);
+            if (disc) {
+                x = 2.0 * x - 1.0;
+                y = 2.0 * y - 1.0;
+            }
+        } while (disc ? x * x + y * y > 0.64 : (x < 0.02 || x > 0.98 || y < 0.02 || y > 0.98));
+        P[2 * i] = x;
+        P[2 * i + 1] = y;
+    }
+    P[2 * n] = -3e3;
+    P[2 * n + 1] = -3e3;
+    P[2 * n + 2] = 3e3;
+    P[2 * n + 3] = -3e3;
+    P[2 * n + 4] = 0.0;
+    P[2 * n + 5] = 3e3;
+    int32_t nt = 1;
+    T[0] = n;
+    T[1] = n + 1;
+    T[2] = n + 2;
+    dead[0] = 0;
+    /* Bowyer-Watson, O(n^2): the cavity's boundary edges, then a fan */
+    for (int32_t p = 0; p < n; p++) {
+        int32_t ne = 0;
+        for (int32_t t = 0; t < nt; t++) {
+            if (dead[t] || !gen_incircle(P + 2 * T[3 * t], P + 2 * T[3 * t + 1],
+                                         P + 2 * T[3 * t + 2], P + 2 * p))
+                continue;
+            dead[t] = 1;
+            for (int k = 0; k < 3; k++) {
+                int32_t a = T[3 * t + k], b = T[3 * t + (k + 1) % 3], j;
+                for (j = 0; j < ne; j++)
+                    if (E[2 * j] == b && E[2 * j + 1] == a)
+                        break;
+                if (j < ne) { /* shared by two cavity triangles: inside */
+                    E[2 * j] = E[2 * (ne - 1)];
+                    E[2 * j + 1] = E[2 * (ne - 1) + 1];
+                    ne--;
+                } else {
+                    E[2 * ne] = a;
+                    E[2 * ne + 1] = b;
+                    ne++;
+                }
+            }
+        }
+        int32_t w = 0; /* compact */
+        for (int32_t t = 0; t < nt; t++)
+            if (!dead[t]) {
+                memmove(T + 3 * w, T + 3 * t, 3 * sizeof *T);
+                dead[w++] = 0;
+            }
+        nt = w;
+        if (nt + ne > cap)
+            goto done;
+        for (int32_t j = 0; j < ne; j++) {
+            T[3 * nt] = E[2 * j];
+            T[3 * nt + 1] = E[2 * j + 1];
+            T[3 * nt + 2] = p;
+            dead[nt++] = 0;
+        }
+    }
+    int32_t nf = 0;
+    for (int32_t t = 0; t < nt; t++)
+        nf += T[3 * t] < n && T[3 * t + 1] < n && T[3 * t + 2] < n;
+    m = gen_alloc(n, nf);
+    if (!m.V)
+        goto done;
+    for (int32_t i = 0; i < n; i++) {
+        m.V[3 * i] = stretch * P[2 * i];
+        m.V[3 * i + 1] = P[2 * i + 1];
+        m.V[3 * i + 2] = 0.0;
+    }
+    nf = 0;
+    for (int32_t t = 0; t < nt; t++)
+        if (T[3 * t] < n && T[3 * t + 1] < n && T[3 * t + 2] < n) {
+            set_face(m.F + 3 * nf, T[3 * t], T[3 * t + 1], T[3 * t + 2]);
+            nf++;
+        }
+done:
+    free(P);
+    free(T);
+    free(E);
+    free(dead);
+    return m;
+}

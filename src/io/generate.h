@@ -35,4 +35,11 @@ mfmm_gen_mesh mfmm_gen_torus(int nu, int nv, double R, double r);
  * n x n squares: (n+1)^2 vertices. */
 mfmm_gen_mesh mfmm_gen_sine(int n);
 
+/* A Delaunay triangulation of n points (z = 0): random points in the unit
+ * square [0,1]^2 with points along its sides (disc 0), or in a disc with
+ * points on its rim r = 1 + cos(3 a) / 20 (disc 1), then x multiplied by `stretch`
+ * (needles and obtuse corners). A convex region; the same seed gives the
+ * same mesh. */
+mfmm_gen_mesh mfmm_gen_delaunay(int n, int disc, double stretch, uint64_t seed);
+
 #endif

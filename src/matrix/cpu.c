@@ -12,6 +12,7 @@
 #include "base/error.h"
 #include "cpu.h"
 #include "exact/exact.h"
+#include "exact/slots.h"
 #include "mesh/order.h"
 #include "solve/solve.h"
 #include "start/seed.h"
@@ -23,8 +24,11 @@ static int32_t cpu_block_rows(const mfmm_rows_job *job, int n_workers, int ring)
     size_t nv = (size_t)job->mesh->nv;
     size_t row_bytes = job->slot_bytes;
     size_t work = (size_t)n_workers * nv * 32; /* solver + a float64 row */
-    /* each solver's exact-start state (the tables are the mesh's, not the job's) */
-    if (mfmm_exact_start_on(job->opt->exact_start_radius))
+    /* each solver's exact-start or window state (the tables are the mesh's,
+     * not the job's) */
+    if (job->opt->method == MFMM_METHOD_WINDOWS)
+        work += (size_t)n_workers * mfmm_slots_bytes(job->mesh);
+    else if (mfmm_exact_start_on(job->opt->exact_start_radius))
         work += (size_t)n_workers * mfmm_exact_start_bytes(job->mesh);
     size_t left = job->budget > work ? job->budget - work : 0;
     /* ring 0: rows go straight into the caller's buffer */
@@ -48,6 +52,7 @@ static void fill_solve_options(const mfmm_rows_job *job, mfmm_solve_options *so)
     so->targets = job->targets;
     so->n_targets = job->targets ? job->width : 0;
     so->exact_start_radius = job->opt->exact_start_radius;
+    so->method = job->opt->method;
 }
 
 static int cmp_i32(const void *a, const void *b)
@@ -328,7 +333,8 @@ mfmm_status mfmm_rows_threads(const mfmm_rows_job *job, int32_t start, mfmm_erro
     }
     /* the exact start's tables: the mesh's, built now if not yet (exact.h) */
     const mfmm_exact_tables *tables = NULL;
-    if (mfmm_exact_start_on(job->opt->exact_start_radius) &&
+    if ((mfmm_exact_start_on(job->opt->exact_start_radius) ||
+         job->opt->method == MFMM_METHOD_WINDOWS) &&
         mfmm_exact_tables_of(job->mesh, &tables) != MFMM_OK) {
         free(p.ring);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the exact start");

@@ -83,6 +83,12 @@ static mfmm_status matrix_run(const mfmm_mesh *mesh, const int32_t *sources, int
                          "max_distance is %g; it must be >= 0 (+inf: no limit)", o->max_distance);
     if (mfmm_check_exact_start(o->exact_start_radius, err) != MFMM_OK)
         return MFMM_ERR_BAD_ARGUMENT;
+    if (mfmm_check_method((int)o->method, o->cost != NULL, err) != MFMM_OK)
+        return MFMM_ERR_BAD_ARGUMENT;
+    if (o->method == MFMM_METHOD_WINDOWS && o->backend == MFMM_BACKEND_OPENCL)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "MFMM_METHOD_WINDOWS runs on the serial and threads backends, not "
+                         "OpenCL; use threads (or auto)");
     if (o->n_threads < 0)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "n_threads is %d, must be >= 0",
                          (int)o->n_threads);
@@ -211,10 +217,11 @@ static mfmm_status matrix_run(const mfmm_mesh *mesh, const int32_t *sources, int
     default: { /* auto: OpenCL when it keeps every compute unit busy, else
                 * threads from the first row not delivered, saying why */
         int32_t done = 0;
-        if (job.sparse) {
+        if (job.sparse || o->method == MFMM_METHOD_WINDOWS) {
             info->backend_used = MFMM_BACKEND_THREADS;
-            snprintf(info->backend_reason, sizeof info->backend_reason,
-                     "the OpenCL backend computes dense rows only, not sparse rows");
+            snprintf(info->backend_reason, sizeof info->backend_reason, "%s",
+                     job.sparse ? "the OpenCL backend computes dense rows only, not sparse rows"
+                                : "the OpenCL backend has no window method");
             st = mfmm_rows_threads(&job, 0, err);
             break;
         }

@@ -34,4 +34,5 @@ void mfmm_matrix_options_init(mfmm_matrix_options *options)
     options->user = NULL;
     options->opencl = NULL;
     options->exact_start_radius = MFMM_EXACT_START_AUTO;
+    options->method = MFMM_METHOD_FMM;
 }

@@ -45,6 +45,9 @@ mfmm_status mfmm_farthest_points(mfmm_solver *solver, int32_t start, int32_t k,
     st = mfmm_check_exact_start(opt.exact_start_radius, err);
     if (st != MFMM_OK)
         return st;
+    st = mfmm_check_method((int)opt.method, opt.cost != NULL, err);
+    if (st != MFMM_OK)
+        return st;
     if (start < 0 || start >= nv)
         return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, start,
                          "start vertex %ld is outside [0, %ld)", (long)start, (long)nv);
@@ -88,7 +91,7 @@ mfmm_status mfmm_farthest_points(mfmm_solver *solver, int32_t start, int32_t k,
         int32_t n_touched;
         if (mfmm_solve_local(solver, &src, 1, &opt, &T, &touched, &n_touched) < 0) {
             st = mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1,
-                           "out of memory for the exact start's workspace");
+                           "out of memory for the solver's workspace");
             break;
         }
         for (int32_t j = 0; j < n_touched; j++) {

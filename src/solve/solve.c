@@ -9,6 +9,7 @@
 #include "mesh/check.h"
 #include "mesh/mesh.h"
 #include "mesh/order.h"
+#include "exact/slots.h"
 #include "mesh/spokes.h"
 #include "start/straight.h"
 #include "start/seed.h"
@@ -28,6 +29,7 @@ struct mfmm_solver {
     const double *fixed_cost;
     int fixed_location;
     mfmm_exact_ws *exact; /* the exact start's workspace, made on first use */
+    mfmm_slots *windows;  /* MFMM_METHOD_WINDOWS's workspace, made on first use */
     int64_t start_fallbacks; /* the last solve's (mfmm_solve_info) */
     mfmm_mapped_args args; /* mfmm_solve's arguments in internal order (order.h) */
     /* the mesh's spokes (mfmm_mesh_spokes_of), asked for by the first march
@@ -81,6 +83,7 @@ void mfmm_solver_destroy(mfmm_solver *solver)
     free(solver->T);
     free(solver->touched);
     mfmm_exact_ws_destroy(solver->exact);
+    mfmm_slots_destroy(solver->windows);
     free(solver->args.block);
     free(solver);
 }
@@ -98,6 +101,20 @@ void mfmm_solve_options_init(mfmm_solve_options *options)
     options->n_targets = 0;
     options->unfolding = 1;
     options->exact_start_radius = MFMM_EXACT_START_AUTO;
+    options->method = MFMM_METHOD_FMM;
+}
+
+mfmm_status mfmm_check_method(int method, int has_cost, mfmm_error *err)
+{
+    if (method != MFMM_METHOD_FMM && method != MFMM_METHOD_WINDOWS)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "method is %d; it must be MFMM_METHOD_FMM (0) or MFMM_METHOD_WINDOWS (1)",
+                         method);
+    if (method == MFMM_METHOD_WINDOWS && has_cost)
+        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
+                         "MFMM_METHOD_WINDOWS computes geodesic distance without a cost; use "
+                         "MFMM_METHOD_FMM for a cost");
+    return MFMM_OK;
 }
 
 mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources, int32_t n_sources,
@@ -136,6 +153,9 @@ mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources, int32_t 
             return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, i, "target %ld: vertex %ld is outside [0, %ld)",
                              (long)i, (long)opt.targets[i], (long)mesh->nv);
     st = mfmm_check_exact_start(opt.exact_start_radius, err);
+    if (st != MFMM_OK)
+        return st;
+    st = mfmm_check_method((int)opt.method, opt.cost != NULL, err);
     if (st != MFMM_OK)
         return st;
     for (int32_t i = 0; i < n_sources; i++) {
@@ -222,6 +242,13 @@ static int32_t solver_march(mfmm_solver *solver, const mfmm_source *sources, int
         opt.cost_location = MFMM_COST_NONE;
     solver_reset_pending(solver);
     solver->start_fallbacks = 0;
+    if (opt.method == MFMM_METHOD_WINDOWS) {
+        if (!solver->windows && mfmm_slots_create(mesh, &solver->windows) != MFMM_OK)
+            return -1;
+        solver->n_pending = mfmm_slots_run(solver->windows, sources, n_sources, opt.max_distance,
+                                           opt.targets, opt.n_targets, T, solver->touched);
+        return solver->n_pending;
+    }
     mfmm_march_state s;
     memset(&s, 0, sizeof s);
     s.T = T;
@@ -324,7 +351,7 @@ mfmm_status mfmm_solve_mapped(mfmm_solver *solver, const mfmm_source *sources, i
     int32_t n_touched;
     if (mfmm_solve_local(solver, a->sources, n_sources, &opt, &T, &touched, &n_touched) < 0)
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1,
-                         "out of memory for the exact start's workspace");
+                         "out of memory for the solver's workspace");
     /* the one pass over the row: gathered into input order */
     mfmm_order_values_out(mesh, T, distances);
     return MFMM_OK;

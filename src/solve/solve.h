@@ -23,6 +23,10 @@ int32_t mfmm_solve_local(mfmm_solver *solver, const mfmm_source *sources, int32_
                          const mfmm_solve_options *options, const double **T,
                          const int32_t **touched, int32_t *n_touched);
 
+/* MFMM_ERR_BAD_ARGUMENT (with err's message) unless `method` is an
+ * mfmm_method that can take the cost given (has_cost). */
+mfmm_status mfmm_check_method(int method, int has_cost, mfmm_error *err);
+
 /* The mesh a solver was made for. */
 const mfmm_mesh *mfmm_solver_mesh(const mfmm_solver *solver);
 

@@ -252,6 +252,13 @@ static void test_smaller_option_structs(void **state)
     assert_int_equal(mfmm_solve(solver, &s, 1, so_old, d, &err), MFMM_OK);
     assert_memory_equal(d, ref, (size_t)nv * sizeof *d);
     free(so_old);
+    /* without method: the march, whatever the newer field would say */
+    mfmm_solve_options_init(&so);
+    so.method = MFMM_METHOD_WINDOWS;
+    so_old = older(&so, offsetof(mfmm_solve_options, method));
+    assert_int_equal(mfmm_solve(solver, &s, 1, so_old, d, &err), MFMM_OK);
+    assert_memory_equal(d, ref, (size_t)nv * sizeof *d);
+    free(so_old);
     so_old = older(&so, sizeof(size_t)); /* struct_size alone: every default */
     assert_int_equal(mfmm_solve(solver, &s, 1, so_old, d, &err), MFMM_OK);
     assert_memory_equal(d, ref, (size_t)nv * sizeof *d);
@@ -292,7 +299,7 @@ static void test_smaller_option_structs(void **state)
     free(eo_old);
     mfmm_exact_solver_destroy(ex);
 
-    /* matrix options without opencl and opencl_options */
+    /* matrix options without opencl and opencl_options, then without method */
     int32_t src[2] = {0, 33};
     double *rows = malloc(2 * (size_t)nv * sizeof *rows);
     double *rref = malloc(2 * (size_t)nv * sizeof *rref);
@@ -309,6 +316,12 @@ static void test_smaller_option_structs(void **state)
     assert_int_equal(info.backend_used, MFMM_BACKEND_SERIAL);
     assert_memory_equal(rows, rref, 2 * (size_t)nv * sizeof *rows);
     free(o_old);
+    o.method = MFMM_METHOD_WINDOWS; /* not in the older struct: the march */
+    o_old = older(&o, offsetof(mfmm_matrix_options, method));
+    assert_int_equal(mfmm_distance_matrix(mesh, src, 2, o_old, &info, &err), MFMM_OK);
+    assert_memory_equal(rows, rref, 2 * (size_t)nv * sizeof *rows);
+    free(o_old);
+    o.method = MFMM_METHOD_FMM;
     o.struct_size = sizeof o + 8;
     assert_int_equal(mfmm_distance_matrix(mesh, src, 2, &o, &info, &err), MFMM_ERR_BAD_ARGUMENT);
     assert_non_null(strstr(err.message, "mfmm_matrix_options.struct_size"));

@@ -277,6 +277,24 @@ expect 0 "distance -o a 250-character name" "$BIN" distance "$T/g.obj" --source 
     { cmp -s "$T/$long" "$T/d.txt" && ! ls "$T" | grep -q '^lll.*\.......$' && ok "long name: complete, no temporary" ||
       fail "long name: $(ls "$T" | grep '^lll')"; }
 
+# ---- --method windows: the flat grid's Euclidean distances; its usage errors ----
+if expect 0 "distance --method windows" "$BIN" distance "$T/g.obj" --source "$C" --method windows -o "$T/w.txt"; then
+    paste -d ' ' "$T/v.txt" "$T/w.txt" | awk '
+        function abs(a) { return a < 0 ? -a : a }
+        { n++; e = abs($5 - sqrt($2 * $2 + $3 * $3)); if (e > m) m = e }
+        END { printf "%d %.3g\n", n, m; exit !(n == '"$NV"' && m <= 1e-12) }' >"$T/chk" &&
+        ok "windows on the grid is Euclidean: $(cat "$T/chk")" || fail "windows on the grid: $(cat "$T/chk")"
+fi
+expect 0 "landmarks --method windows" "$BIN" landmarks "$T/g.obj" -k 3 --method windows -o "$T/lw.txt"
+expect 0 "allpairs --method windows" "$BIN" allpairs "$T/g.obj" --method windows --quiet -o "$T/aw.npy"
+expect 2 "distance --exact with --method" "$BIN" distance "$T/g.obj" --source "$C" --exact --method windows -o "$T/x.txt" &&
+    { grep -q -- "--exact and --method are two methods" "$T/err" && ok "--exact --method message" || fail "message: $(cat "$T/err")"; }
+expect 2 "distance --method windows with --cost" "$BIN" distance "$T/g.obj" --source "$C" --method windows --cost "$T/cost.txt" -o "$T/x.txt" &&
+    { grep -q -- "it takes no --cost" "$T/err" && ok "--method windows --cost message" || fail "message: $(cat "$T/err")"; }
+expect 2 "allpairs --method windows --backend opencl" "$BIN" allpairs "$T/g.obj" --method windows --backend opencl -o "$T/x.npy"
+expect 2 "voronoi --method exact" "$BIN" voronoi "$T/g.obj" --source "$C" --method exact -o "$T/x.txt"
+[ ! -e "$T/x.txt" ] && [ ! -e "$T/x.npy" ] && ok "refused --method runs write nothing" || fail "a refused run wrote"
+
 # ---- options that conflict are refused, not resolved by the last one ----
 expect 2 "--plain-start with --exact-start-radius" "$BIN" distance "$T/g.obj" --source "$C" --plain-start --exact-start-radius 3 -o "$T/x.txt"
 expect 2 "allpairs --exact-start-radius with --plain-start" "$BIN" allpairs "$T/g.obj" --exact-start-radius 3 --plain-start -o "$T/x.npy"

@@ -12,7 +12,7 @@
  * Input layout (all optional past the end: zeros):
  *   byte 0: nv - 3 (3..66)      byte 1: nf - 1 (1..128)
  *   byte 2: flags: 1 cost, 2 per-face cost, 4 max_distance, 8 no unfolding,
- *           16 face source, 32 no straighten
+ *           16 face source, 32 no straighten, 64 MFMM_METHOD_WINDOWS
  *   byte 3: number of vertex sources - 1 (1..4)
  *   then nv * 3 int8 coordinates / 8, nf * 3 vertex bytes (mod nv),
  *   sources, cost bytes ((1 + b) / 16), a max_distance byte, a target,
@@ -192,6 +192,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (flags & 4)
         so.max_distance = next(&r) / 16.0;
     so.unfolding = (flags & 8) ? 0 : 1;
+#ifndef FUZZ_OPENCL
+    if (flags & 64) /* the window method (refused with a cost, and on OpenCL) */
+        so.method = MFMM_METHOD_WINDOWS;
+#endif
     int32_t target = next(&r) % nv;
     double level = next(&r) / 16.0;
 
@@ -246,6 +250,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     mo.cost_location = so.cost_location;
     mo.max_distance = so.max_distance;
     mo.unfolding = so.unfolding;
+    mo.method = so.method;
     mo.out = rows;
 #ifdef FUZZ_OPENCL
     int unavailable = 0;

@@ -477,6 +477,72 @@ def test_exact_start_is_passed_through_and_part_of_the_job(hand, client, tmp_pat
                            progress=False, exact_start=-1.0)
 
 
+def test_method_is_passed_through_and_part_of_the_job(hand, client, tmp_path):
+    """method="windows" reaches the tasks (the rows equal the serial
+    windows rows), and the job records it, so that a store of one method is
+    not resumed with the other (never a mix of rows); the march's jobs
+    record None, as stores written before the option."""
+    src = SOURCES[:20]
+    want = hand.distance_matrix(src, backend="serial", dtype="float64", method="windows")
+    store = str(tmp_path / "windows.zarr")
+    Z = md.distance_matrix(hand, store, sources=src, client=client, dtype="float64",
+                           block_rows=8, progress=False, method="windows")
+    assert np.array_equal(Z[:], want)
+    assert Z.attrs[md.JOB_ATTR]["method"] == "windows"
+    with pytest.raises(md.StoreError, match="differs in: method"):
+        md.distance_matrix(hand, store, sources=src, client=client, dtype="float64",
+                           progress=False)
+    Z = md.distance_matrix(hand, store, sources=src, client=client, dtype="float64",
+                           progress=False, method="windows")  # the same job: resumed
+    assert Z.attrs[md.RUN_ATTR]["blocks_computed"] == 0
+    march = str(tmp_path / "march.zarr")
+    Z = md.distance_matrix(hand, march, sources=src, client=client, dtype="float64",
+                           block_rows=8, progress=False)
+    assert Z.attrs[md.JOB_ATTR]["method"] is None
+    with pytest.raises(md.StoreError, match="differs in: method"):
+        md.distance_matrix(hand, march, sources=src, client=client, dtype="float64",
+                           progress=False, method="windows")
+    # a store that records no method is the march's: its blocks still verify
+    job = md.job_description(hand, src, None, "float64", None, None, None, True)
+    old = {k: v for k, v in job.items() if k != "method"}
+    assert zs.same_job(old, job) == [] and zs.job_key(old) == zs.job_key(job)
+    # refused before the store is touched
+    bad = str(tmp_path / "bad.zarr")
+    with pytest.raises(ValueError, match="takes no cost"):
+        md.distance_matrix(hand, bad, sources=src, client=client, progress=False,
+                           method="windows", cost=np.ones(hand.n_vertices))
+    with pytest.raises(ValueError, match="not opencl"):
+        md.distance_matrix(hand, bad, sources=src, client=client, progress=False,
+                           method="windows", backend="opencl")
+    with pytest.raises(ValueError, match="not a method of"):
+        md.distance_matrix(hand, bad, sources=src, client=client, progress=False,
+                           method="exact")
+    assert not os.path.exists(bad)
+
+
+def test_command_line_method(hand, client, tmp_path, capsys):
+    """--method windows on the Zarr command line: the windows rows; a
+    resume with the other method is refused with one line and status 2."""
+    src = tmp_path / "src.txt"
+    src.write_text("0 5 9\n")
+    store = str(tmp_path / "w.zarr")
+    args = [str(MESHES / "hand_lowres.obj"), "-o", store, "--scheduler",
+            client.scheduler.address, "--sources", str(src), "--dtype", "float64",
+            "--no-progress"]
+    assert cli_allpairs_zarr(args + ["--method", "windows"]) == 0
+    assert np.array_equal(zarr.open_array(store, mode="r")[:],
+                          hand.distance_matrix([0, 5, 9], backend="serial", dtype="float64",
+                                               method="windows"))
+    capsys.readouterr()
+    assert cli_allpairs_zarr(args + ["--resume"]) == 2
+    err = capsys.readouterr().err
+    assert "differs in: method" in err and len(err.strip().splitlines()) == 1
+    cost = tmp_path / "cost.txt"
+    cost.write_text("1\n" * hand.n_vertices)
+    assert cli_allpairs_zarr(args + ["--method", "windows", "--cost", str(cost)]) == 2
+    assert "takes no cost" in capsys.readouterr().err
+
+
 def test_mesh_options_reach_the_workers_and_the_job(hand, client, tmp_path):
     """The workers build the caller's mesh, options included: one unfolding
     step changes the rows of hand_lowres (an obtuse corner keeps its plain

@@ -418,7 +418,7 @@ def test_every_cli_help_lists_every_option():
             names.discard("source")  # a trap for --source, not an option (--sources is)
         if "CLI_SHARED_LONG_OPTIONS" in table:
             names |= {"help", "output", "source", "face-source", "cost", "cost-per-face",
-                      "plain-start", "exact-start-radius", "weld"}
+                      "plain-start", "exact-start-radius", "weld", "method"}
         helptext = subprocess.run([cli, sub, "--help"], capture_output=True, text=True).stdout
         missing = [n for n in names if not re.search(rf"--{n}\b", helptext)]
         assert not missing, f"meshfmm {sub} --help lacks {missing}"

@@ -105,7 +105,7 @@ def _allpairs_help() -> int:
     except ImportError as e:
         text = (f"  (its options cannot be listed: {e}); --scheduler, --workers, --resume,\n"
                 "  --overwrite, --dtype, --sources, --targets, --max-distance, --cost,\n"
-                "  --backend, --exact-start-radius, --plain-start, --block-rows,\n"
+                "  --backend, --method, --exact-start-radius, --plain-start, --block-rows,\n"
                 "  --compression, --no-progress, --no-spokes\n")
     sys.stdout.write(text)
     return 0

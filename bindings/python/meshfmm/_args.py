@@ -313,6 +313,30 @@ def matrix_dtype(dtype: Any) -> Tuple[np.dtype, int]:
     raise ValueError(f"dtype must be float32 or float64, got {dt}")
 
 
+def method(name: Any, exact: bool = True) -> int:
+    """A method name -> the C mfmm_method ("fmm", "windows"); "exact" (where
+    the caller takes it: exact=True) -> -1."""
+    names = ["fmm", "windows"] + (["exact"] if exact else [])
+    if not isinstance(name, str) or name not in names:
+        raise ValueError(f"method must be one of {names}, not {name!r}")
+    return -1 if name == "exact" else _lib.METHODS[name]
+
+
+def solve_method(name: Any, cost: Any, what: str) -> int:
+    """The C mfmm_method of a call that solves by mfmm_solve or its rows
+    (`what` names it in messages): "fmm" or "windows"; "exact" (its own
+    solver, mfmm_solve_exact) and "windows" with a cost are refused."""
+    if name == "exact":
+        raise ValueError(f"method='exact' is not a method of {what}: it takes 'fmm' or "
+                         "'windows' (exact distances: Mesh.distance(method='exact'), one "
+                         "solve per source)")
+    m = method(name, exact=False)
+    if m == _lib.MFMM_METHOD_WINDOWS and cost is not None:
+        raise ValueError("method='windows' computes geodesic distance: it takes no cost "
+                         "(use method='fmm')")
+    return m
+
+
 def backend(name: Any) -> int:
     """A backend name ("auto", "serial", "threads", "opencl"; any case) -> the
     C mfmm_backend."""

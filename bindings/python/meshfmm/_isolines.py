@@ -187,8 +187,9 @@ def cli_isolines(argv: Any) -> int:
     ap.add_argument("--field", metavar="FILE",
                     help="a per-vertex field instead of a solve: .npy or .txt, one value per "
                          "vertex (as meshfmm distance writes); no sources then")
-    ap.add_argument("--method", choices=["fmm", "exact"], default="fmm",
-                    help="distance method (default: fmm)")
+    ap.add_argument("--method", choices=["fmm", "windows", "exact"], default="fmm",
+                    help="distance method: fmm (default), windows (more accurate, never "
+                         "below the geodesic distance) or exact (Mesh.distance's method)")
     ap.add_argument("--max-distance", type=float, metavar="X",
                     help="stop the solve past X; farther vertices are unreached")
     ap.add_argument("--cost", metavar="FILE",

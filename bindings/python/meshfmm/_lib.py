@@ -108,6 +108,11 @@ MFMM_BACKEND_THREADS = 2
 MFMM_BACKEND_OPENCL = 3
 BACKENDS = {"auto": 0, "serial": 1, "threads": 2, "opencl": 3}
 
+# mfmm_method (the C solve's methods; "exact" is mfmm_solve_exact, apart)
+MFMM_METHOD_FMM = 0
+MFMM_METHOD_WINDOWS = 1
+METHODS = {"fmm": MFMM_METHOD_FMM, "windows": MFMM_METHOD_WINDOWS}
+
 # enum mfmm_dtype
 MFMM_FLOAT32 = 0
 MFMM_FLOAT64 = 1
@@ -192,6 +197,7 @@ class mfmm_solve_options(_Sized):
         ("n_targets", c_int32),
         ("unfolding", c_int32),
         ("exact_start_radius", c_double),  # the exact start, in mean edge lengths
+        ("method", c_enum),  # mfmm_method
     ]
 
 
@@ -287,6 +293,7 @@ class mfmm_matrix_options(_Sized):
         ("user", c_void_p),
         ("opencl", c_void_p),  # mfmm_opencl_context *
         ("opencl_options", c_void_p),  # const mfmm_opencl_options *
+        ("method", c_enum),  # mfmm_method
     ]
 
 

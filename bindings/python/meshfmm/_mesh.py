@@ -489,11 +489,16 @@ class Mesh:
         cost_location : {"vertex", "face"}, optional
             Where ``cost`` lives; needed only when the mesh has as many
             vertices as faces.
-        method : {"fmm", "exact"}
-            "fmm" (default): the Fast Marching Method. "exact": exact
-            polyhedral geodesic distances by window propagation
-            (``mfmm_solve_exact``), without cost, targets, unfolding or
-            exact_start options.
+        method : {"fmm", "windows", "exact"}
+            "fmm" (default): the Fast Marching Method from the exact start.
+            "windows": window propagation keeping two windows per
+            half-edge (``MFMM_METHOD_WINDOWS``; the documentation's page
+            "The windows method"): more accurate than "fmm", never below
+            the geodesic distance, exact where the surface unfolds flat, at
+            several times its time; no cost (unfolding and exact_start do
+            not apply). "exact": exact polyhedral geodesic
+            distances by window propagation (``mfmm_solve_exact``), without
+            cost, targets, unfolding or exact_start options.
         exact_start : bool, "auto" or float
             True or "auto" (default): the march starts from the exact
             distances of the vertices within 7 mean edge lengths of each
@@ -569,8 +574,10 @@ class Mesh:
                 raise ValueError("method='exact' computes geodesic distance: it takes no cost, "
                                  "targets, unfolding or exact_start")
             return self._distance_exact(sources, max_distance, bar)
-        if method != "fmm":
-            raise ValueError(f"method must be 'fmm' or 'exact', not {method!r}")
+        windows = _args.method(method) == _lib.MFMM_METHOD_WINDOWS
+        if windows and cost is not None:
+            raise ValueError("method='windows' computes geodesic distance: it takes no cost "
+                             "(use method='fmm')")
         if _args.is_int(sources):  # the common case, kept cheap (bench/suite/bench_python.py)
             one = _lib.mfmm_source(_args.index(sources, "source"), -1)
             src_addr, n_src = ctypes.addressof(one), 1
@@ -580,7 +587,7 @@ class Mesh:
         opts = None
         radius = _args.exact_start_radius(exact_start)
         if (cost is not None or max_distance is not None or targets is not None
-                or not unfolding or cost_location is not None or radius is not None):
+                or not unfolding or cost_location is not None or radius is not None or windows):
             opts = _lib.mfmm_solve_options.from_buffer_copy(self._opts_template)
             c, loc = _args.cost_array(cost, cost_location, self._nv, self._nf)
             if c is not None:
@@ -598,6 +605,8 @@ class Mesh:
                 opts.unfolding = 0
             if radius is not None:
                 opts.exact_start_radius = radius
+            if windows:
+                opts.method = _lib.MFMM_METHOD_WINDOWS
             opts = byref(opts)
         out = np.empty(self._nv, dtype=np.float64)
         err = _lib.mfmm_error()
@@ -790,8 +799,9 @@ class Mesh:
         ----------
         source, target : int or SurfacePoint
             Vertex ids or points inside faces.
-        method : {"fmm", "exact"}
-            The distances the path descends (:meth:`distance`).
+        method : {"fmm", "windows", "exact"}
+            The distances the path descends (:meth:`distance`; "windows"
+            and "exact" take no cost).
         cost, cost_location, exact_start
             As in :meth:`distance`.
         max_points, straighten
@@ -827,6 +837,7 @@ class Mesh:
         cost_location: Optional[str] = None,
         unfolding: bool = True,
         exact_start: Any = True,
+        method: str = "fmm",
         return_radii: bool = False,
         return_distances: bool = False,
     ) -> Any:
@@ -850,6 +861,11 @@ class Mesh:
             The first point, a vertex in a face.
         cost, cost_location, unfolding, exact_start
             As in :meth:`distance`.
+        method : {"fmm", "windows"}
+            The solve of each point (:meth:`distance`): "fmm" (default) or
+            "windows" (no cost; unfolding and exact_start do not apply).
+            The points equal those of a loop of ``distance(...,
+            method=method)`` solves. "exact" is not offered here.
         return_radii : bool
             Also return float64 (k,): each point's distance to the points
             before it when chosen (+inf for the first): the covering radius
@@ -869,8 +885,10 @@ class Mesh:
         Raises
         ------
         ValueError
-            k out of range, a start out of range or in no face, a bad cost.
+            k out of range, a start out of range or in no face, a bad cost,
+            a method other than "fmm" or "windows", a cost with "windows".
         """
+        m = _args.solve_method(method, cost, "farthest_point_sampling")
         k = _args.index(k, "k")
         start = _args.index(start, "start")
         if not (0 <= start < self.n_vertices):
@@ -890,6 +908,7 @@ class Mesh:
         radius = _args.exact_start_radius(exact_start)
         if radius is not None:
             opts.exact_start_radius = radius
+        opts.method = m
         if k < 1:
             raise ValueError(f"k must be >= 1, got {k}")
         points = np.empty(k, dtype=np.int32)
@@ -941,7 +960,8 @@ class Mesh:
             The distances from these sources (:meth:`distance` with the same
             sources); None solves them.
         **kwargs
-            :meth:`distance`'s options for that solve (cost, method, ...).
+            :meth:`distance`'s options for that solve (cost, method: "fmm",
+            "windows" or "exact", ...).
 
         Returns
         -------
@@ -1036,6 +1056,7 @@ class Mesh:
         cost_location: Optional[str] = None,
         unfolding: bool = True,
         exact_start: Any = True,
+        method: str = "fmm",
         n_threads: int = 0,
         memory_limit: int = 0,
         progress: Any = None,
@@ -1068,6 +1089,15 @@ class Mesh:
         max_distance, cost, cost_location, unfolding, exact_start
             As in :meth:`distance`. Every backend starts each row alike;
             OpenCL rows equal the serial rows bit for bit.
+        method : {"fmm", "windows"}
+            As in :meth:`distance`: "fmm" (default) on every backend;
+            "windows" (no cost) on "serial" and "threads" ("auto" runs
+            threads and says why in :class:`MatrixInfo`; "opencl" refuses
+            it with a ValueError). Rows equal ``distance(source,
+            method=method)`` bit for bit in float64, with targets,
+            max_distance and sparse rows alike. "exact" is not a matrix
+            method (a ValueError): solve each row with
+            ``distance(method="exact")``.
         n_threads : int
             Threads of the threads backend; 0 for all cores.
         memory_limit : int
@@ -1129,6 +1159,7 @@ class Mesh:
             The dense result would not fit the memory available
             (``size_check``).
         """
+        _args.solve_method(method, cost, "distance_matrix")
         pts = None
         if targets is not None and _has_surface_point(targets):
             pts = Points.parse(targets, "target", self.n_vertices, self.n_faces)
@@ -1142,8 +1173,8 @@ class Mesh:
             cost, cost_location = w.cost(cost, cost_location)
         progress, bar = _guards.progress_callback(progress, "distance matrix")
         kw = dict(max_distance=max_distance, cost=cost, cost_location=cost_location,
-                  unfolding=unfolding, exact_start=exact_start, n_threads=n_threads,
-                  memory_limit=memory_limit, progress=progress,
+                  unfolding=unfolding, exact_start=exact_start, method=method,
+                  n_threads=n_threads, memory_limit=memory_limit, progress=progress,
                   size_check=_args.flag(size_check, "size_check"))
         info = None
         try:
@@ -1211,7 +1242,7 @@ class Mesh:
             Most rows per block, >= 1.
         **kwargs
             :meth:`distance_matrix`'s keyword options (backend, dtype,
-            targets, max_distance, cost, ...) except ``sparse``,
+            targets, max_distance, cost, method, ...) except ``sparse``,
             ``symmetric`` and ``out``. ``progress`` is called as
             ``progress(rows_done, S)`` over the whole job;
             ``return_info=True`` adds each block's :class:`MatrixInfo`.

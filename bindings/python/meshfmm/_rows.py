@@ -65,13 +65,14 @@ class Request:
 
 def options(mesh: "Mesh", req: Request, out: np.ndarray, *, sparse: bool, cost: Any,
             cost_location: Optional[str], max_distance: Any, unfolding: bool,
-            exact_start: Any, n_threads: Any,
-            memory_limit: Any) -> Tuple[_lib.mfmm_matrix_options, List[Any]]:
+            exact_start: Any, n_threads: Any, memory_limit: Any,
+            method: Any = "fmm") -> Tuple[_lib.mfmm_matrix_options, List[Any]]:
     """The call's mfmm_matrix_options, and the arrays they point into (keep
     them alive until the call returns). `out` is the dense output, or an
     empty array for sparse output."""
     opts = _lib.mfmm_matrix_options()
     _lib.mfmm_matrix_options_init(byref(opts))
+    opts.method = _args.solve_method(method, cost, "distance_matrix")
     opts.backend = req.backend
     opts.dtype = req.c_dtype
     c, loc = _args.cost_array(cost, cost_location, mesh._nv, mesh._nf)
@@ -98,8 +99,10 @@ def options(mesh: "Mesh", req: Request, out: np.ndarray, *, sparse: bool, cost: 
         opts.targets = _args.addr(req.tgt)
         opts.n_targets = req.tgt.shape[0]
     auto = _lib.BACKENDS["auto"]
-    if req.backend == auto and sparse:
-        pass  # the library runs threads (OpenCL does dense rows only)
+    if req.backend == auto and (sparse or opts.method == _lib.MFMM_METHOD_WINDOWS):
+        pass  # the library runs threads (OpenCL does dense rows of the march only)
+    elif opts.method == _lib.MFMM_METHOD_WINDOWS:
+        pass  # backend "opencl": the library refuses the windows method before any device
     elif req.backend in (auto, _lib.BACKENDS["opencl"]):
         opts.opencl = shared_opencl_context()
     return opts, [c, req.src, req.tgt, out]

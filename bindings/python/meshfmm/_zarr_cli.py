@@ -77,6 +77,11 @@ def zarr_parser() -> argparse.ArgumentParser:
     ap.add_argument("--cost", help="per-vertex or per-face cost (.npy or .txt)", action=_Once)
     ap.add_argument("--backend", choices=["threads", "serial", "opencl", "auto"], default="threads",
                     action=_Once)
+    ap.add_argument("--method", choices=["fmm", "windows"], default="fmm", action=_Once,
+                    help="fmm (default): the march; windows: window propagation, more "
+                         "accurate, never below the geodesic distance, several times the "
+                         "time (no --cost, not --backend opencl); part of the job, so "
+                         "--resume refuses a store of the other method")
     st = ap.add_mutually_exclusive_group()
     st.add_argument("--exact-start-radius", type=float, metavar="R", action=_Once,
                     help="radius of the exact start in mean edge lengths (default: the library's)")
@@ -92,6 +97,7 @@ def zarr_parser() -> argparse.ArgumentParser:
 
 
 def _run(a: argparse.Namespace) -> int:
+    client = None
     try:
         _store.refuse_inputs(a.output, [a.mesh, a.sources, a.targets, a.cost])
         mesh = Mesh(*load_mesh(a.mesh), spokes=not a.no_spokes)
@@ -100,7 +106,6 @@ def _run(a: argparse.Namespace) -> int:
         cost = None
         if a.cost:
             cost = np.load(a.cost) if a.cost.endswith(".npy") else np.loadtxt(a.cost, ndmin=1)
-        client = None
         if a.scheduler:
             from distributed import Client
 
@@ -110,7 +115,8 @@ def _run(a: argparse.Namespace) -> int:
                 print(f"meshfmm: Dask dashboard at {link}", file=sys.stderr)
         Z = _job.distance_matrix(mesh, a.output, sources=src, targets=tgt, client=client,
                             dtype=a.dtype, resume=a.resume, block_rows=a.block_rows,
-                            backend=a.backend, max_distance=a.max_distance, cost=cost,
+                            backend=a.backend, method=a.method,
+                            max_distance=a.max_distance, cost=cost,
                             n_workers=a.workers, progress=not a.no_progress,
                             exact_start=(False if a.plain_start else
                                          True if a.exact_start_radius is None
@@ -120,8 +126,6 @@ def _run(a: argparse.Namespace) -> int:
         print(f"meshfmm: wrote {Z.shape[0]} x {Z.shape[1]} {Z.dtype} to {a.output} "
               f"({run.get('blocks_computed')} blocks computed, {run.get('blocks_skipped')} "
               "already complete)", file=sys.stderr)
-        if client is not None:
-            client.close()
         return 0
     except KeyboardInterrupt:
         print("meshfmm: interrupted; complete blocks are kept (run again with --resume)",
@@ -130,6 +134,11 @@ def _run(a: argparse.Namespace) -> int:
     except (ValueError, TypeError, OSError, StoreOwnerError) as e:
         print(f"meshfmm: {e}", file=sys.stderr)
         return 2
+    finally:
+        # on failure too: a client left open keeps reconnecting to its
+        # scheduler after the command returned
+        if client is not None:
+            client.close()
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -87,7 +87,7 @@ def compute_block(key: str, V: np.ndarray, F: np.ndarray, url: str,
     kw = dict(backend=opts["backend"], dtype=opts["dtype"],
               n_threads=_task_threads(opts["n_threads"], opts.get("host_threads") or {}),
               max_distance=opts["max_distance"], unfolding=opts["unfolding"],
-              exact_start=opts.get("exact_start", True))
+              exact_start=opts.get("exact_start", True), method=opts.get("method", "fmm"))
     if opts["cost"] is not None:
         kw.update(cost=opts["cost"], cost_location=opts["cost_location"])
     # the library's target columns: each row stops once its targets settle

@@ -119,7 +119,8 @@ def _sha256(*arrays: Optional[np.ndarray]) -> Optional[str]:
 def job_description(mesh: Mesh, sources: Optional[np.ndarray], targets: Optional[np.ndarray],
                     dtype: str, max_distance: Optional[float], cost: Optional[np.ndarray],
                     cost_location: Optional[str], unfolding: bool,
-                    exact_start_radius: Union[None, float, str] = None) -> Dict[str, Any]:
+                    exact_start_radius: Union[None, float, str] = None,
+                    method: str = "fmm") -> Dict[str, Any]:
     """What identifies a job, as stored in the array's attributes.
 
     Hashes of the mesh, sources, targets and cost, and the options that
@@ -145,6 +146,10 @@ def job_description(mesh: Mesh, sources: Optional[np.ndarray], targets: Optional
     exact_start_radius : float, "auto" or None
         The exact start's radius in mean edge lengths (0: the plain start;
         None or "auto": the library's default, recorded as "auto").
+    method : {"fmm", "windows"}
+        The rows' method, recorded as None for "fmm" (so a job of the
+        march matches stores that do not record it) and as "windows" else:
+        a store of one method is a different job for the other.
 
     Returns
     -------
@@ -153,7 +158,7 @@ def job_description(mesh: Mesh, sources: Optional[np.ndarray], targets: Optional
         ``n_vertices``, ``n_faces``, ``sources_sha256``, ``n_sources``,
         ``targets_sha256``, ``n_targets``, ``dtype``, ``max_distance``,
         ``cost_sha256``, ``cost_location``, ``unfolding``,
-        ``exact_start_radius``, ``max_unfold_steps``.
+        ``exact_start_radius``, ``max_unfold_steps``, ``method``.
     """
     V = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
     F = np.ascontiguousarray(mesh.faces, dtype=np.int32)
@@ -175,6 +180,9 @@ def job_description(mesh: Mesh, sources: Optional[np.ndarray], targets: Optional
         # as given (None: the default, 64), so a job that leaves it unset
         # matches stores that do not record it
         "max_unfold_steps": mesh.options["max_unfold_steps"],
+        # None for the march (the default), so that its jobs match stores
+        # that do not record a method
+        "method": None if method == "fmm" else method,
     }
 
 
@@ -280,7 +288,7 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                     n_threads: int = 0, max_distance: Optional[float] = None,
                     cost: Any = None, cost_location: Optional[str] = None,
                     unfolding: bool = True, exact_start: Any = True,
-                    n_workers: Optional[int] = None,
+                    method: str = "fmm", n_workers: Optional[int] = None,
                     storage_options: Optional[dict] = None, compression: str = "lz4",
                     progress: Any = True, retries: int = 3, overwrite: bool = False) -> Any:
     """A dense S x N (or S x T) distance matrix computed as Dask tasks
@@ -332,6 +340,11 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
     max_distance, cost, cost_location, unfolding, exact_start
         As in ``Mesh.distance``; the job records the exact start's radius,
         so a store computed with another one is a different job.
+    method : {"fmm", "windows"}
+        The rows' method, as in ``Mesh.distance_matrix`` ("windows": no
+        cost, and not on the "opencl" backend; under "auto" the workers run
+        threads). The job records it: resuming a store with the other
+        method is refused (:class:`StoreError`), never a mix of rows.
     n_workers : int, optional
         Processes of the LocalCluster started when `client` is None.
     storage_options : dict, optional
@@ -395,11 +408,15 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
     if cost is not None:
         cost_arr, _ = _args.cost_array(cost, cost_location, nv, mesh.n_faces)
     radius = _start_radius(_args.exact_start_radius(exact_start))
+    _args.solve_method(method, cost, "meshfmm.distributed.distance_matrix")
     if compression not in _CODECS:
         raise ValueError(f"compression must be one of {', '.join(map(repr, _CODECS))}, "
                          f"not {compression!r}")
     if backend not in ("auto", "threads", "serial", "opencl"):
         raise ValueError(f"backend must be auto, threads, serial or opencl, not {backend!r}")
+    if method == "windows" and backend == "opencl":
+        raise ValueError("method='windows' runs on the serial and threads backends, not "
+                         "opencl (backend='auto' runs threads)")
     if not _args.is_int(retries) or retries < 0:
         raise ValueError(f"retries must be an integer >= 0, not {retries!r}")
     if block_rows is not None and (not _args.is_int(block_rows) or block_rows < 1):
@@ -412,12 +429,13 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
     mesh.distance_matrix(src[:1] if src is not None else [0], targets=tgt, backend="serial",
                          dtype=dt.name, max_distance=0.0, cost=cost_arr,
                          cost_location=cost_location, unfolding=unfolding,
-                         exact_start=exact_start, n_threads=_args.index(n_threads, "n_threads"))
+                         exact_start=exact_start, method=method,
+                         n_threads=_args.index(n_threads, "n_threads"))
     url, storage_options = _store.open_store(store, storage_options)
     n_rows = nv if src is None else src.shape[0]
     n_cols = nv if tgt is None else tgt.shape[0]
     job = job_description(mesh, src, tgt, dt.name, max_distance, cost_arr, cost_location,
-                          unfolding, radius)
+                          unfolding, radius, method)
     # refused before a cluster is started for nothing; checked again below
     _store.check_store(url, storage_options, job, (n_rows, n_cols), resume, overwrite)
     token = uuid.uuid4().hex  # this run's owner token
@@ -488,7 +506,7 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                               fresh, n_rows, dask_threads, progress, owner,
                               {"backend": backend, "dtype": dt.name,
                                "max_distance": max_distance, "unfolding": unfolding,
-                               "exact_start": radius, "cost": cost_arr,
+                               "exact_start": radius, "method": method, "cost": cost_arr,
                                "cost_location": cost_location, "n_threads": n_threads,
                                "host_threads": host_threads,
                                "mesh_options": mesh.options}, retries)

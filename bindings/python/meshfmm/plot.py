@@ -356,8 +356,9 @@ def cli_render(argv: Sequence[str]) -> int:
                     help="number of evenly spaced isolines, 0 for none (default: 10)")
     ap.add_argument("--levels", metavar="A,B,...",
                     help="isoline values, comma-separated (instead of --isolines)")
-    ap.add_argument("--method", choices=["fmm", "exact"], default="fmm",
-                    help="distance method (default: fmm)")
+    ap.add_argument("--method", choices=["fmm", "windows", "exact"], default="fmm",
+                    help="distance method: fmm (default), windows (more accurate, never "
+                         "below the geodesic distance) or exact (Mesh.distance's method)")
     ap.add_argument("--size", type=int, nargs=2, default=[800, 600], metavar=("W", "H"),
                     help="picture size in pixels (default: 800 600)")
     ap.add_argument("--cmap", default="viridis", help="matplotlib colour map (default: viridis)")

@@ -1,0 +1,103 @@
+/* The window method behind MFMM_METHOD_WINDOWS (internal): window
+ * propagation keeping K windows in place on each half-edge ("slots"), in
+ * distance order. Every value it writes is the length of a path on the
+ * surface, so never below the exact solver's beyond rounding. The design:
+ * slots.c; the rules below are kept for bench/micro/bench_slots.c. */
+#ifndef MFMM_EXACT_SLOTS_H
+#define MFMM_EXACT_SLOTS_H
+
+#include <stdint.h>
+
+#include "exact.h"
+
+typedef struct mfmm_slots mfmm_slots;
+
+/* A workspace on the mesh's exact tables (mfmm_exact_tables_of). */
+mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out);
+void mfmm_slots_destroy(mfmm_slots *s);
+/* About the bytes a workspace holds on `mesh` (K = 2), its tables apart. */
+size_t mfmm_slots_bytes(const mfmm_mesh *mesh);
+
+/* The pass rule: bit 0 clear (default) passes the windows entering a face
+ * through an edge once both of the edge's ends have settled (each half-edge
+ * once); set, only the first such edge of each face. Bit 1 set: a window
+ * kept in a slot after its half-edge was passed is crossed at once (else it
+ * waits for nothing: it is dropped). Bit 2 set: a third window takes a
+ * slot only from a window it dominates (no longer at the slot's interval's
+ * ends and middle; the worse score where it dominates both), else the least
+ * score rank (sum of the values at the edge's ends and middle) decides.
+ * Bits 2-3 = 2: the score is that of the window's function over the whole
+ * edge (its interval ignored); = 3: the least score, and a window less than
+ * a slot's at its own interval's ends and middle takes that slot too. Bits 4-5, to measure what the parts cost:
+ * bit 4 no vertex offers but the source's (edge relaxation instead), bit 5
+ * no passes (offers and relaxation only). Bit 6: prefetch the face records
+ * of the vertex at the heap's top. Bit 7: a vertex offers windows only
+ * where needed: a saddle, a vertex at a wall, or one whose distance did not
+ * come from a window's ray (edge relaxation, a window's end). */
+void mfmm_slots_set_rule(mfmm_slots *s, int rule);
+/* Bit 8: a half-edge is passed when the front reaches its windows' least
+ * value (a second heap, of half-edges, beside the vertices'), not when its
+ * ends have settled; a window that comes later is crossed at once (bit 1).
+ * Bit 9 (with bit 7): only a vertex reached by a ray whose neighbourhood
+ * unfolds flat (angle sum 2 pi, or a wall's vertex of pi or less) skips its
+ * offers. Bit 10: a window over K on a half-edge drops, of the K + 1, the
+ * one whose loss raises the least the sum over 9 points of the edge of the
+ * lowest value there (the envelope), not the worst score. Bit 11: a window crossing a face lowers the far corner, where the
+ * corner is beside the window's interval, over the interval's nearer end
+ * (the ray to it, then straight across the face: a path), not only at a
+ * graze; the corner offers (it was not reached by a ray). The main rule,
+ * 3906 (bits 1, 6-11), set by mfmm_slots_create: exact on triangulations
+ * of convex planar regions and on developable surfaces (cylinders, a
+ * cube). Rule 834 (bits 1, 6-9): the same without bits 10 and 11. */
+#define SL_RULE_MAIN 3906
+
+/* K windows per half-edge instead of 2 (1 to 8; ranks 1 and 3 of the rule
+ * need 2, and fall back to rank 0). 0 when out of memory or K is out of
+ * range. */
+int mfmm_slots_set_k(mfmm_slots *s, int K);
+
+/* Distances from internal vertex `source` to every vertex, in internal
+ * order (out: nv, +inf where not reached). */
+void mfmm_slots_solve(mfmm_slots *s, int32_t source, double *out);
+
+/* Several vertex sources (internal ids), each with its value (value NULL:
+ * all 0); out as mfmm_slots_solve. */
+void mfmm_slots_solve_multi(mfmm_slots *s, int32_t n, const int32_t *src, const double *value,
+                            double *out);
+
+/* A point in internal face f: w[j] the barycentric weight of internal
+ * vertex fv[j] (fv: f's corners in any order). Its corners get their
+ * straight distances and its edges windows of the point. A face with no
+ * area (or weights summing to 0 or less) reaches nothing: all +inf. */
+void mfmm_slots_solve_face(mfmm_slots *s, int32_t f, const int32_t fv[3], const double w[3],
+                           double *out);
+
+/* The solve behind MFMM_METHOD_WINDOWS: sources as for mfmm_solve, in
+ * internal ids (vertex sources, points in faces, each with its value),
+ * stopped once the front passes max_distance (+inf: none) or, with
+ * n_targets > 0, once every internal vertex of `targets` has settled and the
+ * front has passed the largest of their values. T: (nv,) +inf on entry; the
+ * values of the vertices settled by then are written (those within
+ * max_distance), the same bits as a solve without the stops (values after
+ * a vertex settles only lower it by rounding, 1e-13 relative, and the run
+ * goes on past the stop by SL_STOP relative). settled: (nv,) out, may be
+ * NULL: the vertices written. Returns how many. */
+int32_t mfmm_slots_run(mfmm_slots *s, const mfmm_source *sources, int32_t n_sources,
+                       double max_distance, const int32_t *targets, int32_t n_targets,
+                       double *T, int32_t *settled);
+
+/* Counters of the last solve. */
+typedef struct mfmm_slots_info {
+    int64_t crossed;   /* windows passed across a face */
+    int64_t emitted;   /* windows offered to a slot (children and vertex offers) */
+    int64_t kept;      /* of those, kept in a slot */
+    int64_t late;      /* kept in a half-edge already passed */
+    int64_t late_vertex; /* lowerings of a settled vertex */
+    int64_t settled;
+    int64_t narrow, trimmed, evicted; /* offers dropped: too narrow, trimmed away, one of three */
+    int64_t local;     /* slots taken by rank 3's local rule */
+    int64_t merged;    /* offers joined to a slot with the same pseudo-source */
+} mfmm_slots_info;
+void mfmm_slots_get_info(const mfmm_slots *s, mfmm_slots_info *info);
+
+#endif
