@@ -64,34 +64,6 @@ static void ex_set_in(mfmm_exact_ws *ws, int32_t v, int32_t c, double psi, doubl
     ws->in_angle[v] = ws->fan_a0[c] + ws->fr[c / 3].sgn[c % 3] * psi;
 }
 
-/* Trims the interval [*b0, *b1] of an edge of length L (in the frame where
- * its pseudo-source is (px, py) at distance sigma) to the part where it is
- * shorter than the paths through the edge's ends, with distances dA (at 0)
- * and dB (at L). sigma + |I X| - (dA + t) does not increase with t, so the
- * part beaten by A is [0, t*), t* the root of
- * sigma + sqrt((t - px)^2 + py^2) = dA + t; likewise from B. The caller
- * raises dA by EX_TIE where A starts no windows (a flat vertex): where I, A
- * and the edge are almost on one line the two sides are equal to rounding,
- * and a window trimmed there left what lay behind A unreached (+inf, or
- * longer than a path along the edges). Not where A starts windows: those
- * carry the path on, and windows kept at ties there went round coincident
- * vertices without end. Returns 0 when too little is left. Without branches (an end not reached yet, d = +inf,
- * gives inf / inf = NaN, which moves nothing): whether an end moves is data
- * the branch predictor cannot guess. */
-static int ex_trim(double px, double py, double sigma, double L, double dA, double dB,
-                   double *b0, double *b1)
-{
-    double py2 = py * py;
-    double a = dA - sigma, qx = L - px, c = dB - sigma;
-    int ok = !(px + a <= 0.0) & !(qx + c <= 0.0);
-    double t0 = (px * px + py2 - a * a) / (2.0 * (px + a));
-    double t1 = L - (qx * qx + py2 - c * c) / (2.0 * (qx + c));
-    double s0 = t0 > *b0 ? t0 : *b0, s1 = t1 < *b1 ? t1 : *b1;
-    *b0 = s0;
-    *b1 = s1;
-    return ok & (s1 - s0 > EX_MIN_WIDTH * L);
-}
-
 /* The distance from x to the interval [s0, s1] (s0 <= s1), as maxima
  * (no branch) */
 static double ex_gap(double x, double s0, double s1)
@@ -289,21 +261,6 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
                     double sigma, int known)
 {
     ex_emit_inline(ws, h, s0, s1, ix, iy, sigma, known);
-}
-
-/* Where the line from I through X = (x, 0) meets the line O + s u (s). */
-static double ex_hit(double ox, double oy, double ux, double uy, double ix, double iy, double x,
-                     double len)
-{
-    double xx = x - ox, xy = -oy, jx = ix - ox, jy = iy - oy;
-    double num = xx * jy - xy * jx;
-    double den = (xx - jx) * uy - (xy - jy) * ux;
-    double s = num / den;
-    if (!(s >= 0.0))
-        s = 0.0;
-    if (!(s <= len))
-        s = len;
-    return s;
 }
 
 void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)

@@ -157,24 +157,8 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
         return MFMM_ERR_OUT_OF_MEMORY;
     }
     /* a vertex at a wall (two wall edges, no zero-area face or copy) whose
-     * angle sum is pi or less bends no shortest path: it needs no offers */
-    for (size_t v = 0; v < nv; v++) {
-        s->need[v] = t->pseudo[v];
-        if (!s->need[v])
-            continue;
-        double a = 0.0;
-        int walls = 0, odd = 0;
-        for (int32_t j = t->vf_offset[v]; j < t->vf_offset[v + 1]; j++) {
-            int32_t c = ex_corner(t->vf_corner, t->face_in, j);
-            const ex_face *r = t->fr + c / 3;
-            int k = c % 3;
-            odd |= r->skip != 0;
-            a += r->angle[k];
-            walls += (r->across[ex_next[k]] < 0) + (r->across[ex_prev[k]] < 0);
-        }
-        s->need[v] = odd || walls != 2 || !(a <= EX_PI * (1.0 + 1e-9));
-    }
-    /* rule bit 9: a vertex whose offers the windows beside it make
+     * angle sum is pi or less bends no shortest path: it needs no offers;
+     * rule bit 9: a vertex whose offers the windows beside it make
      * redundant once a ray reaches it: one whose neighbourhood unfolds flat
      * (an angle sum of 2 pi, no wall) or a wall's vertex of pi or less */
     for (size_t v = 0; v < nv; v++) {
@@ -188,6 +172,7 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
             a += r->angle[k];
             walls += (r->across[ex_next[k]] < 0) + (r->across[ex_prev[k]] < 0);
         }
+        s->need[v] = t->pseudo[v] && (odd || walls != 2 || !(a <= EX_PI * (1.0 + 1e-9)));
         s->flat[v] = !s->need[v] && !odd &&
                      ((walls == 0 && fabs(a - EX_TWO_PI) <= 1e-9 * EX_TWO_PI) || walls == 2);
     }
@@ -279,21 +264,6 @@ static inline void sl_update(mfmm_slots *s, int32_t v, double dist, int ray)
     }
     mfmm_heap_push_or_decrease(&s->h, v, dist, lab == 1);
     s->h.label[v] = 1;
-}
-
-/* ex_trim (propagate.c) */
-static inline int sl_trim(double px, double py, double sigma, double L, double dA, double dB,
-                          double *b0, double *b1)
-{
-    double py2 = py * py;
-    double a = dA - sigma, qx = L - px, c = dB - sigma;
-    int ok = !(px + a <= 0.0) & !(qx + c <= 0.0);
-    double t0 = (px * px + py2 - a * a) / (2.0 * (px + a));
-    double t1 = L - (qx * qx + py2 - c * c) / (2.0 * (qx + c));
-    double s0 = t0 > *b0 ? t0 : *b0, s1 = t1 < *b1 ? t1 : *b1;
-    *b0 = s0;
-    *b1 = s1;
-    return ok & (s1 - s0 > EX_MIN_WIDTH * L);
 }
 
 /* the distance a window gives at x of its edge: over the nearer end of its
@@ -524,7 +494,7 @@ static void sl_emit(mfmm_slots *s, int32_t h, double s0, double s1, double t0, d
     double da = s->d[va], db = s->d[vb];
     da += EX_TIE * da;
     db += EX_TIE * db;
-    if (!sl_trim(ix, -iy, sigma, L, da, db, &s0, &s1)) {
+    if (!ex_trim(ix, -iy, sigma, L, da, db, &s0, &s1)) {
         s->info.trimmed++;
         return;
     }
@@ -549,21 +519,6 @@ static void sl_emit(mfmm_slots *s, int32_t h, double s0, double s1, double t0, d
         if (!rq->skip)
             sl_keep(s, q, rq->v[ex_next[q % 3]] != va, L, s0, s1, t0, t1, ix, iy, sigma);
     }
-}
-
-/* ex_hit (propagate.c): where the line from I through (x, 0) meets O + s u */
-static inline double sl_hit(double ox, double oy, double ux, double uy, double ix, double iy,
-                            double x, double len)
-{
-    double xx = x - ox, xy = -oy, jx = ix - ox, jy = iy - oy;
-    double num = xx * jy - xy * jx;
-    double den = (xx - jx) * uy - (xy - jy) * ux;
-    double t = num / den;
-    if (!(t >= 0.0))
-        t = 0.0;
-    if (!(t <= len))
-        t = len;
-    return t;
 }
 
 /* A window entering face h / 3 through h crosses it (ex_propagate). */
@@ -596,10 +551,10 @@ static void sl_cross(mfmm_slots *s, int32_t h, const sl_win *w)
         int32_t hl = 3 * f + m2;
         double lac = r->len[m2], il = 1.0 / (lac < EX_SHORT_CHILD * L ? hypot(cx, cy) : lac);
         double ux = -cx * il, uy = -cy * il;
-        double s_hi = b0 <= 0.0 ? lac : sl_hit(cx, cy, ux, uy, px, py, b0, lac);
-        double s_lo = tc <= b1 ? 0.0 : sl_hit(cx, cy, ux, uy, px, py, b1, lac);
-        double t_hi = g0 <= 0.0 ? lac : sl_hit(cx, cy, ux, uy, px, py, g0, lac);
-        double t_lo = tc <= g1 ? 0.0 : sl_hit(cx, cy, ux, uy, px, py, g1, lac);
+        double s_hi = b0 <= 0.0 ? lac : ex_hit(cx, cy, ux, uy, px, py, b0, lac);
+        double s_lo = tc <= b1 ? 0.0 : ex_hit(cx, cy, ux, uy, px, py, b1, lac);
+        double t_hi = g0 <= 0.0 ? lac : ex_hit(cx, cy, ux, uy, px, py, g0, lac);
+        double t_lo = tc <= g1 ? 0.0 : ex_hit(cx, cy, ux, uy, px, py, g1, lac);
         double qx = px - cx, qy = py - cy;
         double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
         sl_emit(s, hl, s_lo, s_hi, t_lo, t_hi, ix, iy > 0.0 ? iy : 0.0, sigma, 0);
@@ -608,10 +563,10 @@ static void sl_cross(mfmm_slots *s, int32_t h, const sl_win *w)
         int32_t hr = 3 * f + m1;
         double lbc = r->len[m1], il = 1.0 / (lbc < EX_SHORT_CHILD * L ? hypot(cx - L, cy) : lbc);
         double ux = (cx - L) * il, uy = cy * il;
-        double s_lo = b1 >= L ? 0.0 : sl_hit(L, 0.0, ux, uy, px, py, b1, lbc);
-        double s_hi = tc >= b0 ? lbc : sl_hit(L, 0.0, ux, uy, px, py, b0, lbc);
-        double t_lo = g1 >= L ? 0.0 : sl_hit(L, 0.0, ux, uy, px, py, g1, lbc);
-        double t_hi = tc >= g0 ? lbc : sl_hit(L, 0.0, ux, uy, px, py, g0, lbc);
+        double s_lo = b1 >= L ? 0.0 : ex_hit(L, 0.0, ux, uy, px, py, b1, lbc);
+        double s_hi = tc >= b0 ? lbc : ex_hit(L, 0.0, ux, uy, px, py, b0, lbc);
+        double t_lo = g1 >= L ? 0.0 : ex_hit(L, 0.0, ux, uy, px, py, g1, lbc);
+        double t_hi = tc >= g0 ? lbc : ex_hit(L, 0.0, ux, uy, px, py, g0, lbc);
         double qx = px - L, qy = py;
         double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
         sl_emit(s, hr, s_lo, s_hi, t_lo, t_hi, ix, iy > 0.0 ? iy : 0.0, sigma, 0);
