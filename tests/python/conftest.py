@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import functools
 import os
+import shutil
 from pathlib import Path
 
 import pytest
@@ -149,3 +150,24 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
         terminalreporter.write_line(f"written to {path}")
     except OSError as exc:
         terminalreporter.write_line(f"could not write {path}: {exc}")
+
+
+def find_cli():
+    """The C command line: $MESHFMM_CLI, else the newest build*/meshfmm of the
+    repository, else `meshfmm` on PATH; None when there is none."""
+    env = os.environ.get("MESHFMM_CLI")
+    if env:
+        return env if os.access(env, os.X_OK) else None
+    builds = [p for p in REPO.glob("build*/meshfmm") if p.is_file() and os.access(p, os.X_OK)]
+    if builds:
+        return str(max(builds, key=lambda p: p.stat().st_mtime))
+    return shutil.which("meshfmm")
+
+
+@pytest.fixture(scope="module")
+def cli():
+    """find_cli()'s path; skips the test when there is no command line."""
+    path = find_cli()
+    if path is None:
+        pytest.skip("no meshfmm command line found (set MESHFMM_CLI or build with CMake)")
+    return path

@@ -8,8 +8,6 @@ and the Python package's library must be built from the same tree.
 from __future__ import annotations
 
 import json
-import os
-import shutil
 import subprocess
 from pathlib import Path
 
@@ -18,24 +16,6 @@ import pytest
 
 import meshfmm
 from conftest import MESHES, REPO, load, mesh, need_data
-
-
-def find_cli():
-    env = os.environ.get("MESHFMM_CLI")
-    if env:
-        return env if os.access(env, os.X_OK) else None
-    builds = [p for p in REPO.glob("build*/meshfmm") if p.is_file() and os.access(p, os.X_OK)]
-    if builds:
-        return str(max(builds, key=lambda p: p.stat().st_mtime))
-    return shutil.which("meshfmm")
-
-
-@pytest.fixture(scope="module")
-def cli():
-    path = find_cli()
-    if path is None:
-        pytest.skip("no meshfmm command line found (set MESHFMM_CLI or build with CMake)")
-    return path
 
 
 def run(cli, *args):

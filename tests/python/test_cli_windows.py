@@ -13,18 +13,10 @@ import numpy as np
 import pytest
 
 from conftest import MESHES, mesh
-from test_cli import find_cli, run
+from test_cli import run
 
 NAME = "spot.obj"
 PATH = MESHES / NAME
-
-
-@pytest.fixture(scope="module")
-def cli():
-    path = find_cli()
-    if path is None:
-        pytest.skip("no meshfmm command line found (set MESHFMM_CLI or build with CMake)")
-    return path
 
 
 def refused(cli, *args):

@@ -25,7 +25,7 @@ from test_workflows import split_at_x
 
 
 def _cli():
-    from test_cli import find_cli
+    from conftest import find_cli
 
     path = find_cli()
     if path is None:

@@ -16,7 +16,7 @@ import pytest
 
 import meshfmm
 from conftest import MESHES, mesh, need_data
-from test_cli import find_cli
+from conftest import find_cli
 
 SOURCES = [0, 17, 400, 809, 3, 17]
 

@@ -129,7 +129,7 @@ def test_cli_npz_and_targets(tmp_path):
 
     need_data()
     sp = pytest.importorskip("scipy.sparse")
-    from test_cli import find_cli
+    from conftest import find_cli
 
     exe = find_cli()
     if exe is None:

@@ -305,7 +305,7 @@ def test_surface_points_as_targets():
 
 # ---------------------------------------------------------------- the CLI
 def _cli():
-    from test_cli import find_cli
+    from conftest import find_cli
 
     path = find_cli()
     if path is None:
