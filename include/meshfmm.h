@@ -246,7 +246,8 @@ typedef struct mfmm_solver mfmm_solver;
  * first solve builds what later solves reuse (the exact start's workspace;
  * the mesh's shared tables, once per mesh, under a lock); after that a solve
  * allocates only copies of its arguments, and costs in proportion to what it
- * reaches (max_distance, targets) apart from filling `distances`.
+ * reaches (max_distance, targets) apart from filling `distances` (with
+ * MFMM_METHOD_WINDOWS, also one pass over the mesh to clear its slots).
  *   mesh: the mesh, which must outlive the solver.
  *   out:  receives the solver; NULL on failure.
  * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_OUT_OF_MEMORY. Thread-safe. */
