@@ -302,30 +302,26 @@ void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
     if (b0 < tc) {
         /* left child: edge C -> A (half-edge 3f+m2), rays through [b0, min(b1, tc)] */
         int32_t hl = 3 * f + m2;
-        double lac = r->len[m2], il = 1.0 / (lac < EX_SHORT_CHILD * L ? hypot(cx, cy) : lac);
-        double ux = -cx * il, uy = -cy * il;
-        double s_hi = b0 <= 0.0 ? lac : ex_hit(cx, cy, ux, uy, px, py, b0, lac);
-        double s_lo = tc <= b1 ? 0.0 : ex_hit(cx, cy, ux, uy, px, py, b1, lac);
-        double qx = px - cx, qy = py - cy;
-        double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
+        ex_child c = ex_child_left(r, m);
+        double s_hi = b0 <= 0.0 ? c.len : ex_child_hit(&c, px, py, b0);
+        double s_lo = tc <= b1 ? 0.0 : ex_child_hit(&c, px, py, b1);
+        double ix, iy;
+        ex_child_source(&c, px, py, &ix, &iy);
         /* its end at C when the window holds C (C updated above), at A
          * when the window starts at A (A updated where it was emitted):
          * the same distance again, in another frame */
-        ex_emit_inline(ws, hl, s_lo, s_hi, ix, iy > 0.0 ? iy : 0.0, sigma,
-                       (tc <= b1) | (b0 <= 0.0) << 1);
+        ex_emit_inline(ws, hl, s_lo, s_hi, ix, iy, sigma, (tc <= b1) | (b0 <= 0.0) << 1);
     }
     if (b1 > tc) {
         /* right child: edge B -> C (half-edge 3f+m1), rays through [max(b0, tc), b1] */
         int32_t hr = 3 * f + m1;
-        double lbc = r->len[m1], il = 1.0 / (lbc < EX_SHORT_CHILD * L ? hypot(cx - L, cy) : lbc);
-        double ux = (cx - L) * il, uy = cy * il;
-        double s_lo = b1 >= L ? 0.0 : ex_hit(L, 0.0, ux, uy, px, py, b1, lbc);
-        double s_hi = tc >= b0 ? lbc : ex_hit(L, 0.0, ux, uy, px, py, b0, lbc);
-        double qx = px - L, qy = py;
-        double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
+        ex_child c = ex_child_right(r, m);
+        double s_lo = b1 >= L ? 0.0 : ex_child_hit(&c, px, py, b1);
+        double s_hi = tc >= b0 ? c.len : ex_child_hit(&c, px, py, b0);
+        double ix, iy;
+        ex_child_source(&c, px, py, &ix, &iy);
         /* (likewise at B and at C) */
-        ex_emit_inline(ws, hr, s_lo, s_hi, ix, iy > 0.0 ? iy : 0.0, sigma,
-                       (b1 >= L) | (tc >= b0) << 1);
+        ex_emit_inline(ws, hr, s_lo, s_hi, ix, iy, sigma, (b1 >= L) | (tc >= b0) << 1);
     }
 }
 

@@ -549,27 +549,25 @@ static void sl_cross(mfmm_slots *s, int32_t h, const sl_win *w)
     int m1 = ex_next[m], m2 = ex_prev[m];
     if (b0 < tc) {
         int32_t hl = 3 * f + m2;
-        double lac = r->len[m2], il = 1.0 / (lac < EX_SHORT_CHILD * L ? hypot(cx, cy) : lac);
-        double ux = -cx * il, uy = -cy * il;
-        double s_hi = b0 <= 0.0 ? lac : ex_hit(cx, cy, ux, uy, px, py, b0, lac);
-        double s_lo = tc <= b1 ? 0.0 : ex_hit(cx, cy, ux, uy, px, py, b1, lac);
-        double t_hi = g0 <= 0.0 ? lac : ex_hit(cx, cy, ux, uy, px, py, g0, lac);
-        double t_lo = tc <= g1 ? 0.0 : ex_hit(cx, cy, ux, uy, px, py, g1, lac);
-        double qx = px - cx, qy = py - cy;
-        double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
-        sl_emit(s, hl, s_lo, s_hi, t_lo, t_hi, ix, iy > 0.0 ? iy : 0.0, sigma, 0);
+        ex_child c = ex_child_left(r, m);
+        double s_hi = b0 <= 0.0 ? c.len : ex_child_hit(&c, px, py, b0);
+        double s_lo = tc <= b1 ? 0.0 : ex_child_hit(&c, px, py, b1);
+        double t_hi = g0 <= 0.0 ? c.len : ex_child_hit(&c, px, py, g0);
+        double t_lo = tc <= g1 ? 0.0 : ex_child_hit(&c, px, py, g1);
+        double ix, iy;
+        ex_child_source(&c, px, py, &ix, &iy);
+        sl_emit(s, hl, s_lo, s_hi, t_lo, t_hi, ix, iy, sigma, 0);
     }
     if (b1 > tc) {
         int32_t hr = 3 * f + m1;
-        double lbc = r->len[m1], il = 1.0 / (lbc < EX_SHORT_CHILD * L ? hypot(cx - L, cy) : lbc);
-        double ux = (cx - L) * il, uy = cy * il;
-        double s_lo = b1 >= L ? 0.0 : ex_hit(L, 0.0, ux, uy, px, py, b1, lbc);
-        double s_hi = tc >= b0 ? lbc : ex_hit(L, 0.0, ux, uy, px, py, b0, lbc);
-        double t_lo = g1 >= L ? 0.0 : ex_hit(L, 0.0, ux, uy, px, py, g1, lbc);
-        double t_hi = tc >= g0 ? lbc : ex_hit(L, 0.0, ux, uy, px, py, g0, lbc);
-        double qx = px - L, qy = py;
-        double ix = qx * ux + qy * uy, iy = ux * qy - uy * qx;
-        sl_emit(s, hr, s_lo, s_hi, t_lo, t_hi, ix, iy > 0.0 ? iy : 0.0, sigma, 0);
+        ex_child c = ex_child_right(r, m);
+        double s_lo = b1 >= L ? 0.0 : ex_child_hit(&c, px, py, b1);
+        double s_hi = tc >= b0 ? c.len : ex_child_hit(&c, px, py, b0);
+        double t_lo = g1 >= L ? 0.0 : ex_child_hit(&c, px, py, g1);
+        double t_hi = tc >= g0 ? c.len : ex_child_hit(&c, px, py, g0);
+        double ix, iy;
+        ex_child_source(&c, px, py, &ix, &iy);
+        sl_emit(s, hr, s_lo, s_hi, t_lo, t_hi, ix, iy, sigma, 0);
     }
 }
 

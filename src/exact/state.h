@@ -234,4 +234,47 @@ static inline double ex_hit(double ox, double oy, double ux, double uy, double i
     return s;
 }
 
+/* A child edge of a window crossing a face through half-edge m (the
+ * exact solver's ex_propagate and the window method's sl_cross): the edge
+ * C -> A (left, half-edge 3f + ex_prev[m]) or B -> C (right, 3f + ex_next[m])
+ * as the line O + s u, s in [0, len], in m's frame (A at 0, B at (L, 0),
+ * C at (cx, cy)). A child shorter than EX_SHORT_CHILD of L takes its
+ * direction from the corners' positions, not its own length. */
+typedef struct ex_child {
+    double ox, oy, ux, uy, len;
+} ex_child;
+
+static inline ex_child ex_child_left(const ex_face *r, int m)
+{
+    double cx = r->cx[m], cy = r->cy[m], lac = r->len[ex_prev[m]];
+    double il = 1.0 / (lac < EX_SHORT_CHILD * r->len[m] ? hypot(cx, cy) : lac);
+    ex_child c = {cx, cy, -cx * il, -cy * il, lac};
+    return c;
+}
+
+static inline ex_child ex_child_right(const ex_face *r, int m)
+{
+    double cx = r->cx[m], cy = r->cy[m], L = r->len[m], lbc = r->len[ex_next[m]];
+    double il = 1.0 / (lbc < EX_SHORT_CHILD * L ? hypot(cx - L, cy) : lbc);
+    ex_child c = {L, 0.0, (cx - L) * il, cy * il, lbc};
+    return c;
+}
+
+/* Where the ray from (px, py) through (x, 0) crosses the child edge (ex_hit) */
+static inline double ex_child_hit(const ex_child *c, double px, double py, double x)
+{
+    return ex_hit(c->ox, c->oy, c->ux, c->uy, px, py, x, c->len);
+}
+
+/* The pseudo-source (px, py) in the child edge's frame: (*ix, *iy), *iy
+ * clamped to >= 0 (the side of the face it leaves) */
+static inline void ex_child_source(const ex_child *c, double px, double py, double *ix,
+                                   double *iy)
+{
+    double qx = px - c->ox, qy = py - c->oy;
+    double y = c->ux * qy - c->uy * qx;
+    *ix = qx * c->ux + qy * c->uy;
+    *iy = y > 0.0 ? y : 0.0;
+}
+
 #endif
