@@ -26,10 +26,18 @@ void mfmm_exact_tables_destroy(mfmm_exact_tables *tables);
 size_t mfmm_exact_tables_bytes(const mfmm_mesh *mesh);
 size_t mfmm_exact_ws_bytes(const mfmm_mesh *mesh);
 
-/* The mesh's own tables (mesh->exact_tables): built on first use under the
+/* The mesh's own tables (mesh->exact_tables): made on first use under the
  * mesh's lock, then shared by every workspace on the mesh until the mesh is
- * destroyed. MFMM_ERR_OUT_OF_MEMORY when they cannot be built. */
+ * destroyed. MFMM_ERR_OUT_OF_MEMORY when they cannot be made. */
 mfmm_status mfmm_exact_tables_of(const mfmm_mesh *mesh, const mfmm_exact_tables **out);
+
+/* Builds the tables where a run may read them (a tile at a time, under the
+ * mesh's lock; what is built stays): within `radius` of any of the n
+ * points (n, 3), internal coordinates, since no path shorter than radius
+ * leaves that ball; points NULL or radius +inf: everywhere. The first
+ * solve on a large mesh so builds only its patch's share. */
+void mfmm_exact_tables_ensure(const mfmm_exact_tables *tables, const double *points, int32_t n,
+                              double radius);
 
 /* A workspace on shared tables (not freed with it). */
 mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *tables, mfmm_exact_ws **out);

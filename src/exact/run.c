@@ -234,6 +234,26 @@ static mfmm_status ex_run_once(mfmm_exact_ws *ws, const mfmm_source *sources,
 mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t n_sources,
                           double max_d, size_t memory_limit)
 {
+    /* the tables within max_d of the sources (no path it keeps goes farther) */
+    double few[3 * 8] = {0}, *p = n_sources <= 8 ? few : malloc(3 * (size_t)n_sources * sizeof *p);
+    double least = INFINITY;
+    for (int32_t i = 0; p && i < n_sources; i++) {
+        const mfmm_source *s = sources + i;
+        least = fmin(least, s->value);
+        if (s->face < 0) {
+            memcpy(p + 3 * i, ws->mesh->xyz + 3 * (size_t)s->vertex, 3 * sizeof *p);
+            continue;
+        }
+        double w[3], sum = 0.0;
+        for (int k = 0; k < 3; k++)
+            sum += w[k] = s->bary[k] > 0.0 ? s->bary[k] : 0.0;
+        for (int k = 0; k < 3; k++)
+            w[k] /= sum;
+        mfmm_bary_to_xyz(ws->mesh, s->face, w, p + 3 * i);
+    }
+    mfmm_exact_tables_ensure(ws->t, p, n_sources, p ? max_d - least : INFINITY);
+    if (p != few)
+        free(p);
     ws->walls = 0;
     mfmm_status st = ex_run_once(ws, sources, n_sources, max_d, memory_limit);
     if (st == MFMM_OK && ws->over_budget) {
@@ -267,8 +287,8 @@ mfmm_status ex_check_sources(const mfmm_exact_ws *ws, const mfmm_source *sources
             return st;
         double b[3];
         if (sources[i].face >= 0 &&
-            ws->fr[ws->face_in[mfmm_order_point_in(ws->mesh, sources[i].face, sources[i].bary, b)]]
-                    .skip == 1)
+            mfmm_mesh_degenerate(ws->mesh,
+                                 mfmm_order_point_in(ws->mesh, sources[i].face, sources[i].bary, b)))
             return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, i,
                              "source %ld lies on face %ld, which has zero area", (long)i,
                              (long)sources[i].face);

@@ -118,6 +118,7 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     mfmm_status st = mfmm_exact_tables_of(mesh, &t);
     if (st != MFMM_OK)
         return st;
+    mfmm_exact_tables_ensure(t, NULL, 0, INFINITY);
     mfmm_slots *s = calloc(1, sizeof *s);
     if (!s)
         return MFMM_ERR_OUT_OF_MEMORY;

@@ -193,7 +193,7 @@ mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *t, mfmm_exact_w
     for (int32_t i = 0; i < ws->n_nm; i++)
         ws->nm_head[i] = -1;
     /* memory_limit counts the tables too, shared or not */
-    ws->fixed_bytes = t->bytes + mfmm_exact_ws_bytes(t->mesh) + (size_t)ws->n_nm * sizeof(int32_t);
+    ws->fixed_bytes = t->full_bytes + mfmm_exact_ws_bytes(t->mesh) + (size_t)ws->n_nm * sizeof(int32_t);
     ws->max_d = INFINITY;
     ws->peak_bytes = ws->fixed_bytes;
     *out = ws;

@@ -48,6 +48,12 @@
 #define EX_MAX_PASS 8
 /* a vertex whose angle sum exceeds 2 pi by this much is a saddle */
 #define EX_SADDLE_TOL 1e-12
+/* vertices in a tile of the lazily built tables, and a tile's levels: its
+ * face records, and those with the fans and flags of every vertex and face
+ * its records touch (ready to be read) */
+#define EX_TILE 32
+#define EX_TILE_FACES 1
+#define EX_TILE_READY 2
 
 /* k + 1 and k - 1 modulo 3, looked up: with k of a random window, a
  * comparison there is a branch mispredicted about half the time */
@@ -121,7 +127,20 @@ struct mfmm_exact_tables {
     int32_t *nm_he, *nm_next;
     int32_t n_nm;
     double inv_w;      /* 1 / bucket width */
-    size_t bytes;
+    /* Built lazily, a tile at a time, under the mesh's lock (tables.c,
+     * mfmm_exact_tables_ensure): tile T is the vertices EX_TILE T to
+     * EX_TILE (T + 1) - 1 and the records of the faces whose least vertex
+     * is one of them (records tile_rec[T] to tile_rec[T + 1] - 1) */
+    int32_t n_tiles, n_ready;
+    int32_t *tile_rec;   /* (n_tiles + 1,) */
+    int32_t *rec_face;   /* (nf,) a record's mesh face (face_in's inverse) */
+    uint8_t *tile_state; /* (n_tiles,) EX_TILE_FACES | EX_TILE_READY */
+    uint8_t *vertex_done; /* (nv,) 1 once a vertex's fan and flags are built */
+    double *tile_box;    /* (n_tiles, 6) the bounding box of the tile's vertices */
+    double pad;          /* how far beyond a tile's vertices its records and their neighbours reach */
+    double short_len;    /* no edge this long or longer is short (ex_wall_short_edge) */
+    size_t bytes;        /* built so far */
+    size_t full_bytes;   /* once every tile is built */
 };
 
 /* A workspace: shared tables (the mesh's) and one solve's state. */

@@ -1,8 +1,9 @@
 /* A mesh's read-only tables for the exact solver (exact.h): face records in
  * the frames of their edges, fans of corners around each vertex, least
- * heights, the half-edges of non-manifold edges; built once per mesh and
- * shared by every workspace. */
+ * heights, the half-edges of non-manifold edges; made once per mesh,
+ * built tile by tile where runs need them, and shared by every workspace. */
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -20,6 +21,12 @@ void mfmm_exact_tables_destroy(mfmm_exact_tables *t)
     free(t->height);
     free(t->nm_he);
     free(t->nm_next);
+    if (t->rec_face != t->face_in)
+        free(t->rec_face);
+    free(t->tile_rec);
+    free(t->tile_state);
+    free(t->vertex_done);
+    free(t->tile_box);
     free(t);
 }
 
@@ -44,31 +51,44 @@ static int ex_i32_pair_cmp(const void *pa, const void *pb)
     return (a[0] > b[0]) - (a[0] < b[0]);
 }
 
+/* A face's skip flag from the mesh alone (ex_face.skip): 1 zero area, 2 a
+ * copy. The records' own test also checks their frames, which the mesh's
+ * test of zero area implies (mesh/build.c: twice the area above 64 eps
+ * times the longest edge squared leaves every height above 60 eps times it). */
+static int ex_mesh_skip(const mfmm_mesh *mesh, int32_t f)
+{
+    return mfmm_mesh_degenerate(mesh, f) ? 1 : mfmm_mesh_copy(mesh, f) ? 2 : 0;
+}
+
 /* Non-manifold edges (three or more faces, copies aside) join every face on
  * them: a shortest path may cross from any of them into any other. Their
- * half-edges (across -1) get flip 2 and a place in a cycle per edge
- * (nm_he, nm_next), which ex_fan_out walks. As walls, they would make a
- * path through one bend at a vertex, too long. 0, or
- * -1 when out of memory. */
+ * half-edges (no face across, ex_build_faces) get flip 2 and a place in a
+ * cycle per edge (nm_he, nm_next), which ex_fan_out walks. As walls, they
+ * would make a path through one bend at a vertex, too long. 0, or -1 when
+ * out of memory. */
 static int ex_link_nonmanifold(mfmm_exact_tables *t)
 {
+    const mfmm_mesh *mesh = t->mesh;
+    /* an edge with two faces (copies aside) has them across each other */
+    if (mesh->info.n_nonmanifold_edges == 0 && mesh->info.n_duplicate_faces == 0)
+        return 0;
     size_t n = 0;
     for (int32_t f = 0; f < t->nf; f++)
         for (int k = 0; k < 3; k++)
-            n += t->fr[t->face_in[f]].across[k] == -1 && !mfmm_mesh_copy(t->mesh, f);
+            n += mesh->face_neighbor[3 * (size_t)f + k] < 0 && !mfmm_mesh_copy(mesh, f);
     if (n == 0)
         return 0;
     ex_wall *w = malloc(n * sizeof *w);
     if (!w)
         return -1;
     n = 0;
-    /* copies aside, zero-area ones too (skip 1 then), as build_edges has it */
+    /* copies aside, zero-area ones too, as build_edges has it */
     for (int32_t f = 0; f < t->nf; f++) {
-        const ex_face *r = t->fr + t->face_in[f];
+        const int32_t *fv = mesh->face_records[f].v;
         for (int k = 0; k < 3; k++) {
-            if (r->across[k] != -1 || mfmm_mesh_copy(t->mesh, f))
+            if (mesh->face_neighbor[3 * (size_t)f + k] >= 0 || mfmm_mesh_copy(mesh, f))
                 continue;
-            int32_t a = r->v[ex_next[k]], b = r->v[ex_prev[k]];
+            int32_t a = fv[ex_next[k]], b = fv[ex_prev[k]];
             w[n].lo = a < b ? a : b;
             w[n].hi = a < b ? b : a;
             w[n].h = 3 * t->face_in[f] + k;
@@ -105,7 +125,6 @@ static int ex_link_nonmanifold(mfmm_exact_tables *t)
             pairs[2 * q] = w[u].h;
             pairs[2 * q + 1] = w[u + 1 < j ? u + 1 : i].h;
             q++;
-            t->fr[w[u].h / 3].flip[w[u].h % 3] = 2;
         }
     }
     free(w);
@@ -116,116 +135,55 @@ static int ex_link_nonmanifold(mfmm_exact_tables *t)
     }
     free(pairs);
     t->n_nm = (int32_t)n_nm;
-    t->bytes += 2 * n_nm * sizeof(int32_t);
     return 0;
 }
 
-/* Makes every edge shorter than EX_SHORT_EDGE times the longest edge of a
- * face at either end a wall, its ends pseudo-sources that start windows all
- * around (their fans are then open: ex_build_fans). A window crossing a face
+/* Whether half-edge h is on a non-manifold edge (nm_he, sorted). */
+static int ex_is_nonmanifold(const mfmm_exact_tables *t, int32_t h)
+{
+    int32_t lo = 0, hi = t->n_nm;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (t->nm_he[mid] < h)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < t->n_nm && t->nm_he[lo] == h;
+}
+
+/* The longest edge of the faces at v, from the coordinates as the records
+ * have them (ex_build_faces). */
+static double ex_reach(const mfmm_exact_tables *t, int32_t v)
+{
+    const double *X = t->mesh->xyz;
+    double m = 0.0;
+    for (int32_t i = t->vf_offset[v]; i < t->vf_offset[v + 1]; i++) {
+        const int32_t *fv = t->mesh->face_records[MFMM_WEDGE_FACE(t->vf_corner[i])].v;
+        for (int k = 0; k < 3; k++)
+            m = fmax(m, vdist(X + 3 * (size_t)fv[(k + 1) % 3], X + 3 * (size_t)fv[(k + 2) % 3]));
+    }
+    return m;
+}
+
+/* Makes an edge shorter than EX_SHORT_EDGE times the longest edge of a face
+ * at either end a wall, its ends pseudo-sources that start windows all
+ * around (their fans are then open: ex_build_fan). A window crossing a face
  * goes on in the frame of the edge it leaves, whose direction comes from
  * the corners' positions in the face's frame, exact to rounding of the
  * face's longest edge: for an edge 2e-15 long in a face 0.06 long that is a
  * turn of a few per cent, and distances below the straight line beyond it.
  * A path through the short edge is then one through an end of it, longer by
  * at most twice its length. */
-static void ex_wall_short_edges(mfmm_exact_tables *t)
+static void ex_wall_short_edge(const mfmm_exact_tables *t, ex_face *r, int k)
 {
-    double *reach = t->height; /* scratch (nv), filled later */
-    for (int32_t v = 0; v < t->nv; v++) {
-        double m = 0.0;
-        for (int32_t i = t->vf_offset[v]; i < t->vf_offset[v + 1]; i++) {
-            const ex_face *r = t->fr + ex_corner(t->vf_corner, t->face_in, i) / 3;
-            m = fmax(m, fmax(r->len[0], fmax(r->len[1], r->len[2])));
-        }
-        reach[v] = m;
-    }
-    for (int32_t f = 0; f < t->nf; f++) {
-        ex_face *r = t->fr + f;
-        if (r->skip == 2)
-            continue;
-        for (int k = 0; k < 3; k++) {
-            int32_t a = r->v[ex_next[k]], b = r->v[ex_prev[k]];
-            if (r->len[k] >= EX_SHORT_EDGE * fmax(reach[a], reach[b]))
-                continue;
-            r->across[k] = -1;
-            r->flip[k] = 0;
-            t->pseudo[a] = 1;
-            t->pseudo[b] = 1;
-        }
-    }
-}
-
-/* Walks the fan of every vertex through the faces across its edges, giving
- * each corner its angles (fan_a0, fan_sgn) and each vertex its angle sum;
- * NaN for vertices whose corners do not form one closed disk. */
-static void ex_build_fans(mfmm_exact_tables *t)
-{
-    for (int32_t v = 0; v < t->nv; v++) {
-        /* copies (skip 2) apart; a zero-area face (skip 1) ends the fan */
-        int32_t n_c = 0, c0 = -1;
-        int ok = 1;
-        t->fan_total[v] = NAN;
-        for (int32_t i = t->vf_offset[v]; i < t->vf_offset[v + 1]; i++) {
-            int32_t c = ex_corner(t->vf_corner, t->face_in, i);
-            if (t->fr[c / 3].skip == 1)
-                ok = 0;
-            if (t->fr[c / 3].skip == 0) {
-                c0 = c0 < 0 ? c : c0;
-                n_c++;
-            }
-        }
-        if (!ok || n_c < 3)
-            continue;
-        int32_t f = c0 / 3, k = c0 % 3;
-        int32_t ent = t->fr[f].v[(k + 1) % 3];
-        double e = 0.0;
-        int32_t steps = 0;
-        for (;;) {
-            const int32_t *fv = t->fr[f].v;
-            int32_t c = 3 * f + k, far;
-            int kent;
-            if (fv[(k + 1) % 3] == ent) {
-                t->fan_a0[c] = e;
-                t->fr[f].sgn[k] = 1;
-                far = fv[(k + 2) % 3];
-                kent = (k + 1) % 3;
-            } else {
-                t->fan_a0[c] = e + t->fr[f].angle[k];
-                t->fr[f].sgn[k] = -1;
-                far = fv[(k + 1) % 3];
-                kent = (k + 2) % 3;
-            }
-            e += t->fr[f].angle[k];
-            steps++;
-            int32_t nx = t->fr[f].across[kent];
-            if (nx < 0 || steps > n_c) {
-                ok = 0;
-                break;
-            }
-            f = nx / 3;
-            k = ex_corner_of(t->fr[f].v, v);
-            ent = far;
-            if (k < 0) {
-                ok = 0;
-                break;
-            }
-            if (3 * f + k == c0) {
-                ok = steps == n_c && t->fr[f].v[(k + 1) % 3] == ent;
-                break;
-            }
-        }
-        if (ok)
-            t->fan_total[v] = e;
-    }
-}
-
-size_t mfmm_exact_tables_bytes(const mfmm_mesh *mesh)
-{
-    size_t nv = (size_t)mesh->nv, nf = (size_t)mesh->nf;
-    return sizeof(mfmm_exact_tables) + nf * sizeof(ex_face) + 64 +
-           nf * (sizeof(int32_t) + 3 * sizeof(double)) +
-           nv * (1 + 2 * sizeof(double));
+    if (r->skip == 2 || r->len[k] >= t->short_len)
+        return;
+    int32_t a = r->v[ex_next[k]], b = r->v[ex_prev[k]];
+    if (r->len[k] >= EX_SHORT_EDGE * fmax(ex_reach(t, a), ex_reach(t, b)))
+        return;
+    r->across[k] = -1;
+    r->flip[k] = 0;
 }
 
 /* A zero-area face's corners on one line (ex_pass): positions along its
@@ -259,64 +217,48 @@ static void ex_lay_on_line(const double *X, ex_face *r)
     }
 }
 
-mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **out)
+/* The first record of tile T (tile_rec), found once: faces are in the
+ * order of their least vertex, their records too (mfmm_exact_tables_create). */
+static int32_t ex_tile_first(mfmm_exact_tables *t, int32_t T)
 {
-    if (!out)
-        return MFMM_ERR_NULL_POINTER;
-    *out = NULL;
-    if (!mesh)
-        return MFMM_ERR_NULL_POINTER;
-    if (mesh->nf > INT32_MAX / 3 - 1 || (size_t)mesh->nf > (SIZE_MAX - 64) / sizeof(ex_face))
-        return MFMM_ERR_BAD_COUNT;
-    mfmm_exact_tables *t = calloc(1, sizeof *t);
-    if (!t)
-        return MFMM_ERR_OUT_OF_MEMORY;
-    size_t nv = (size_t)mesh->nv, nf = (size_t)mesh->nf, nh = 3 * nf;
-    t->mesh = mesh;
-    t->nv = mesh->nv;
-    t->nf = mesh->nf;
-    t->vf_offset = mesh->vertex_face_offset;
-    t->fr_block = malloc((nf ? nf : 1) * sizeof(ex_face) + 64);
-    if (t->fr_block) {
-        uintptr_t a = (uintptr_t)t->fr_block;
-        t->fr = (ex_face *)(void *)((char *)t->fr_block + ((64 - a % 64) % 64));
+    if (t->tile_rec[T] >= 0)
+        return t->tile_rec[T];
+    int32_t v0 = T * EX_TILE, lo = 0, hi = t->nf;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        const int32_t *fv = t->mesh->face_records[t->rec_face[mid]].v;
+        int32_t least = fv[0] < fv[1] ? fv[0] : fv[1];
+        if ((least < fv[2] ? least : fv[2]) < v0)
+            lo = mid + 1;
+        else
+            hi = mid;
     }
-    t->vf_corner = mesh->vertex_wedge;
-    t->face_in = malloc((nf ? nf : 1) * sizeof *t->face_in);
-    t->pseudo = calloc(nv ? nv : 1, sizeof *t->pseudo);
-    double *angle = calloc(nv ? nv : 1, sizeof *angle);
-    /* counting sort of the faces by their least vertex: cnt (nv + 1) */
-    int32_t *cnt = calloc(nv + 1, sizeof *cnt);
-    t->fan_a0 = malloc((nh ? nh : 1) * sizeof *t->fan_a0);
-    t->fan_total = malloc((nv ? nv : 1) * sizeof *t->fan_total);
-    t->height = malloc((nv ? nv : 1) * sizeof *t->height);
-    if (!t->fr_block || !t->face_in || !t->pseudo || !angle || !cnt ||
-        !t->fan_a0 || !t->fan_total || !t->height) {
-        free(angle);
-        free(cnt);
-        mfmm_exact_tables_destroy(t);
-        return MFMM_ERR_OUT_OF_MEMORY;
-    }
-    t->bytes = mfmm_exact_tables_bytes(mesh);
+    return t->tile_rec[T] = lo;
+}
+
+/* The tile of record i: its face's least vertex's. */
+static int32_t ex_tile_of_record(const mfmm_exact_tables *t, int32_t i)
+{
+    const int32_t *fv = t->mesh->face_records[t->rec_face[i]].v;
+    int32_t least = fv[0] < fv[1] ? fv[0] : fv[1];
+    return (least < fv[2] ? least : fv[2]) / EX_TILE;
+}
+
+/* Tile T's face records: the corners in the frames of the opposite edges,
+ * lengths and angles, the faces across, non-manifold and short edges. */
+static void ex_build_faces(mfmm_exact_tables *t, int32_t T)
+{
+    if (t->tile_state[T] & EX_TILE_FACES)
+        return;
+    const mfmm_mesh *mesh = t->mesh;
     const double *X = mesh->xyz;
     const mfmm_face *F = mesh->face_records;
-    for (size_t f = 0; f < nf; f++) {
+    int32_t i0 = ex_tile_first(t, T), i1 = T + 1 < t->n_tiles ? ex_tile_first(t, T + 1) : t->nf;
+    for (int32_t i = i0; i < i1; i++) {
+        int32_t f = t->rec_face[i];
         const int32_t *fv = F[f].v;
-        int32_t lo = fv[0] < fv[1] ? fv[0] : fv[1];
-        cnt[(lo < fv[2] ? lo : fv[2]) + 1]++;
-    }
-    for (size_t v = 0; v < nv; v++)
-        cnt[v + 1] += cnt[v];
-    for (size_t f = 0; f < nf; f++) {
-        const int32_t *fv = F[f].v;
-        int32_t lo = fv[0] < fv[1] ? fv[0] : fv[1];
-        t->face_in[f] = cnt[lo < fv[2] ? lo : fv[2]]++;
-    }
-    free(cnt);
-    for (size_t f = 0; f < nf; f++) {
-        const int32_t *fv = F[f].v;
-        int bad = mfmm_mesh_degenerate(mesh, (int32_t)f);
-        ex_face *r = t->fr + t->face_in[f];
+        int bad = mfmm_mesh_degenerate(mesh, f);
+        ex_face *r = t->fr + i;
         memset(r, 0, sizeof *r);
         for (int k = 0; k < 3; k++) {
             r->len[k] = vdist(X + 3 * (size_t)fv[(k + 1) % 3], X + 3 * (size_t)fv[(k + 2) % 3]);
@@ -344,104 +286,327 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
         }
         if (bad)
             ex_lay_on_line(X, r);
-        r->skip = (uint8_t)(bad ? 1 : mfmm_mesh_copy(mesh, (int32_t)f) ? 2 : 0);
-    }
-    for (size_t f = 0; f < nf; f++) {
-        const int32_t *fv = F[f].v;
-        ex_face *r = t->fr + t->face_in[f];
+        r->skip = (uint8_t)(bad ? 1 : mfmm_mesh_copy(mesh, f) ? 2 : 0);
         for (int k = 0; k < 3; k++) {
-            int32_t g = mesh->face_neighbor[3 * f + k];
+            int32_t g = mesh->face_neighbor[3 * (size_t)f + k];
             r->across[k] = -1;
             r->flip[k] = 0;
-            if (g < 0 || r->skip == 2 || t->fr[t->face_in[g]].skip == 2)
-                continue;
-            int32_t a = fv[(k + 1) % 3], b = fv[(k + 2) % 3];
-            const int32_t *gv = F[g].v;
-            for (int m = 0; m < 3; m++) {
-                if (gv[m] != a && gv[m] != b) {
-                    /* into a zero-area face: -2 - its half-edge (ex_pass) */
-                    int32_t hg = 3 * t->face_in[g] + m;
-                    r->across[k] = t->fr[t->face_in[g]].skip ? -2 - hg : hg;
-                    r->flip[k] = gv[(m + 1) % 3] != a;
+            int gskip = g < 0 ? 0 : ex_mesh_skip(mesh, g);
+            if (g >= 0 && r->skip != 2 && gskip != 2) {
+                int32_t a = fv[(k + 1) % 3], b = fv[(k + 2) % 3];
+                const int32_t *gv = F[g].v;
+                for (int m = 0; m < 3; m++) {
+                    if (gv[m] != a && gv[m] != b) {
+                        /* into a zero-area face: -2 - its half-edge (ex_pass) */
+                        int32_t hg = 3 * t->face_in[g] + m;
+                        r->across[k] = gskip ? -2 - hg : hg;
+                        r->flip[k] = gv[(m + 1) % 3] != a;
+                    }
                 }
             }
+            if (r->across[k] == -1 && t->n_nm > 0 && ex_is_nonmanifold(t, 3 * i + k))
+                r->flip[k] = 2;
+            ex_wall_short_edge(t, r, k);
         }
-    }
-    /* pseudo-source candidates: saddles, vertices at a wall, and vertices of
-     * zero-area faces; unreferenced vertices have nothing to start */
-    for (size_t f = 0; f < nf; f++) {
-        const ex_face *r = t->fr + f;
-        const int32_t *fv = r->v;
-        if (r->skip) {
-            for (int k = 0; k < 3 && r->skip == 1; k++)
-                t->pseudo[fv[k]] = 1;
-            continue;
-        }
-        for (int k = 0; k < 3; k++) {
-            /* angle at corner k, seen in the frame of the opposite edge */
-            double x = r->cx[k], y = r->cy[k], L = r->len[k];
-            double a = atan2(y * L, y * y - x * (L - x));
-            t->fr[f].angle[k] = a;
-            angle[fv[k]] += a;
-            if (r->across[k] < 0) { /* a wall, or a zero-area face */
-                t->pseudo[fv[(k + 1) % 3]] = 1;
-                t->pseudo[fv[(k + 2) % 3]] = 1;
+        if (!r->skip)
+            for (int k = 0; k < 3; k++) {
+                /* angle at corner k, seen in the frame of the opposite edge */
+                double x = r->cx[k], y = r->cy[k], L = r->len[k];
+                r->angle[k] = atan2(y * L, y * y - x * (L - x));
             }
+    }
+    t->tile_state[T] |= EX_TILE_FACES;
+    t->bytes += (size_t)(i1 - i0) * (sizeof(ex_face) + 3 * sizeof(double));
+}
+
+/* Walks the fan of v through the faces across its edges, giving each
+ * corner its angles (fan_a0, fan_sgn) and v its angle sum; NaN where v's
+ * corners do not form one closed disk. */
+static void ex_build_fan(mfmm_exact_tables *t, int32_t v)
+{
+    /* copies (skip 2) apart; a zero-area face (skip 1) ends the fan */
+    int32_t n_c = 0, c0 = -1;
+    int ok = 1;
+    t->fan_total[v] = NAN;
+    for (int32_t i = t->vf_offset[v]; i < t->vf_offset[v + 1]; i++) {
+        int32_t c = ex_corner(t->vf_corner, t->face_in, i);
+        if (t->fr[c / 3].skip == 1)
+            ok = 0;
+        if (t->fr[c / 3].skip == 0) {
+            c0 = c0 < 0 ? c : c0;
+            n_c++;
         }
     }
-    for (size_t v = 0; v < nv; v++)
-        if (angle[v] > EX_TWO_PI + EX_SADDLE_TOL)
-            t->pseudo[v] = 1;
-    free(angle);
-    if (ex_link_nonmanifold(t) != 0) {
-        mfmm_exact_tables_destroy(t);
-        return MFMM_ERR_OUT_OF_MEMORY;
-    }
-    ex_wall_short_edges(t);
-    double sum_len = 0.0;
-    size_t n_len = 0;
-    for (size_t hh = 0; hh < nh; hh++) {
-        if (!t->fr[hh / 3].skip) {
-            sum_len += t->fr[hh / 3].len[hh % 3];
-            n_len++;
+    if (!ok || n_c < 3)
+        return;
+    int32_t f = c0 / 3, k = c0 % 3;
+    int32_t ent = t->fr[f].v[(k + 1) % 3];
+    double e = 0.0;
+    int32_t steps = 0;
+    for (;;) {
+        const int32_t *fv = t->fr[f].v;
+        int32_t c = 3 * f + k, far;
+        int kent;
+        if (fv[(k + 1) % 3] == ent) {
+            t->fan_a0[c] = e;
+            t->fr[f].sgn[k] = 1;
+            far = fv[(k + 2) % 3];
+            kent = (k + 1) % 3;
+        } else {
+            t->fan_a0[c] = e + t->fr[f].angle[k];
+            t->fr[f].sgn[k] = -1;
+            far = fv[(k + 1) % 3];
+            kent = (k + 2) % 3;
+        }
+        e += t->fr[f].angle[k];
+        steps++;
+        int32_t nx = t->fr[f].across[kent];
+        if (nx < 0 || steps > n_c) {
+            ok = 0;
+            break;
+        }
+        f = nx / 3;
+        k = ex_corner_of(t->fr[f].v, v);
+        ent = far;
+        if (k < 0) {
+            ok = 0;
+            break;
+        }
+        if (3 * f + k == c0) {
+            ok = steps == n_c && t->fr[f].v[(k + 1) % 3] == ent;
+            break;
         }
     }
-    double width = n_len ? EX_BUCKET_WIDTH * sum_len / (double)n_len : 1.0;
-    t->inv_w = width > 0.0 && isfinite(1.0 / width) ? 1.0 / width : 1.0;
-    ex_build_fans(t);
-    /* a vertex whose faces are not one closed fan (several fans meeting at
-     * it, as two copies of a face make a closed fan of their own) joins
-     * parts of the surface that share no edge: only a pseudo-source there
-     * carries distances from one part to the other (a fuzzed mesh's doubled
-     * face left d(20) 0.10 above d(27) + |20 27|) */
-    for (size_t v = 0; v < nv; v++)
-        if (t->vf_offset[v + 1] > t->vf_offset[v] && isnan(t->fan_total[v]))
-            t->pseudo[v] = 1;
-    for (size_t v = 0; v < nv; v++) {
-        double h = INFINITY;
-        for (int32_t j = t->vf_offset[v]; j < t->vf_offset[v + 1]; j++) {
-            int32_t c = ex_corner(t->vf_corner, t->face_in, j);
-            const ex_face *r = t->fr + c / 3;
-            if (r->skip == 1) {
-                /* a path may reach v along a zero-area face's edge, or
-                 * through it from a face that has v on an edge (ex_pass):
-                 * no height bounds its last segment */
-                h = 0.0;
-                break;
-            }
-            if (!r->skip && r->cy[c % 3] < h)
-                h = r->cy[c % 3];
+    if (ok)
+        t->fan_total[v] = e;
+}
+
+/* Vertex v's fan, least height, and whether it may bend a path (pseudo):
+ * a saddle, at a wall or on a zero-area face, or where its faces are not
+ * one closed fan (several fans meeting at it, as two copies of a face make
+ * a closed fan of their own, join parts of the surface that share no edge:
+ * only a pseudo-source there carries distances from one part to the
+ * other). Builds the records of every face at v first. */
+static void ex_build_vertex(mfmm_exact_tables *t, int32_t v)
+{
+    if (t->vertex_done[v])
+        return;
+    for (int32_t i = t->vf_offset[v]; i < t->vf_offset[v + 1]; i++)
+        ex_build_faces(t, ex_tile_of_record(t, ex_corner(t->vf_corner, t->face_in, i) / 3));
+    int pseudo = 0;
+    double sum = 0.0, h = INFINITY;
+    for (int32_t i = t->vf_offset[v]; i < t->vf_offset[v + 1]; i++) {
+        int32_t c = ex_corner(t->vf_corner, t->face_in, i);
+        const ex_face *r = t->fr + c / 3;
+        int k = c % 3;
+        if (r->skip == 1) {
+            /* a path may reach v along a zero-area face's edge, or through
+             * it from a face that has v on an edge (ex_pass): no height
+             * bounds its last segment */
+            pseudo = 1;
+            h = 0.0;
+        } else if (r->skip == 0) {
+            sum += r->angle[k];
+            pseudo |= r->across[ex_next[k]] < 0 || r->across[ex_prev[k]] < 0;
+            h = fmin(h, r->cy[k]);
         }
-        t->height[v] = h;
     }
-    for (int32_t f = 0; f < t->nf; f++) {
-        ex_face *r = t->fr + f;
+    ex_build_fan(t, v);
+    if (sum > EX_TWO_PI + EX_SADDLE_TOL ||
+        (t->vf_offset[v + 1] > t->vf_offset[v] && isnan(t->fan_total[v])))
+        pseudo = 1;
+    t->pseudo[v] = (uint8_t)pseudo;
+    t->height[v] = h;
+    t->vertex_done[v] = 1;
+    t->bytes += 2 + 2 * sizeof(double);
+}
+
+/* Tile T ready to be read: its records, and the fans and flags of their
+ * vertices (and so the records of every face at those). */
+static void ex_build_tile(mfmm_exact_tables *t, int32_t T)
+{
+    if (t->tile_state[T] & EX_TILE_READY)
+        return;
+    int32_t i0 = ex_tile_first(t, T), i1 = T + 1 < t->n_tiles ? ex_tile_first(t, T + 1) : t->nf;
+    ex_build_faces(t, T);
+    for (int32_t i = i0; i < i1; i++)
+        for (int k = 0; k < 3; k++)
+            ex_build_vertex(t, t->fr[i].v[k]);
+    for (int32_t i = i0; i < i1; i++) {
+        ex_face *r = t->fr + i;
         r->tie = 0;
         for (int k = 0; k < 3; k++)
             r->tie |= (uint8_t)((t->pseudo[r->v[k]] ? 0 : 1) << k);
     }
+    t->tile_state[T] |= EX_TILE_READY;
+    t->n_ready++;
+}
+
+size_t mfmm_exact_tables_bytes(const mfmm_mesh *mesh)
+{
+    size_t nv = (size_t)mesh->nv, nf = (size_t)mesh->nf;
+    size_t n_tiles = (nv + EX_TILE - 1) / EX_TILE;
+    return sizeof(mfmm_exact_tables) + nf * sizeof(ex_face) + 64 +
+           nf * ((mesh->piece_next ? 2 : 1) * sizeof(int32_t) + 3 * sizeof(double)) +
+           nv * (2 + 2 * sizeof(double)) + n_tiles * (sizeof(int32_t) + 1 + 6 * sizeof(double));
+}
+
+mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **out)
+{
+    if (!out)
+        return MFMM_ERR_NULL_POINTER;
+    *out = NULL;
+    if (!mesh)
+        return MFMM_ERR_NULL_POINTER;
+    if (mesh->nf > INT32_MAX / 3 - 1 || (size_t)mesh->nf > (SIZE_MAX - 64) / sizeof(ex_face))
+        return MFMM_ERR_BAD_COUNT;
+    mfmm_exact_tables *t = calloc(1, sizeof *t);
+    if (!t)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    size_t nv = (size_t)mesh->nv, nf = (size_t)mesh->nf, nh = 3 * nf;
+    t->mesh = mesh;
+    t->nv = mesh->nv;
+    t->nf = mesh->nf;
+    t->vf_offset = mesh->vertex_face_offset;
+    t->vf_corner = mesh->vertex_wedge;
+    t->n_tiles = (int32_t)((nv + EX_TILE - 1) / EX_TILE);
+    size_t n_tiles = (size_t)t->n_tiles;
+    /* the arrays that tiles fill are left untouched (their pages unused)
+     * until a tile is built */
+    t->fr_block = malloc((nf ? nf : 1) * sizeof(ex_face) + 64);
+    if (t->fr_block) {
+        uintptr_t a = (uintptr_t)t->fr_block;
+        t->fr = (ex_face *)(void *)((char *)t->fr_block + ((64 - a % 64) % 64));
+    }
+    t->face_in = malloc((nf ? nf : 1) * sizeof *t->face_in);
+    t->pseudo = malloc(nv ? nv : 1);
+    t->fan_a0 = malloc((nh ? nh : 1) * sizeof *t->fan_a0);
+    t->fan_total = malloc((nv ? nv : 1) * sizeof *t->fan_total);
+    t->height = malloc((nv ? nv : 1) * sizeof *t->height);
+    t->tile_rec = malloc((n_tiles + 1) * sizeof *t->tile_rec);
+    t->tile_state = calloc(n_tiles ? n_tiles : 1, 1);
+    t->vertex_done = calloc(nv ? nv : 1, 1);
+    t->tile_box = malloc((n_tiles ? n_tiles : 1) * 6 * sizeof *t->tile_box);
+    if (!t->fr_block || !t->face_in || !t->pseudo || !t->fan_a0 || !t->fan_total ||
+        !t->height || !t->tile_rec || !t->tile_state || !t->vertex_done || !t->tile_box) {
+        mfmm_exact_tables_destroy(t);
+        return MFMM_ERR_OUT_OF_MEMORY;
+    }
+#if MFMM_POISON_UNBUILT
+    /* vertex ids -1 and NaN lengths: a run that reads a tile it did not
+     * build faults under the sanitizers instead of reading zeros */
+    memset(t->fr_block, 0xff, (nf ? nf : 1) * sizeof(ex_face) + 64);
+    memset(t->fan_a0, 0xff, (nh ? nh : 1) * sizeof *t->fan_a0);
+    memset(t->pseudo, 0xff, nv ? nv : 1);
+    memset(t->fan_total, 0xff, (nv ? nv : 1) * sizeof *t->fan_total);
+    memset(t->height, 0xff, (nv ? nv : 1) * sizeof *t->height);
+#endif
+    const mfmm_face *F = mesh->face_records;
+    for (size_t T = 0; T <= n_tiles; T++)
+        t->tile_rec[T] = -1;
+    if (!mesh->piece_next) {
+        /* faces are in the order of their least vertex (order.h): records
+         * in face order, found per tile when built (ex_tile_first) */
+        for (size_t f = 0; f < nf; f++)
+            t->face_in[f] = (int32_t)f;
+        t->rec_face = t->face_in;
+    } else {
+        /* pieces of faces cut at T-junctions follow the faces: a counting
+         * sort of the faces by their least vertex, so that a patch's
+         * records lie together in memory */
+        int32_t *cnt = calloc(nv + 1, sizeof *cnt);
+        t->rec_face = malloc((nf ? nf : 1) * sizeof *t->rec_face);
+        if (!cnt || !t->rec_face) {
+            free(cnt);
+            mfmm_exact_tables_destroy(t);
+            return MFMM_ERR_OUT_OF_MEMORY;
+        }
+        for (size_t f = 0; f < nf; f++) {
+            const int32_t *fv = F[f].v;
+            int32_t lo = fv[0] < fv[1] ? fv[0] : fv[1];
+            cnt[(lo < fv[2] ? lo : fv[2]) + 1]++;
+        }
+        for (size_t v = 0; v < nv; v++)
+            cnt[v + 1] += cnt[v];
+        for (size_t T = 0; T < n_tiles; T++)
+            t->tile_rec[T] = cnt[T * EX_TILE];
+        for (size_t f = 0; f < nf; f++) {
+            const int32_t *fv = F[f].v;
+            int32_t lo = fv[0] < fv[1] ? fv[0] : fv[1];
+            t->face_in[f] = cnt[lo < fv[2] ? lo : fv[2]]++;
+            t->rec_face[t->face_in[f]] = (int32_t)f;
+        }
+        free(cnt);
+    }
+    for (size_t T = 0; T < n_tiles; T++) {
+        double *b = t->tile_box + 6 * T;
+        for (int j = 0; j < 3; j++) {
+            b[j] = INFINITY;
+            b[3 + j] = -INFINITY;
+        }
+        for (size_t v = T * EX_TILE; v < (T + 1) * EX_TILE && v < nv; v++)
+            for (int j = 0; j < 3; j++) {
+                b[j] = fmin(b[j], mesh->xyz[3 * v + j]);
+                b[3 + j] = fmax(b[3 + j], mesh->xyz[3 * v + j]);
+            }
+    }
+    /* a tile's records lie within an edge of its vertices, the faces and
+     * vertices they lead to within another, and a window may pass through
+     * EX_MAX_PASS zero-area faces in a row (ex_pass) */
+    double L = mesh->info.max_edge_length;
+    t->pad = (3.0 + (mesh->info.n_degenerate_faces > 0 ? EX_MAX_PASS : 0)) * L;
+    if (!isfinite(t->pad))
+        t->pad = INFINITY;
+    t->short_len = 2.0 * EX_SHORT_EDGE * L;
+    if (!(t->short_len < INFINITY))
+        t->short_len = INFINITY;
+    double width = EX_BUCKET_WIDTH * mesh->info.mean_edge_length;
+    t->inv_w = width > 0.0 && isfinite(1.0 / width) ? 1.0 / width : 1.0;
+    if (ex_link_nonmanifold(t) != 0) {
+        mfmm_exact_tables_destroy(t);
+        return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    t->full_bytes = mfmm_exact_tables_bytes(mesh) + 2 * (size_t)t->n_nm * sizeof(int32_t);
+    t->bytes = t->full_bytes - nf * (sizeof(ex_face) + 3 * sizeof(double)) -
+               nv * (2 + 2 * sizeof(double));
     *out = t;
     return MFMM_OK;
+}
+
+/* The distance from point p to tile T's box. */
+static double ex_box_distance(const double *b, const double *p)
+{
+    double s = 0.0;
+    for (int j = 0; j < 3; j++) {
+        double d = fmax(b[j] - p[j], fmax(p[j] - b[3 + j], 0.0));
+        s += d * d;
+    }
+    return sqrt(s);
+}
+
+void mfmm_exact_tables_ensure(const mfmm_exact_tables *tables, const double *points, int32_t n,
+                              double radius)
+{
+    /* the tiles are the tables' one mutable part, guarded by the mesh's lock */
+    mfmm_exact_tables *t = (mfmm_exact_tables *)(uintptr_t)tables;
+    mfmm_mesh *m = (mfmm_mesh *)(uintptr_t)t->mesh;
+    pthread_mutex_lock(&m->cache_lock);
+    if (t->n_ready < t->n_tiles) {
+        double reach = radius + t->pad;
+        int all = !points || !(reach < INFINITY);
+        for (int32_t T = 0; T < t->n_tiles; T++) {
+            if (t->tile_state[T] & EX_TILE_READY)
+                continue;
+            int near = all;
+            for (int32_t i = 0; i < n && !near; i++)
+                near = ex_box_distance(t->tile_box + 6 * T, points + 3 * i) <= reach;
+            if (near)
+                ex_build_tile(t, T);
+        }
+        if (m->exact_tables == t)
+            m->exact_tables_bytes = t->bytes;
+    }
+    pthread_mutex_unlock(&m->cache_lock);
 }
 
 static void tables_free(void *t)

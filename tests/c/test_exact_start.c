@@ -336,6 +336,65 @@ static void test_shared_tables(void **state)
     mfmm_free(F);
 }
 
+/* The tables are built where runs need them: a first solve on a fresh mesh
+ * builds a small share of them, and every row, from vertex or face
+ * sources, equals the row on the same mesh with all of them built, bit for
+ * bit (on the beetle's non-manifold edges too). */
+static void lazy_rows(mfmm_mesh *fresh, mfmm_mesh *full, int32_t nv, int32_t nf, double share)
+{
+    const mfmm_exact_tables *t = NULL;
+    assert_int_equal(mfmm_exact_tables_of(full, &t), MFMM_OK);
+    mfmm_exact_tables_ensure(t, NULL, 0, INFINITY);
+    size_t all = tm_memory_entry(full, "exact tables (once built)");
+    double *a = malloc((size_t)nv * sizeof *a), *b = malloc((size_t)nv * sizeof *b);
+    assert_non_null(a);
+    assert_non_null(b);
+    mfmm_solver *sa = NULL, *sb = NULL;
+    assert_int_equal(mfmm_solver_create(fresh, &sa), MFMM_OK);
+    assert_int_equal(mfmm_solver_create(full, &sb), MFMM_OK);
+    for (int k = 0; k < 4; k++) {
+        mfmm_source src = tm_vertex_source((int32_t)(((int64_t)nv * (2 * k + 1)) / 8));
+        if (k == 3) {
+            src.vertex = -1;
+            src.face = nf / 3;
+            src.bary[0] = 0.2;
+            src.bary[1] = 0.5;
+            src.bary[2] = 0.3;
+        }
+        assert_int_equal(mfmm_solve(sa, &src, 1, NULL, a, NULL), MFMM_OK);
+        if (k == 0) {
+            size_t first = tm_memory_entry(fresh, "exact tables (once built)");
+            print_message("first solve built %.1f %% of the exact tables\n", 100.0 * first / all);
+            assert_true(first > 0 && first <= share * all);
+        }
+        assert_int_equal(mfmm_solve(sb, &src, 1, NULL, b, NULL), MFMM_OK);
+        assert_memory_equal(a, b, (size_t)nv * sizeof *a);
+    }
+    mfmm_solver_destroy(sa);
+    mfmm_solver_destroy(sb);
+    free(a);
+    free(b);
+}
+
+static void test_lazy_tables(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh g = mfmm_gen_sine(300);
+    mfmm_mesh *fresh = tm_make(&g), *full = tm_make(&g);
+    lazy_rows(fresh, full, g.nv, g.nf, 0.1);
+    mfmm_mesh_destroy(fresh);
+    mfmm_mesh_destroy(full);
+    mfmm_gen_free(&g);
+    int32_t nv = 0, nf = 0, *F = NULL, *F2 = NULL;
+    fresh = tm_load_data("meshes/beetle.obj", &nv, &nf, &F);
+    full = tm_load_data("meshes/beetle.obj", &nv, &nf, &F2);
+    lazy_rows(fresh, full, nv, nf, 1.0);
+    mfmm_mesh_destroy(fresh);
+    mfmm_mesh_destroy(full);
+    mfmm_free(F);
+    mfmm_free(F2);
+}
+
 /* exact_start_radius 0 gives the rows of the plain start as the library gave
  * them before the option existed (values recorded from that build, commit
  * 7d9f5ad, which has no such option; %.17g round-trips): to a few ulps since
@@ -641,6 +700,7 @@ int main(void)
         cmocka_unit_test(test_patch_settles_early),
         cmocka_unit_test(test_never_worse),
         cmocka_unit_test(test_shared_tables),
+        cmocka_unit_test(test_lazy_tables),
         cmocka_unit_test(test_off_is_plain_start),
         cmocka_unit_test(test_saddle_corner_continuous),
         cmocka_unit_test(test_auto_radius),
