@@ -242,12 +242,14 @@ typedef enum mfmm_cost_location {
 
 typedef struct mfmm_solver mfmm_solver;
 
-/* Makes a reusable workspace for marches on one mesh, for one thread. The
- * first solve builds what later solves reuse (the exact start's workspace;
- * the mesh's shared tables, once per mesh, under a lock); after that a solve
- * allocates only copies of its arguments, and costs in proportion to what it
- * reaches (max_distance, targets) apart from filling `distances` (with
- * MFMM_METHOD_WINDOWS, also one pass over the mesh to clear its slots).
+/* Makes a reusable workspace for marches on one mesh, for one thread. Solves
+ * build what later solves reuse (the exact start's workspace; the mesh's
+ * shared tables, under a lock: the exact start's around the patches it
+ * solves, the march's spokes once marches have paid for them, section 10);
+ * a solve allocates only copies of its arguments, and costs in proportion
+ * to what it reaches (max_distance, targets) apart from filling `distances`
+ * (with MFMM_METHOD_WINDOWS, also one pass over the mesh to clear its
+ * slots).
  *   mesh: the mesh, which must outlive the solver.
  *   out:  receives the solver; NULL on failure.
  * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_OUT_OF_MEMORY. Thread-safe. */
@@ -388,8 +390,9 @@ typedef struct mfmm_exact_solver mfmm_exact_solver;
 
 /* Makes a workspace for exact solves on one mesh, for one thread; its window
  * queue grows as needed and is kept for the next solve. The mesh's edge
- * tables are built by the first exact solver or exact start on it (under a
- * lock) and shared by every solver on the mesh.
+ * tables are built where solves reach (under a lock; a solve to a
+ * max_distance builds them near its sources only) and shared by every
+ * solver on the mesh.
  *   mesh: the mesh, which must outlive the solver.
  *   out:  receives the solver; NULL on failure.
  * Errors: MFMM_ERR_NULL_POINTER; MFMM_ERR_OUT_OF_MEMORY. Thread-safe. */
@@ -781,9 +784,12 @@ struct mfmm_mesh_options {
      * keeps its plain stencil. Default 64; >= 1. */
     int32_t max_unfold_steps;
     /* 1 (default): marches at F = 1 with unfolding read per-vertex update
-     * records ("spokes"), built by the first such solve and kept with the
-     * mesh, for a shorter march. 0: never build them (less memory); the
-     * results are the same bit for bit. */
+     * records ("spokes", about 400 bytes a vertex) for a march about 0.7x
+     * as long, built once the mesh's marches have settled 8 times its
+     * vertices without them (about what building them costs; so a program
+     * that asks a few fields never pays for them), or by the first row of a
+     * distance matrix of 8 rows or more; kept with the mesh. 0: never build
+     * them (less memory). The results are the same bit for bit. */
     int32_t spokes;
 };
 
@@ -801,8 +807,8 @@ MFMM_API void mfmm_mesh_options_init(mfmm_mesh_options *options);
 #define MFMM_EXACT_START_AUTO_VERTICES 40000
 
 /* The memory a mesh holds, array by array (solvers' and calls' workspaces
- * apart); entries built on first use ("spokes (once built)", "exact tables
- * (once built)") count 0 until then.
+ * apart); entries built on use ("spokes (once built)", "exact tables
+ * (once built)": the part built so far) count 0 until then.
  *   names: (max,) out: each array's name, a static string of the library.
  *   bytes: (max,) out: its size in bytes.
  *   max:   room in names and bytes; 0 (with NULL arrays) to ask for the count.

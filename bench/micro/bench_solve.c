@@ -178,7 +178,7 @@ static double spoke_edges_time(const mfmm_mesh *mesh, int repeats, int n_sources
                                double *min_out)
 {
     mfmm_march_mesh m = mfmm_mesh_march_view(mesh);
-    if (mfmm_mesh_spokes_of(mesh, &m.spoke_offset, &m.spokes) != MFMM_OK || !m.spokes)
+    if (mfmm_mesh_spokes_of(mesh, 1, &m.spoke_offset, &m.spokes) != MFMM_OK || !m.spokes)
         return NAN;
     return time_runs(mesh, repeats, n_sources, spoke_edges, &m, times, min_out);
 }

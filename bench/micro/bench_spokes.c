@@ -34,7 +34,7 @@ static void bench(const char *name, const double *V, int32_t nv, const int32_t *
     }
     mfmm_march_mesh walk = mfmm_mesh_march_view(mesh), sp = walk;
     double t0 = now();
-    if (mfmm_mesh_spokes_of(mesh, &sp.spoke_offset, &sp.spokes) != MFMM_OK) {
+    if (mfmm_mesh_spokes_of(mesh, 1, &sp.spoke_offset, &sp.spokes) != MFMM_OK) {
         fprintf(stderr, "%s: out of memory for the spokes\n", name);
         mfmm_mesh_destroy(mesh);
         return;

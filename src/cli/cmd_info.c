@@ -126,8 +126,8 @@ int cmd_info(int argc, char **argv)
         printf("edge length max:       %.6g\n", m.max_edge_length);
         printf("edge length mean:      %.6g\n", m.mean_edge_length);
         printf("bbox diagonal:         %.6g\n", m.bbox_diagonal);
-        printf("mesh memory:           %.1f MB (%.0f bytes per vertex; a first solve adds\n"
-               "                       its spokes and exact tables, about 710 more)\n",
+        printf("mesh memory:           %.1f MB (%.0f bytes per vertex; solves add the\n"
+               "                       march's spokes and exact tables, up to about 730 more)\n",
                (double)mesh_bytes / 1e6, (double)mesh_bytes / (m.n_vertices > 0 ? m.n_vertices : 1));
     }
     if (m.n_coincident_vertices > 0)

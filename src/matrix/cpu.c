@@ -177,6 +177,7 @@ mfmm_status mfmm_rows_serial(const mfmm_rows_job *job, int32_t start, mfmm_error
     if (st != MFMM_OK)
         return mfmm_fail(err, st, -1, "could not create a solver");
     mfmm_solver_fix_cost(solver, job->cost, job->cost_location);
+    mfmm_solver_expect_rows(solver, job->n_sources);
     if (!direct)
         buf = calloc((size_t)block, row_bytes);
     if (!direct && !buf) {
@@ -269,8 +270,10 @@ static void *pool_worker(void *arg)
     const mfmm_rows_job *job = p->job;
     mfmm_solver *solver = NULL;
     mfmm_status st = mfmm_solver_create(job->mesh, &solver);
-    if (st == MFMM_OK)
+    if (st == MFMM_OK) {
         mfmm_solver_fix_cost(solver, job->cost, job->cost_location);
+        mfmm_solver_expect_rows(solver, job->n_sources);
+    }
     mfmm_solve_options so;
     fill_solve_options(job, &so);
     pthread_mutex_lock(&p->mu);

@@ -85,10 +85,13 @@ struct mfmm_mesh {
     void *exact_tables;
     void (*exact_tables_free)(void *);
     size_t exact_tables_bytes;
-    /* The march's spokes (spokes.c), built on the first march at F = 1 with
-     * unfolding, under cache_lock, then read-only; NULL until then, and
-     * always where spokes_allowed is 0 (mfmm_mesh_options.spokes). */
+    /* The march's spokes (spokes.c), built under cache_lock once marches at
+     * F = 1 with unfolding have settled MFMM_SPOKES_AFTER times nv vertices
+     * without them (spoke_credit), or for a job of many rows; then
+     * read-only. NULL until then, and always where spokes_allowed is 0
+     * (mfmm_mesh_options.spokes). */
     int spokes_allowed;
+    int64_t spoke_credit;
     int32_t *spoke_offset;     /* (nv+1,) CSR into spokes */
     mfmm_spoke *spokes;        /* 64-byte aligned, in spoke_block */
     void *spoke_block;

@@ -139,7 +139,7 @@ static mfmm_status spokes_build(mfmm_mesh *mesh)
     return MFMM_OK;
 }
 
-mfmm_status mfmm_mesh_spokes_of(const mfmm_mesh *mesh, const int32_t **offset,
+mfmm_status mfmm_mesh_spokes_of(const mfmm_mesh *mesh, int eager, const int32_t **offset,
                                 const mfmm_spoke **spokes)
 {
     /* the mesh's cache is the one mutable part of a built mesh (mesh.h) */
@@ -150,10 +150,21 @@ mfmm_status mfmm_mesh_spokes_of(const mfmm_mesh *mesh, const int32_t **offset,
     if (!m->spokes_allowed) /* set at creation: no lock needed */
         return MFMM_OK;
     pthread_mutex_lock(&m->cache_lock);
-    if (!m->spokes)
+    if (!m->spokes && (eager || m->spoke_credit >= (int64_t)MFMM_SPOKES_AFTER * m->nv))
         st = spokes_build(m);
     *offset = m->spoke_offset;
     *spokes = m->spokes;
     pthread_mutex_unlock(&m->cache_lock);
     return st;
+}
+
+void mfmm_mesh_spokes_count(const mfmm_mesh *mesh, int64_t settled)
+{
+    mfmm_mesh *m = (mfmm_mesh *)(uintptr_t)mesh;
+    if (!m->spokes_allowed || settled <= 0)
+        return;
+    pthread_mutex_lock(&m->cache_lock);
+    if (m->spoke_credit < INT64_MAX - settled)
+        m->spoke_credit += settled;
+    pthread_mutex_unlock(&m->cache_lock);
 }

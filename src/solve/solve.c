@@ -32,11 +32,12 @@ struct mfmm_solver {
     mfmm_slots *windows;  /* MFMM_METHOD_WINDOWS's workspace, made on first use */
     int64_t start_fallbacks; /* the last solve's (mfmm_solve_info) */
     mfmm_mapped_args args; /* mfmm_solve's arguments in internal order (order.h) */
-    /* the mesh's spokes (mfmm_mesh_spokes_of), asked for by the first march
-     * at F = 1 with unfolding; NULL then only if out of memory (the face
-     * walk gives the same rows) */
+    /* the mesh's spokes (mfmm_mesh_spokes_of), asked for by each march at
+     * F = 1 with unfolding until built (the face walk gives the same
+     * rows); many_rows: build them at once (mfmm_solver_expect_rows) */
     const int32_t *spoke_offset;
     const mfmm_spoke *spokes;
+    int many_rows;
 };
 
 mfmm_status mfmm_solver_create(const mfmm_mesh *mesh, mfmm_solver **out)
@@ -290,13 +291,17 @@ static int32_t solver_march(mfmm_solver *solver, const mfmm_source *sources, int
         }
     }
     mfmm_march_mesh mm = mfmm_mesh_march_view(mesh);
-    if (!s.cost && s.unfolding) {
+    int spoked = !s.cost && s.unfolding;
+    if (spoked) {
         if (!solver->spokes)
-            (void)mfmm_mesh_spokes_of(mesh, &solver->spoke_offset, &solver->spokes);
+            (void)mfmm_mesh_spokes_of(mesh, solver->many_rows, &solver->spoke_offset,
+                                      &solver->spokes);
         mm.spoke_offset = solver->spoke_offset;
         mm.spokes = solver->spokes;
     }
     int32_t settled = mfmm_march_run(&s, &mm);
+    if (spoked && !solver->spokes)
+        mfmm_mesh_spokes_count(mesh, settled);
     /* target flags on vertices never touched (touched ones: reset below) */
     for (int32_t i = 0; i < opt.n_targets; i++)
         s.label[opt.targets[i]] &= (uint8_t)MFMM_STATE_MASK;
@@ -355,4 +360,9 @@ mfmm_status mfmm_solve_mapped(mfmm_solver *solver, const mfmm_source *sources, i
     /* the one pass over the row: gathered into input order */
     mfmm_order_values_out(mesh, T, distances);
     return MFMM_OK;
+}
+
+void mfmm_solver_expect_rows(mfmm_solver *solver, int64_t n_rows)
+{
+    solver->many_rows = n_rows >= MFMM_SPOKES_AFTER;
 }

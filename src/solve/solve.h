@@ -27,6 +27,11 @@ int32_t mfmm_solve_local(mfmm_solver *solver, const mfmm_source *sources, int32_
  * mfmm_method that can take the cost given (has_cost). */
 mfmm_status mfmm_check_method(int method, int has_cost, mfmm_error *err);
 
+/* Tells a solver how many solves a job will ask of it on this mesh: with
+ * MFMM_SPOKES_AFTER or more, the first builds the march's spokes
+ * (mesh/spokes.h) instead of waiting for the marches to pay for them. */
+void mfmm_solver_expect_rows(mfmm_solver *solver, int64_t n_rows);
+
 /* The mesh a solver was made for. */
 const mfmm_mesh *mfmm_solver_mesh(const mfmm_solver *solver);
 

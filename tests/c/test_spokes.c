@@ -85,7 +85,7 @@ static void check_mesh(const mfmm_mesh *mesh, const char *name)
 {
     int32_t nv = mesh->nv;
     mfmm_march_mesh walk = mfmm_mesh_march_view(mesh), sp = walk;
-    assert_int_equal(mfmm_mesh_spokes_of(mesh, &sp.spoke_offset, &sp.spokes), MFMM_OK);
+    assert_int_equal(mfmm_mesh_spokes_of(mesh, 1, &sp.spoke_offset, &sp.spokes), MFMM_OK);
     assert_non_null(sp.spokes);
     ws a = ws_make(nv), b = ws_make(nv);
     double *ref = malloc(nv * sizeof *ref);
@@ -153,7 +153,8 @@ static size_t spoke_bytes(const mfmm_mesh *mesh)
     return tm_memory_entry(mesh, "spokes (once built)");
 }
 
-/* The memory report names the spokes once a march has built them. */
+/* The memory report names the spokes once the marches have built them
+ * (MFMM_SPOKES_AFTER full marches). */
 static void test_memory_report(void **state)
 {
     (void)state;
@@ -164,7 +165,10 @@ static void test_memory_report(void **state)
     mfmm_solver *solver = NULL;
     assert_int_equal(mfmm_solver_create(mesh, &solver), MFMM_OK);
     mfmm_source src = tm_vertex_source(0);
-    assert_int_equal(mfmm_solve(solver, &src, 1, NULL, d, NULL), MFMM_OK);
+    for (int q = 0; q <= MFMM_SPOKES_AFTER; q++) {
+        assert_int_equal(spoke_bytes(mesh), 0);
+        assert_int_equal(mfmm_solve(solver, &src, 1, NULL, d, NULL), MFMM_OK);
+    }
     /* a closed fan's wrap shares its spoke, so a closed genus-0 mesh holds
      * one spoke per neighbour, 2E = 6 nv - 12 (Euler), one per virtual
      * edge, and the offsets (nv + 1) */
@@ -192,7 +196,7 @@ static void test_spokes_off(void **state)
     assert_int_equal(mfmm_mesh_create(g.V, g.nv, g.F, g.nf, &mo, &off, NULL), MFMM_OK);
     const int32_t *offset = (const int32_t *)1;
     const mfmm_spoke *spokes = (const mfmm_spoke *)1;
-    assert_int_equal(mfmm_mesh_spokes_of(off, &offset, &spokes), MFMM_OK);
+    assert_int_equal(mfmm_mesh_spokes_of(off, 1, &offset, &spokes), MFMM_OK);
     assert_null(offset);
     assert_null(spokes);
     double *d_on = malloc((size_t)g.nv * sizeof *d_on), *d_off = malloc((size_t)g.nv * sizeof *d_off);
@@ -201,15 +205,19 @@ static void test_spokes_off(void **state)
     mfmm_solver *s_on = NULL, *s_off = NULL;
     assert_int_equal(mfmm_solver_create(on, &s_on), MFMM_OK);
     assert_int_equal(mfmm_solver_create(off, &s_off), MFMM_OK);
-    for (int q = 0; q < 4; q++) {
-        mfmm_source src = tm_vertex_source((int32_t)(((int64_t)g.nv * (2 * q + 1)) / 8));
+    /* the default mesh marches without its spokes until MFMM_SPOKES_AFTER
+     * full marches, then builds them: rows equal throughout */
+    for (int q = 0; q < MFMM_SPOKES_AFTER + 3; q++) {
+        mfmm_source src = tm_vertex_source((int32_t)(((int64_t)g.nv * (2 * q + 1)) / 24));
         assert_int_equal(mfmm_solve(s_on, &src, 1, NULL, d_on, NULL), MFMM_OK);
         assert_int_equal(mfmm_solve(s_off, &src, 1, NULL, d_off, NULL), MFMM_OK);
         assert_memory_equal(d_on, d_off, (size_t)g.nv * sizeof *d_on);
+        if (q == 0)
+            assert_int_equal(spoke_bytes(on), 0);
     }
     assert_int_equal(spoke_bytes(off), 0);
     assert_true(spoke_bytes(on) > 0);
-    assert_int_equal(mfmm_mesh_spokes_of(on, &offset, &spokes), MFMM_OK);
+    assert_int_equal(mfmm_mesh_spokes_of(on, 1, &offset, &spokes), MFMM_OK);
     assert_non_null(spokes);
     mfmm_solver_destroy(s_on);
     mfmm_solver_destroy(s_off);

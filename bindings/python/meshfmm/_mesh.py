@@ -68,7 +68,9 @@ class Mesh:
         corner (default 64).
     spokes : bool
         True (default): the march builds per-vertex update records (about
-        380 bytes per vertex, on the first solve, kept with the mesh).
+        400 bytes per vertex, kept with the mesh) once the mesh's solves
+        have marched over it 8 times without them, or for a distance
+        matrix of 8 rows or more.
         False puts memory first: the march walks the faces instead, with the
         same results bit for bit and a march 1.25-1.6x as long.
     weld : bool
@@ -418,8 +420,9 @@ class Mesh:
         """The bytes the mesh holds, array by array (``mfmm_mesh_memory``).
 
         "spokes (once built)" and "exact tables (once built)" are 0 until
-        the first solve that builds them (then kept with the mesh); solver
-        workspaces are not counted.
+        solves build them (then kept with the mesh; the exact tables grow
+        with the regions the exact start has solved); solver workspaces
+        are not counted.
 
         Returns
         -------

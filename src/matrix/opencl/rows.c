@@ -222,7 +222,7 @@ static mfmm_status run_upload(run *r, mfmm_error *err)
     const int32_t *spoke_offset = NULL;
     const mfmm_spoke *spokes = NULL;
     if (!job->cost && job->opt->unfolding)
-        (void)mfmm_mesh_spokes_of(mesh, &spoke_offset, &spokes);
+        (void)mfmm_mesh_spokes_of(mesh, 1, &spoke_offset, &spokes);
     r->use_spokes = spokes != NULL;
     if (e == CL_SUCCESS)
         mem[MB_SPOKEOFF] = api->clCreateBuffer(r->cl.context, ro, (r->use_spokes ? nv + 1 : 1) * sizeof(int32_t),
