@@ -51,32 +51,41 @@ typedef struct half_edge {
     int32_t lo, hi, corner;
 } half_edge;
 
-static int half_edge_cmp(const void *pa, const void *pb)
-{
-    const half_edge *a = pa, *b = pb;
-    if (a->lo != b->lo)
-        return a->lo < b->lo ? -1 : 1;
-    if (a->hi != b->hi)
-        return a->hi < b->hi ? -1 : 1;
-    return (a->corner > b->corner) - (a->corner < b->corner);
-}
-
 /* Face adjacency across edges, boundary and non-manifold counts, edge-length
  * statistics. */
 static mfmm_status build_edges(mfmm_mesh *m)
 {
     size_t nc = (size_t)m->nf * 3;
-    half_edge *he = malloc(nc * sizeof *he);
-    if (!he)
+    half_edge *he = malloc((nc ? nc : 1) * sizeof *he);
+    int32_t *lo = malloc((nc ? nc : 1) * sizeof *lo), *hi = malloc((nc ? nc : 1) * sizeof *hi);
+    int32_t *perm = malloc((nc ? nc : 1) * sizeof *perm), *tmp = malloc((nc ? nc : 1) * sizeof *tmp);
+    int32_t *count = malloc(((size_t)m->nv + 1) * sizeof *count);
+    if (!he || !lo || !hi || !perm || !tmp || !count) {
+        free(he);
+        free(lo);
+        free(hi);
+        free(perm);
+        free(tmp);
+        free(count);
         return MFMM_ERR_OUT_OF_MEMORY;
+    }
     for (size_t c = 0; c < nc; c++) {
         size_t f = c / 3, k = c % 3;
         int32_t u = m->face_records[f].v[(k + 1) % 3], v = m->face_records[f].v[(k + 2) % 3];
-        he[c].lo = u < v ? u : v;
-        he[c].hi = u < v ? v : u;
-        he[c].corner = (int32_t)c;
+        lo[c] = u < v ? u : v;
+        hi[c] = u < v ? v : u;
+        perm[c] = (int32_t)c;
     }
-    qsort(he, nc, sizeof *he, half_edge_cmp);
+    /* by (lo, hi, corner): two stable counting passes */
+    mfmm_order_counting(hi, m->nv, perm, tmp, nc, count);
+    mfmm_order_counting(lo, m->nv, tmp, perm, nc, count);
+    for (size_t i = 0; i < nc; i++)
+        he[i] = (half_edge){lo[perm[i]], hi[perm[i]], perm[i]};
+    free(lo);
+    free(hi);
+    free(perm);
+    free(tmp);
+    free(count);
     double sum = 0.0, lmin = INFINITY, lmax = 0.0;
     int32_t n_edges = 0, n_boundary = 0, n_nonmanifold = 0;
     for (size_t i = 0; i < nc;) {

@@ -105,48 +105,58 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_interna
     return MFMM_OK;
 }
 
-typedef struct face_key {
-    int32_t v[3]; /* the face's vertex ids, ascending */
-    int32_t id;
-} face_key;
-
-static int face_key_cmp(const void *pa, const void *pb)
+void mfmm_order_counting(const int32_t *key, int32_t n_keys, const int32_t *in, int32_t *out,
+                         size_t n, int32_t *count)
 {
-    const face_key *a = pa, *b = pb;
-    for (int k = 0; k < 3; k++)
-        if (a->v[k] != b->v[k])
-            return a->v[k] < b->v[k] ? -1 : 1;
-    return (a->id > b->id) - (a->id < b->id);
+    memset(count, 0, ((size_t)n_keys + 1) * sizeof *count);
+    for (size_t i = 0; i < n; i++)
+        count[key[in[i]] + 1]++;
+    for (int32_t k = 0; k < n_keys; k++)
+        count[k + 1] += count[k];
+    for (size_t i = 0; i < n; i++)
+        out[count[key[in[i]]]++] = in[i];
 }
 
 mfmm_status mfmm_order_faces(const int32_t *faces, int32_t nf, int32_t **to_internal,
                              int32_t **to_external)
 {
-    int32_t *in = malloc((size_t)nf * sizeof *in);
-    int32_t *ex = malloc((size_t)nf * sizeof *ex);
-    face_key *keys = malloc((size_t)nf * sizeof *keys);
-    if (!in || !ex || !keys) {
+    size_t n = (size_t)nf;
+    int32_t n_keys = 0;
+    for (size_t i = 0; i < 3 * n; i++)
+        n_keys = faces[i] + 1 > n_keys ? faces[i] + 1 : n_keys;
+    int32_t *in = malloc((n ? n : 1) * sizeof *in);
+    int32_t *ex = malloc((n ? n : 1) * sizeof *ex);
+    int32_t *v = calloc(n ? 3 * n : 1, sizeof *v);
+    int32_t *count = malloc(((size_t)n_keys + 1) * sizeof *count);
+    if (!in || !ex || !v || !count) {
         free(in);
         free(ex);
-        free(keys);
+        free(v);
+        free(count);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
-    for (int32_t f = 0; f < nf; f++) {
-        int32_t a = faces[3 * (size_t)f], b = faces[3 * (size_t)f + 1], c = faces[3 * (size_t)f + 2], t;
+    /* the faces' vertex ids ascending, as three columns */
+    for (size_t f = 0; f < n; f++) {
+        int32_t a = faces[3 * f], b = faces[3 * f + 1], c = faces[3 * f + 2], t;
         if (a > b)
             t = a, a = b, b = t;
         if (b > c)
             t = b, b = c, c = t;
         if (a > b)
             t = a, a = b, b = t;
-        keys[f] = (face_key){{a, b, c}, f};
+        v[f] = a;
+        v[n + f] = b;
+        v[2 * n + f] = c;
+        in[f] = (int32_t)f;
     }
-    qsort(keys, (size_t)nf, sizeof *keys, face_key_cmp);
-    for (int32_t i = 0; i < nf; i++) {
-        ex[i] = keys[i].id;
-        in[keys[i].id] = i;
-    }
-    free(keys);
+    /* by least vertex, then the other two, then input id */
+    mfmm_order_counting(v + 2 * n, n_keys, in, ex, n, count);
+    mfmm_order_counting(v + n, n_keys, ex, in, n, count);
+    mfmm_order_counting(v, n_keys, in, ex, n, count);
+    free(v);
+    free(count);
+    for (size_t i = 0; i < n; i++)
+        in[ex[i]] = (int32_t)i;
     *to_internal = in;
     *to_external = ex;
     return MFMM_OK;
