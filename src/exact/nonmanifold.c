@@ -77,7 +77,14 @@ int ex_dominate(const mfmm_exact_ws *ws, int32_t slot, double L, double *s0p,
             r[nr++] = q / A;
             if (q != 0.0)
                 r[nr++] = C / q;
-        } else if (A == 0.0 && B != 0.0) {
+        } else if (A != 0.0) {
+            /* equal sigmas make the quadratic a line squared (the
+             * bisector of the two pseudo-sources), whose double root
+             * rounding can leave complex: its vertex is taken as a root,
+             * harmless where there is none, as the signs are tested
+             * between the splits below */
+            r[nr++] = -B / (2.0 * A);
+        } else if (B != 0.0) {
             r[nr++] = -C / B;
         }
         double x[4];

@@ -16,6 +16,7 @@
 
 #include "testutil.h"
 #include "exact/exact.h"
+#include "exact/nonmanifold.h"
 #include "start/patch.h"
 #include "mesh/mesh.h"
 
@@ -613,6 +614,94 @@ static void test_nonmanifold_components(void **state)
     ex_free(&fx);
 }
 
+/* Two windows of equal sigma on a non-manifold edge (the same source
+ * unfolded round both sides of a vertex): where they are equal is the
+ * bisector of their pseudo-sources, a double root of ex_dominate's squared
+ * equation that rounding made complex about half the time, and the later
+ * window was then dropped whole, or kept whole, by the sign at the middle. */
+static void test_dominate_equal_sigma(void **state)
+{
+    (void)state;
+    mfmm_exact_ws ws;
+    memset(&ws, 0, sizeof ws);
+    int32_t head = 0;
+    ex_rec kept;
+    ws.nm_head = &head;
+    ws.rec = &kept;
+    uint64_t x = 88172645463325252u;
+    int bisected = 0;
+    for (int trial = 0; trial < 2000; trial++) {
+        double u[5];
+        for (int j = 0; j < 5; j++) {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            u[j] = (double)(x >> 11) / 9007199254740992.0;
+        }
+        double L = 0.5 + 2.0 * u[0], sigma = 3.0 * u[1];
+        double pa = L * (2.0 * u[2] - 0.5), qa = -(0.1 + u[3]) * L;
+        double pn = L * (2.0 * u[4] - 0.5), qn = -(0.1 + u[0] * u[3]) * L;
+        kept = (ex_rec){0.0, L, pa, qa, sigma, 0, -1};
+        /* where |X - N| = |X - K| on the edge (y = 0) */
+        double xb = (pa * pa + qa * qa - pn * pn - qn * qn) / (2.0 * (pa - pn));
+        double s0 = 0.0, s1 = L;
+        int left = ex_dominate(&ws, 0, L, &s0, &s1, pn, qn, sigma);
+        double eps = 1e-9 * L;
+        if (!(xb > eps && xb < L - eps))
+            continue;
+        bisected++;
+        /* the new window is the nearer on its own source's side */
+        assert_true(left);
+        if (pn < pa) {
+            tm_assert_close(s0, 0.0, eps);
+            tm_assert_close(s1, xb, eps);
+        } else {
+            tm_assert_close(s0, xb, eps);
+            tm_assert_close(s1, L, eps);
+        }
+    }
+    assert_true(bisected > 500);
+}
+
+/* A fuzzed mesh (tests/fuzz/regressions/exact/crash-7db1014c..., reduced
+ * to the faces that keep it) of folded fans on non-manifold edges: the
+ * distance between every two vertices is the same both ways. From 6 the
+ * window round the far side of vertex 7 was dropped at edge 4-5 by the one
+ * round the near side (ex_dominate's lost bisector), 2.510413 against
+ * 2.509031 from 2; a graph of 200 points an edge, joined straight within
+ * each face, gives 2.509055, a real path 2.4e-5 longer. */
+static void test_nonmanifold_symmetric(void **state)
+{
+    (void)state;
+    static const double V[39] = {
+        4.125, 4, 3.25, 3.875, 4.75, 3.75, 3.25, 4.125, 3.125, 4.625, 4.5, 3.75,
+        3.25, 4.25, 3.375, 4.75, 4.625, 3.875, 4.25, 4.125, 3.5, 4, 4.875, 3.875,
+        4.5, 4.375, 3.625, 4.125, 5, 4, 3.625, 4.5, 3.5, 4.25, 5.125, 4.125,
+        5, 4.875, 4.125};
+    static const int32_t F[30] = {0, 1, 2, 1, 3, 0, 4, 5, 0, 5, 1, 4, 6, 7, 4,
+                                  7, 5, 6, 8, 9, 10, 11, 12, 3, 0, 5, 1, 4, 7, 5};
+    mfmm_gen_mesh g = ex_alloc(13, 10);
+    memcpy(g.V, V, sizeof V);
+    memcpy(g.F, F, sizeof F);
+    ex_fx fx = ex_make(g);
+    double D[13][13];
+    for (int32_t a = 0; a < 13; a++) {
+        mfmm_source s = tm_vertex_source(a);
+        ex_solve(&fx, &s, 1, NULL);
+        memcpy(D[a], fx.d, sizeof D[a]);
+    }
+    for (int a = 0; a < 13; a++)
+        for (int b = a + 1; b < 13; b++) {
+            if (isinf(D[a][b]) || isinf(D[b][a])) {
+                assert_true(D[a][b] == D[b][a]);
+                continue;
+            }
+            tm_assert_close(D[a][b], D[b][a], 1e-12 * D[a][b]);
+        }
+    tm_assert_close(D[6][2], 2.509031428195, 1e-9);
+    ex_free(&fx);
+}
+
 /* A zero-area face refuses a source; the rest is exact, and its vertex in
  * the middle of the edge it shares, reached through it (ex_pass), is at its
  * Euclidean distance too (it was +inf, behind a wall). */
@@ -1113,6 +1202,8 @@ int main(void)
         cmocka_unit_test(test_interrupt),
         cmocka_unit_test(test_stalled_run_ends_within_bounds),
         cmocka_unit_test(test_nonmanifold_components),
+        cmocka_unit_test(test_dominate_equal_sigma),
+        cmocka_unit_test(test_nonmanifold_symmetric),
         cmocka_unit_test(test_degenerate_face),
         cmocka_unit_test(test_memory_limit),
         cmocka_unit_test(test_threads),
