@@ -35,12 +35,14 @@ int ex_dominate(const mfmm_exact_ws *ws, int32_t slot, double L, double *s0p,
          * half of its fan that gave d(20) 4.24, not 4.41). Nor may a kept
          * window that reaches I as soon drop it: the paths that bend at I
          * are this window's alone. It goes only when it is a kept one come
-         * round again (alike to rounding, as below). */
+         * round again (alike to rounding, as below) over no more than that
+         * one's interval, whose directions alone are carried already. */
         for (int32_t i = ws->nm_head[slot]; i >= 0; i = ws->rec[i].next) {
             const ex_rec *a = ws->rec + i;
             double ds = (sigma - a->sigma) * il, pa = a->px * il, qa = a->py * il;
             if (fabs(ds) + fabs(pw - pa) + fabs(qw - qa) <=
-                EX_TIE * (1.0 + fabs(sigma * il) + fabs(pw) + fabs(qw)))
+                    EX_TIE * (1.0 + fabs(sigma * il) + fabs(pw) + fabs(qw)) &&
+                a->b0 * il <= s0 + EX_POS_TOL && a->b1 * il >= s1 - EX_POS_TOL)
                 return 0;
         }
         return 1;
@@ -77,7 +79,14 @@ int ex_dominate(const mfmm_exact_ws *ws, int32_t slot, double L, double *s0p,
             r[nr++] = q / A;
             if (q != 0.0)
                 r[nr++] = C / q;
-        } else if (A == 0.0 && B != 0.0) {
+        } else if (A != 0.0) {
+            /* equal sigmas make the quadratic a line squared (the
+             * bisector of the two pseudo-sources), whose double root
+             * rounding can leave complex: its vertex is taken as a root,
+             * harmless where there is none, as the signs are tested
+             * between the splits below */
+            r[nr++] = -B / (2.0 * A);
+        } else if (B != 0.0) {
             r[nr++] = -C / B;
         }
         double x[4];

@@ -105,7 +105,7 @@ static void ex_pass(mfmm_exact_ws *ws, int32_t hd, int flip, double L, double s0
     t[k] = r->cx[k];
     if (!isfinite(t[k]))
         return;
-    ws->pass_depth++;
+    ws->pass_face[ws->pass_depth++] = hd / 3;
     for (int j = 0; j < 3; j++) {
         if (j == k)
             continue;
@@ -237,17 +237,28 @@ static void ex_fan_out(mfmm_exact_ws *ws, int32_t h, int32_t va, int32_t vb, dou
         i = ex_nm_slot(ws, g);
         const ex_face *q = ws->fr + g / 3;
         int fl = q->v[ex_next[g % 3]] != va;
+        /* in g's frame (its ends swapped when it runs from vb to va) */
+        double n0 = fl ? L - s1 : s0, n1 = fl ? L - s0 : s1, npx = fl ? L - ix : ix;
         if (q->skip == 1) {
-            /* (not from within a pass: zero-area faces meeting at such
-             * edges would pass a window round among themselves) */
-            if (ws->pass_depth == 0)
-                ex_pass(ws, g, fl, L, s0, s1, ix, iy, sigma);
+            /* not into a face the window is passing through already: the
+             * faces of a pass lie on one line, so that adds no path, and
+             * zero-area faces meeting at such edges would pass a window
+             * round among themselves */
+            int in_pass = 0;
+            for (int j = 0; j < ws->pass_depth; j++)
+                in_pass |= ws->pass_face[j] == g / 3;
+            /* trimmed against the windows kept there as into a face of
+             * area (the pass goes on straight, in the same plane), so that
+             * copies of one window reaching it by several passes do not
+             * each go on */
+            if (in_pass || i < 0 || !ex_dominate(ws, i, L, &n0, &n1, npx, -iy, sigma))
+                continue;
+            ex_keep(ws, i, n0, n1, npx, -iy, sigma);
+            ex_pass(ws, g, fl, L, fl ? L - n1 : n0, fl ? L - n0 : n1, ix, iy, sigma);
             continue;
         }
         if (i < 0)
             return;
-        /* in g's frame (its ends swapped when it runs from vb to va) */
-        double n0 = fl ? L - s1 : s0, n1 = fl ? L - s0 : s1, npx = fl ? L - ix : ix;
         if (!ex_dominate(ws, i, L, &n0, &n1, npx, -iy, sigma))
             continue;
         ex_keep(ws, i, n0, n1, npx, -iy, sigma);

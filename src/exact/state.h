@@ -179,6 +179,7 @@ struct mfmm_exact_solver {
     int (*interrupt)(void *user); /* mfmm_exact_options' (NULL for a patch) */
     void *interrupt_user;
     int pass_depth; /* zero-area faces a window is passing through (ex_pass) */
+    int32_t pass_face[EX_MAX_PASS]; /* those faces' records, outermost first */
     /* with non-manifold edges crossed, windows past a budget (over_budget):
      * the run is redone with those edges as walls (walls; ex_run); past it
      * otherwise, the run stops (stalled) and edge paths finish it */

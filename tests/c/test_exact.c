@@ -16,6 +16,7 @@
 
 #include "testutil.h"
 #include "exact/exact.h"
+#include "exact/nonmanifold.h"
 #include "start/patch.h"
 #include "mesh/mesh.h"
 
@@ -574,6 +575,50 @@ static void test_stalled_run_ends_within_bounds(void **state)
     ex_free(&fx);
 }
 
+/* A run past its window budget (made tiny here) that crossed non-manifold
+ * edges is redone with them as walls, and says so: on a grid with a fin on
+ * an edge by the source, every value finite and at least the exact one
+ * (paths round the walls, or edge paths where that run stalls too), the
+ * fallback no fuzzed mesh reaches once passes through needles on such
+ * edges are trimmed like windows into faces. */
+static void test_nonmanifold_walls_past_budget(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh grid = mfmm_gen_grid(50);
+    int32_t src = 25 * 51 + 3, f0 = 0;
+    while (grid.F[3 * f0] != src)
+        f0++;
+    mfmm_gen_mesh g = ex_alloc(grid.nv + 1, grid.nf + 1);
+    memcpy(g.V, grid.V, (size_t)grid.nv * 3 * sizeof(double));
+    memcpy(g.F, grid.F, (size_t)grid.nf * 3 * sizeof(int32_t));
+    int32_t a = grid.F[3 * f0], b = grid.F[3 * f0 + 1];
+    for (int k = 0; k < 3; k++)
+        g.V[3 * grid.nv + k] = 0.5 * (g.V[3 * a + k] + g.V[3 * b + k]);
+    g.V[3 * grid.nv + 2] += 0.02;
+    g.F[3 * grid.nf] = a;
+    g.F[3 * grid.nf + 1] = b;
+    g.F[3 * grid.nf + 2] = grid.nv;
+    mfmm_gen_free(&grid);
+    ex_fx fx = ex_make(g);
+    int32_t nv = fx.g.nv;
+    mfmm_source s = tm_vertex_source(src);
+    mfmm_exact_info info = {.struct_size = sizeof info};
+    mfmm_error err;
+    ex_solve(&fx, &s, 1, NULL);
+    double *exact = malloc((size_t)nv * sizeof *exact);
+    assert_non_null(exact);
+    memcpy(exact, fx.d, (size_t)nv * sizeof *exact);
+    mfmm_exact_ws_set_budget(fx.solver, 0.05);
+    assert_int_equal(mfmm_solve_exact(fx.solver, &s, 1, NULL, fx.d, &info, &err), MFMM_OK);
+    assert_int_equal(info.nonmanifold_walls, 1);
+    for (int32_t v = 0; v < nv; v++) {
+        assert_true(isfinite(fx.d[v]));
+        assert_true(fx.d[v] >= exact[v] * (1.0 - 1e-12));
+    }
+    free(exact);
+    ex_free(&fx);
+}
+
 /* Two components and a non-manifold edge: a unit square cut along its
  * diagonal (1,0)-(0,1), and a fin on that diagonal, and a copy of the
  * square far away. The diagonal, shared by three faces, joins each to the
@@ -611,6 +656,141 @@ static void test_nonmanifold_components(void **state)
     for (int v = 5; v < 9; v++)
         assert_true(isinf(fx.d[v]));
     ex_free(&fx);
+}
+
+/* Two windows of equal sigma on a non-manifold edge (the same source
+ * unfolded round both sides of a vertex): where they are equal is the
+ * bisector of their pseudo-sources, a double root of ex_dominate's squared
+ * equation that rounding made complex about half the time, and the later
+ * window was then dropped whole, or kept whole, by the sign at the middle. */
+static void test_dominate_equal_sigma(void **state)
+{
+    (void)state;
+    mfmm_exact_ws ws;
+    memset(&ws, 0, sizeof ws);
+    int32_t head = 0;
+    ex_rec kept;
+    ws.nm_head = &head;
+    ws.rec = &kept;
+    uint64_t x = 88172645463325252u;
+    int bisected = 0;
+    for (int trial = 0; trial < 2000; trial++) {
+        double u[5];
+        for (int j = 0; j < 5; j++) {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            u[j] = (double)(x >> 11) / 9007199254740992.0;
+        }
+        double L = 0.5 + 2.0 * u[0], sigma = 3.0 * u[1];
+        double pa = L * (2.0 * u[2] - 0.5), qa = -(0.1 + u[3]) * L;
+        double pn = L * (2.0 * u[4] - 0.5), qn = -(0.1 + u[0] * u[3]) * L;
+        kept = (ex_rec){0.0, L, pa, qa, sigma, 0, -1};
+        /* where |X - N| = |X - K| on the edge (y = 0) */
+        double xb = (pa * pa + qa * qa - pn * pn - qn * qn) / (2.0 * (pa - pn));
+        double s0 = 0.0, s1 = L;
+        int left = ex_dominate(&ws, 0, L, &s0, &s1, pn, qn, sigma);
+        double eps = 1e-9 * L;
+        if (!(xb > eps && xb < L - eps))
+            continue;
+        bisected++;
+        /* the new window is the nearer on its own source's side */
+        assert_true(left);
+        if (pn < pa) {
+            tm_assert_close(s0, 0.0, eps);
+            tm_assert_close(s1, xb, eps);
+        } else {
+            tm_assert_close(s0, xb, eps);
+            tm_assert_close(s1, L, eps);
+        }
+    }
+    assert_true(bisected > 500);
+}
+
+/* A fuzzed mesh (tests/fuzz/regressions/exact/crash-7db1014c..., reduced
+ * to the faces that keep it) of folded fans on non-manifold edges: the
+ * distance between every two vertices is the same both ways. From 6 the
+ * window round the far side of vertex 7 was dropped at edge 4-5 by the one
+ * round the near side (ex_dominate's lost bisector), 2.510413 against
+ * 2.509031 from 2; a graph of 200 points an edge, joined straight within
+ * each face, gives 2.509055, a real path 2.4e-5 longer. */
+static void test_nonmanifold_symmetric(void **state)
+{
+    (void)state;
+    static const double V[39] = {
+        4.125, 4, 3.25, 3.875, 4.75, 3.75, 3.25, 4.125, 3.125, 4.625, 4.5, 3.75,
+        3.25, 4.25, 3.375, 4.75, 4.625, 3.875, 4.25, 4.125, 3.5, 4, 4.875, 3.875,
+        4.5, 4.375, 3.625, 4.125, 5, 4, 3.625, 4.5, 3.5, 4.25, 5.125, 4.125,
+        5, 4.875, 4.125};
+    static const int32_t F[30] = {0, 1, 2, 1, 3, 0, 4, 5, 0, 5, 1, 4, 6, 7, 4,
+                                  7, 5, 6, 8, 9, 10, 11, 12, 3, 0, 5, 1, 4, 7, 5};
+    mfmm_gen_mesh g = ex_alloc(13, 10);
+    memcpy(g.V, V, sizeof V);
+    memcpy(g.F, F, sizeof F);
+    ex_fx fx = ex_make(g);
+    double D[13][13];
+    for (int32_t a = 0; a < 13; a++) {
+        mfmm_source s = tm_vertex_source(a);
+        ex_solve(&fx, &s, 1, NULL);
+        memcpy(D[a], fx.d, sizeof D[a]);
+    }
+    for (int a = 0; a < 13; a++)
+        for (int b = a + 1; b < 13; b++) {
+            if (isinf(D[a][b]) || isinf(D[b][a])) {
+                assert_true(D[a][b] == D[b][a]);
+                continue;
+            }
+            tm_assert_close(D[a][b], D[b][a], 1e-12 * D[a][b]);
+        }
+    tm_assert_close(D[6][2], 2.509031428195, 1e-9);
+    ex_free(&fx);
+}
+
+/* Exact distances between every two vertices of mesh (V, F), both ways:
+ * equal to 1e-12 relative, or both +inf. */
+static void ex_assert_symmetric(const double *V, int32_t nv, const int32_t *F, int32_t nf,
+                                double *D)
+{
+    mfmm_gen_mesh g = ex_alloc(nv, nf);
+    memcpy(g.V, V, (size_t)nv * 3 * sizeof *V);
+    memcpy(g.F, F, (size_t)nf * 3 * sizeof *F);
+    ex_fx fx = ex_make(g);
+    for (int32_t a = 0; a < nv; a++) {
+        mfmm_source s = tm_vertex_source(a);
+        ex_solve(&fx, &s, 1, NULL);
+        memcpy(D + (size_t)a * nv, fx.d, (size_t)nv * sizeof *D);
+    }
+    for (int32_t a = 0; a < nv; a++)
+        for (int32_t b = a + 1; b < nv; b++) {
+            double x = D[(size_t)a * nv + b], y = D[(size_t)b * nv + a];
+            if (isinf(x) || isinf(y))
+                assert_true(x == y);
+            else
+                tm_assert_close(x, y, 1e-12 * x);
+        }
+    ex_free(&fx);
+}
+
+/* Needles (zero-area faces) on a non-manifold edge reached by a window that
+ * is passing through another needle: the straight path from 3 through the
+ * T-junction to 5 (on edge 1-2, the middle of needle 2 5 1, and of edge 1-4
+ * of face 1 3 4, whose copy 3 4 1 keeps the mesh from splitting it) is
+ * sqrt 5 from either end (from 3 it went round through 2, 1 + sqrt 2); and
+ * a needle with two coincident corners (0 1 2) that passes a window from
+ * face 1 4 2 onto edge 0-2, on which 5 is the middle of needle 5 0 2
+ * (sqrt 5 one way, 2.5 the other). Fuzzed meshes, reduced. */
+static void test_pass_into_needle_on_nonmanifold_edge(void **state)
+{
+    (void)state;
+    static const double V1[18] = {2, 0, 2, 0, 3, 0, 3, 3, 0, 4, 2, 0, 4, 3, 0, 2, 3, 0};
+    static const int32_t F1[15] = {0, 1, 2, 1, 3, 4, 1, 4, 2, 2, 5, 1, 3, 4, 1};
+    double D[36];
+    ex_assert_symmetric(V1, 6, F1, 5, D);
+    tm_assert_close(D[3 * 6 + 5], sqrt(5.0), 1e-15);
+    static const double V2[18] = {0, 0, 0, 0, 0, 0, 4.25, 0, 0, 4, 0, 5, 5, 0, 1, 3, 0, 0};
+    static const int32_t F2[12] = {0, 1, 2, 0, 2, 3, 1, 4, 2, 5, 0, 2};
+    ex_assert_symmetric(V2, 6, F2, 4, D);
+    tm_assert_close(D[4 * 6 + 5], sqrt(5.0), 1e-15);
 }
 
 /* A zero-area face refuses a source; the rest is exact, and its vertex in
@@ -1112,7 +1292,11 @@ int main(void)
         cmocka_unit_test(test_max_distance),
         cmocka_unit_test(test_interrupt),
         cmocka_unit_test(test_stalled_run_ends_within_bounds),
+        cmocka_unit_test(test_nonmanifold_walls_past_budget),
         cmocka_unit_test(test_nonmanifold_components),
+        cmocka_unit_test(test_dominate_equal_sigma),
+        cmocka_unit_test(test_nonmanifold_symmetric),
+        cmocka_unit_test(test_pass_into_needle_on_nonmanifold_edge),
         cmocka_unit_test(test_degenerate_face),
         cmocka_unit_test(test_memory_limit),
         cmocka_unit_test(test_threads),

@@ -33,18 +33,23 @@
  * Euclidean distance from either (the lower bound, a minimum of two cones, is
  * not convex). bench/studies/oracle_sweep.py holds the default march to 1e-8.
  * The window method (MFMM_METHOD_WINDOWS) must meet both bounds to rounding
- * and never fall below the exact solve (1e-9 relative), or where it does on
- * a mesh with non-manifold edges, to the exact distance solved back from
- * that vertex (on folded non-manifold fans the exact solver can miss a path
- * one way that it finds the other: 2.8015 against 2.7901 on a regression
- * input, both windows' and the march's value 2.7901).
+ * and never fall below the exact solve (1e-9 relative).
+ *
+ * Symmetry: from vertex sources, the exact distance to a vertex v (the
+ * target byte's, and the farthest one reached) equals the one solved back
+ * from v, min_k t_k + d(v, s_k), to 1e-12 relative, unless either solve
+ * fell back to walls (upper bounds): a path missed one way shows there (on
+ * folded non-manifold fans a window dropped by a lost root of ex_dominate
+ * gave 2.8015 one way and 2.7901 the other; a needle on a non-manifold edge
+ * reached from a pass, 1 + sqrt 2 and sqrt 5).
  *
  * Input layout (all optional past the end: zeros):
  *   byte 0: nv - 3 (3..66)      byte 1: nf - 1 (1..128)
  *   byte 2: flags: 1 face source, 2 max_distance, 4 memory_limit, 8 two sources
  *   byte 3: radius of the exact start, in eighths of a mean edge (0..31)
  *   then nv * 3 int8 coordinates / 8, nf * 3 vertex bytes (mod nv),
- *   the source bytes, a max_distance byte. */
+ *   the source bytes, a max_distance byte, a memory_limit byte, the target
+ *   byte (mod nv). */
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
@@ -187,19 +192,17 @@ static int within(const double *d, const double *lo, const double *hi, int32_t n
 }
 
 /* The exact distance from vertex sources to v solved from v (the least of
- * value + distance back to each source), which on folded non-manifold fans
- * can find a path the forward solve missed; -inf with a face source (no
- * check: splitting the face at the point showed the same, 3.0794 forward
- * and 3.0682 back), +inf when the solve fails (work: nv doubles). */
+ * value + distance back to each source); NaN when that solve fails or fell
+ * back to walls at non-manifold edges, whose values are upper bounds only
+ * (work: nv doubles). */
 static double reverse_exact(mfmm_exact_solver *ex, const mfmm_source *src, int n_src, int32_t v,
                             double *work)
 {
-    for (int k = 0; k < n_src; k++)
-        if (src[k].face >= 0)
-            return -INFINITY;
     mfmm_source s = {v, -1, {0, 0, 0}, 0.0};
-    if (mfmm_solve_exact(ex, &s, 1, NULL, work, NULL, NULL) != MFMM_OK)
-        return INFINITY;
+    mfmm_exact_info info = {.struct_size = sizeof info};
+    if (mfmm_solve_exact(ex, &s, 1, NULL, work, &info, NULL) != MFMM_OK ||
+        info.nonmanifold_walls)
+        return NAN;
     double best = INFINITY;
     for (int k = 0; k < n_src; k++)
         best = fmin(best, src[k].value + work[src[k].vertex]);
@@ -244,6 +247,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         eo.max_distance = (double)next(&r) / 16.0;
     if (flags & 4)
         eo.memory_limit = 4096 + 64 * (size_t)next(&r);
+    int32_t target = next(&r) % nv;
     double *e = malloc((size_t)nv * sizeof *e), *d = malloc((size_t)nv * sizeof *d);
     double *lo = malloc((size_t)nv * sizeof *lo), *hi = malloc((size_t)nv * sizeof *hi);
     double *back = malloc((size_t)nv * sizeof *back);
@@ -294,6 +298,24 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             double len = sqrt(pow(x[0] - y[0], 2) + pow(x[1] - y[1], 2) + pow(x[2] - y[2], 2));
             if (isfinite(e[p]) && isfinite(e[q]) &&
                 !(fabs(e[p] - e[q]) <= len * (1.0 + 1e-9) + 1e-9 * (1.0 + fabs(e[p]))))
+                abort();
+        }
+    }
+    /* symmetry (header comment), from vertex sources without max_distance */
+    int vertex_sources = 1;
+    for (int k = 0; k < n_src; k++)
+        vertex_sources &= src[k].face < 0;
+    if (vertex_sources && !(flags & 2) && !info.nonmanifold_walls) {
+        int32_t far = -1;
+        for (int32_t v = 0; v < nv; v++)
+            if (isfinite(e[v]) && (far < 0 || e[v] > e[far]))
+                far = v;
+        int32_t vs[2] = {target, far};
+        for (int j = 0; j < 2; j++) {
+            if (vs[j] < 0 || !isfinite(e[vs[j]]))
+                continue;
+            double rev = reverse_exact(ex, src, n_src, vs[j], back);
+            if (!isnan(rev) && !(fabs(rev - e[vs[j]]) <= BOUND_REL * e[vs[j]] + btol))
                 abort();
         }
     }
@@ -363,14 +385,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (st == MFMM_OK) {
             if (!within(d, lo, hi, nv, BOUND_REL, BOUND_REL, INFINITY, btol))
                 abort();
-            mfmm_mesh_info mi = {.struct_size = sizeof mi};
-            if (mfmm_mesh_get_info(mesh, &mi) != MFMM_OK)
-                abort();
             for (int32_t v = 0; v < nv; v++)
                 if (!info.nonmanifold_walls && isfinite(e[v]) && !(flags & 2) &&
-                    !(d[v] >= e[v] * (1.0 - 1e-9) - btol) &&
-                    !(mi.n_nonmanifold_edges > 0 &&
-                      reverse_exact(ex, src, n_src, v, back) <= d[v] * (1.0 + 1e-9) + btol))
+                    !(d[v] >= e[v] * (1.0 - 1e-9) - btol))
                     abort();
             if (flags & 2) {
                 so.max_distance = eo.max_distance;

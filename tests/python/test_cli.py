@@ -137,7 +137,10 @@ def test_notes_sources_in_no_face(cli, tmp_path):
 def test_exact_notes_nonmanifold_walls(cli, tmp_path):
     """`distance --exact` says when the exact solver fell back to walls at
     non-manifold edges (its budget of windows passed on degenerate folded
-    fans, test_exact.py), and only then; values equal the Python API's."""
+    fans), and only then; values equal the Python API's. The fuzzed fans
+    below passed that budget until copies of a window passed on through
+    needles were trimmed (test_exact.py); no mesh known now does, so only
+    the silence is checked (the fallback: test_exact.c)."""
     from test_exact import fuzz_exact_mesh
 
     V, F, _, _ = fuzz_exact_mesh("nonmanifold-coincident-fans-window-cycle")
@@ -147,7 +150,7 @@ def test_exact_notes_nonmanifold_walls(cli, tmp_path):
                     + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in F.tolist()))
     out = tmp_path / "d.npy"
     proc = run(cli, "distance", path, "--source", 0, "--exact", "-o", out)
-    assert "non-manifold edges passed their budget" in proc.stderr
+    assert "budget" not in proc.stderr
     with pytest.warns(meshfmm.MeshWarning, match="coincident vertices"):
         m = meshfmm.Mesh(V, F)  # the fans coincide on purpose
     assert np.load(out).tobytes() == m.distance(0, method="exact").tobytes()
