@@ -9,12 +9,11 @@
  * triangulated square (gen grid 24) and an obtuse lattice (stretch 3) the
  * slots' distances against the Euclidean ones.
  *
- *   bench_slots [--repeats R] [--sources S] [--k K] [--rules LIST] [--flat] [MESH...]
+ *   bench_slots [--repeats R] [--sources S] [--k K] [--flat] [MESH...]
  *
  * --flat: the flat checks only (also Delaunay triangulations of random
  * points in a square and a disc, stretched 1, 8 and 30 times in x).
- * --k: windows per half-edge (default 2); --rules: the slot rules to run
- * (src/exact/slots.h; default 3906,834,2882,1858,66,194; 3906 is SL_RULE_MAIN).
+ * --k: windows per half-edge (default 2).
  * MESH: a mesh file or gen:icosphere5 / gen:sine100; default the five real
  * meshes of docs/virtual-sources.md (branch wincap) and gen:icosphere5. */
 #include <math.h>
@@ -30,9 +29,8 @@
 #include "mesh/order.h"
 #include "meshfmm.h"
 
-#define MAXMETH 10 /* default, exact, then slots with the rules below */
-static int rules[MAXMETH - 2] = {SL_RULE_MAIN, 834, 2882, 1858, 66, 194};
-static int NMETH = 8, slot_k = 2;
+#define NMETH 3 /* default, exact, the window method */
+static int slot_k = 2;
 
 static void slots_row(mfmm_slots *sl, const mfmm_mesh *mesh, int32_t v, double *tmp, double *d)
 {
@@ -70,9 +68,7 @@ static void flat_check(const char *name, mfmm_gen_mesh g)
         }
         printf("flat %s exact solver: max |exact - euclid| %.3e\n", name, worst);
     }
-    for (int ri = 0; ri < NMETH - 2; ri++) {
-        int rule = rules[ri];
-        mfmm_slots_set_rule(sl, rule);
+    {
         double worst = 0.0;
         int nbad = 0;
         int32_t srcs[3] = {0, g.nv / 2, g.nv - 1 - g.nv / 7};
@@ -92,9 +88,9 @@ static void flat_check(const char *name, mfmm_gen_mesh g)
                 nbad += !(a <= 1e-12);
             }
         }
-        printf("flat %s rule %d: max |d - euclid| %.3e over 3 sources, %d vertex values off by "
+        printf("flat %s windows: max |d - euclid| %.3e over 3 sources, %d vertex values off by "
                "> 1e-12; max |d - exact| %.3e\n",
-               name, rule, worst, nbad, worst_ex);
+               name, worst, nbad, worst_ex);
     }
     free(tmp);
     free(d);
@@ -142,8 +138,8 @@ static void bench_mesh(const char *name, const double *V, int32_t nv, const int3
     }
     double *rows = malloc((size_t)NMETH * ns * nv * sizeof *rows);
     double *tmp = malloc((size_t)nv * sizeof *tmp);
-    double t[MAXMETH];
-    mfmm_slots_info inf[MAXMETH];
+    double t[NMETH];
+    mfmm_slots_info inf[NMETH];
     memset(inf, 0, sizeof inf);
     for (int m = 0; m < NMETH; m++)
         t[m] = INFINITY;
@@ -168,7 +164,6 @@ static void bench_mesh(const char *name, const double *V, int32_t nv, const int3
                 else if (m == 1)
                     mfmm_solve_exact(ex, &s0, 1, NULL, d, NULL, NULL);
                 else {
-                    mfmm_slots_set_rule(sl, rules[m - 2]);
                     slots_row(sl, mesh, src[i], tmp, d);
                     mfmm_slots_info q;
                     mfmm_slots_get_info(sl, &q);
@@ -228,7 +223,7 @@ static void bench_mesh(const char *name, const double *V, int32_t nv, const int3
         if (m == 0)
             snprintf(label, sizeof label, "default");
         else
-            snprintf(label, sizeof label, "rule %d", rules[m - 2]);
+            snprintf(label, sizeof label, "windows");
         printf("%-8s %9.4f %10.4f %11.3e %6lld %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %7.0f %9.2f\n",
                label, 100.0 * mean / ns, 100.0 * maxe / diag, minrel, nonfin,
                inf[m].crossed / sv, inf[m].emitted / sv, inf[m].trimmed / sv,
@@ -258,18 +253,6 @@ int main(int argc, char **argv)
             flat_only = 1;
         else if (!strcmp(argv[i], "--k") && i + 1 < argc)
             slot_k = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--rules") && i + 1 < argc) {
-            const char *p = argv[++i];
-            int n = 0;
-            while (*p && n < MAXMETH - 2) {
-                char *end;
-                rules[n++] = (int)strtol(p, &end, 10);
-                if (end == p)
-                    break;
-                p = *end == ',' ? end + 1 : end;
-            }
-            NMETH = n + 2;
-        }
         else if (np < 64)
             paths[np++] = argv[i];
     }

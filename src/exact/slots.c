@@ -39,8 +39,7 @@
  *   edge's ends as the exact solver trims (ex_trim; ties kept within
  *   EX_TIE). When K + 1 windows compete, the one whose loss raises the
  *   least the lower envelope (the least value at SL_NS points of the edge,
- *   summed) is dropped. Other rules (slots.h, for measurements) weigh by a
- *   score of the window alone.
+ *   summed) is dropped.
  * - Every value is sigma + a straight segment in a strip unfolded through
  *   the faces the window crossed (possibly ending with a segment from the
  *   interval's end across one face), sigma itself a value, or d(u) + |uv|:
@@ -62,7 +61,7 @@
 /* the run goes on past a stop's level by this much (relative), so that
  * every value written is as final as in a full solve (mfmm_slots_run) */
 #define SL_STOP 1e-10
-/* rule bit 10: the points of an edge (ends included) its windows are weighed at */
+/* the points of an edge (ends included) its windows are weighed at */
 #define SL_NS 9
 
 /* A window: rays from pseudo-source (px, py) at distance sigma across
@@ -70,7 +69,7 @@
  * through the same faces, those the trims cut included: pieces of one
  * window join only where these meet (sl_keep). */
 typedef struct sl_win {
-    double b0, b1, px, py, sigma, score, g0, g1;
+    double b0, b1, px, py, sigma, g0, g1;
 } sl_win;
 
 struct mfmm_slots {
@@ -82,32 +81,18 @@ struct mfmm_slots {
     sl_win *slot;     /* (2 * 3 nf) */
     uint8_t *n_slot;  /* (3 nf) windows held */
     uint8_t *passed;  /* (3 nf) */
-    uint8_t *fpassed; /* (nf) a half-edge of the face has been passed (rule 1) */
     double *d;
     uint8_t *need;    /* (nv) a vertex that may bend a path: the exact tables' pseudo-source
                          flag, less vertices at a wall whose angle sum is pi or less */
     uint8_t *is_src;  /* (nv) the vertex sources of the solve */
     uint8_t *is_tgt;  /* (nv) targets of mfmm_slots_run not yet settled */
-    uint8_t *flat;    /* (nv) rule bit 9: offers redundant after a ray (mfmm_slots_create) */
+    uint8_t *flat;    /* (nv) offers redundant after a ray (mfmm_slots_create) */
     uint8_t *ray;     /* (nv) d came from a window's straight ray (not an edge, not a
                          window's end) */
     mfmm_march_state h; /* T unused; label 0 far, 1 close, 2 settled */
-    mfmm_march_state e; /* rule bit 8: half-edges keyed by their windows' least distance */
-    int rule;
+    mfmm_march_state e; /* half-edges keyed by their windows' least distance */
     int K; /* windows per half-edge (mfmm_slots_set_k), 2 by default */
-    int rank; /* 0: the least score; 1: dominance on the slot's interval; 2: the least
-                 score of the window's function over the whole edge; 3: 0, or less at
-                 its own interval's ends and middle */
-    int ablate; /* for measurements: bit 0 no vertex offers but the source's, bit 1 no passes */
-    int prefetch; /* bit 6 of the rule: prefetch the next vertex's face records */
-    int needed; /* bit 7: a vertex offers windows only where needed (sl_solve) */
-    int late_mode; /* 1: a window kept after its half-edge passed is crossed at once */
-    int order;     /* bit 8: a half-edge is passed in distance order (its windows' least
-                      value), not when its ends have settled */
-    int env;       /* bit 10: a window over K is weighed by the envelope (sl_emit) */
     double tgt_level; /* the largest value of the targets settled (sl_loop) */
-    int endpath;   /* bit 11: a window lowers the far corner of the face it crosses over
-                      its interval's nearer end, however far (sl_cross) */
     mfmm_slots_info info;
 };
 
@@ -132,11 +117,9 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     s->vf_corner = t->vf_corner;
     s->face_in = t->face_in;
     s->K = 2;
-    mfmm_slots_set_rule(s, SL_RULE_MAIN);
     s->slot = malloc((2 * nh + 1) * sizeof *s->slot);
     s->n_slot = malloc(nh + 1);
     s->passed = malloc(nh + 1);
-    s->fpassed = malloc(nf + 1);
     s->d = malloc((nv + 1) * sizeof *s->d);
     s->ray = malloc(nv + 1);
     s->need = malloc(nv + 1);
@@ -152,14 +135,14 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     s->e.heap_vertex = malloc((nh + 1) * sizeof(int32_t));
     s->e.heap_pos = malloc((nh + 1) * sizeof(int32_t));
     if (!s->e.label || !s->e.heap_key || !s->e.heap_vertex || !s->e.heap_pos ||
-        !s->slot || !s->n_slot || !s->passed || !s->fpassed || !s->d || !s->ray || !s->need || !s->flat || !s->is_src || !s->is_tgt || !s->h.label ||
+        !s->slot || !s->n_slot || !s->passed || !s->d || !s->ray || !s->need || !s->flat || !s->is_src || !s->is_tgt || !s->h.label ||
         !s->h.heap_key || !s->h.heap_vertex || !s->h.heap_pos) {
         mfmm_slots_destroy(s);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
     /* a vertex at a wall (two wall edges, no zero-area face or copy) whose
      * angle sum is pi or less bends no shortest path: it needs no offers;
-     * rule bit 9: a vertex whose offers the windows beside it make
+     * flat: a vertex whose offers the windows beside it make
      * redundant once a ray reaches it: one whose neighbourhood unfolds flat
      * (an angle sum of 2 pi, no wall) or a wall's vertex of pi or less */
     for (size_t v = 0; v < nv; v++) {
@@ -196,7 +179,6 @@ void mfmm_slots_destroy(mfmm_slots *s)
     free(s->slot);
     free(s->n_slot);
     free(s->passed);
-    free(s->fpassed);
     free(s->d);
     free(s->ray);
     free(s->need);
@@ -212,20 +194,6 @@ void mfmm_slots_destroy(mfmm_slots *s)
     free(s->e.heap_vertex);
     free(s->e.heap_pos);
     free(s);
-}
-
-void mfmm_slots_set_rule(mfmm_slots *s, int rule)
-{
-    s->rule = rule & 1;
-    s->late_mode = (rule >> 1) & 1;
-    s->rank = (rule >> 2) & 3;
-    s->ablate = (rule >> 4) & 3;
-    s->prefetch = (rule >> 6) & 1;
-    s->needed = (rule >> 7) & 1;
-    s->order = (rule >> 8) & 1;
-    s->needed |= (rule >> 8) & 2; /* bit 9: only flat vertices skip their offers */
-    s->env = (rule >> 10) & 1;
-    s->endpath = (rule >> 11) & 1;
 }
 
 int mfmm_slots_set_k(mfmm_slots *s, int K)
@@ -275,28 +243,11 @@ static inline double sl_at(double x, double b0, double b1, double px, double py,
     return sigma + sqrt((c - px) * (c - px) + py * py) + fabs(x - c);
 }
 
-/* The rank of a window on an edge of length L: the sum of its values at
- * the edge's ends and middle; rank 2: of its function sigma + |P X| there,
- * as if its interval were the whole edge (pieces of one window's rays
- * that cover little of the edge are not then given up to worse ones). */
-static inline double sl_score(int rank, double L, double b0, double b1, double px, double py,
-                              double sigma)
-{
-    if (rank == 2) {
-        b0 = 0.0;
-        b1 = L;
-    }
-    return sl_at(0.0, b0, b1, px, py, sigma) + sl_at(0.5 * L, b0, b1, px, py, sigma) +
-           sl_at(L, b0, b1, px, py, sigma);
-}
-
-/* rule bit 8: half-edge g (not passed) holds a window whose least value is
+/* half-edge g (not passed) holds a window whose least value is
  * sigma + the distance from (px, py) to [b0, b1]: g is passed by then */
 static inline void sl_key(mfmm_slots *s, int32_t g, double b0, double b1, double px, double py,
                           double sigma)
 {
-    if (!s->order)
-        return;
     double c = px < b0 ? b0 : px > b1 ? b1 : px;
     double m = sigma + sqrt((c - px) * (c - px) + py * py);
     uint8_t lab = s->e.label[g];
@@ -336,22 +287,20 @@ static void sl_keep(mfmm_slots *s, int32_t g, int fl, double L, double s0, doubl
         double u0 = fmin(b0, w[i].b0), u1 = fmax(b1, w[i].b1);
         w[i].b0 = u0;
         w[i].b1 = u1;
-        w[i].score = NAN;
         s->info.merged++;
         sl_key(s, g, b0, b1, px, py, sigma);
-        if (s->passed[g] && s->late_mode) {
+        if (s->passed[g]) {
             s->info.late++;
-            sl_win c = {b0, b1, px, py, sigma, 0.0, g0, g1};
+            sl_win c = {b0, b1, px, py, sigma, g0, g1};
             sl_cross(s, g, &c);
         }
         return;
     }
-    double score = NAN; /* taken when a third window comes (lazy) */
     if (n < s->K) {
         at = n;
         s->n_slot[g] = (uint8_t)(n + 1);
-    } else if (s->env) {
-        /* rule bit 10, the envelope: of the K + 1 windows (the new one
+    } else {
+        /* the envelope: of the K + 1 windows (the new one
          * included) drop the one whose loss raises the least least, the
          * sum over SL_NS points of the edge of the lowest value there */
         double val[SL_NS][9];
@@ -380,59 +329,11 @@ static void sl_keep(mfmm_slots *s, int32_t g, int fl, double L, double s0, doubl
         s->info.evicted++;
         if (at == n)
             return;
-    } else {
-        score = sl_score(s->rank, L, b0, b1, px, py, sigma);
-        at = 0;
-        for (int i = 0; i < n; i++) {
-            if (w[i].score != w[i].score)
-                w[i].score = sl_score(s->rank, L, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma);
-            if (w[i].score > w[at].score)
-                at = i;
-        }
-        s->info.evicted++;
-        if (s->rank == 1 && s->K == 2) {
-            /* dominance: a slot is given up only to a window at least as
-             * short at its own interval's ends and middle */
-            int dom[2];
-            for (int i = 0; i < 2; i++) {
-                double u0 = w[i].b0, u1 = w[i].b1, um = 0.5 * (u0 + u1);
-                dom[i] = sl_at(u0, b0, b1, px, py, sigma) <=
-                             sl_at(u0, u0, u1, w[i].px, w[i].py, w[i].sigma) &&
-                         sl_at(um, b0, b1, px, py, sigma) <=
-                             sl_at(um, u0, u1, w[i].px, w[i].py, w[i].sigma) &&
-                         sl_at(u1, b0, b1, px, py, sigma) <=
-                             sl_at(u1, u0, u1, w[i].px, w[i].py, w[i].sigma);
-            }
-            if (dom[0] && dom[1])
-                ; /* the worse score */
-            else if (dom[0] || dom[1])
-                at = dom[0] ? 0 : 1;
-            else
-                return;
-        } else if (!(score < w[at].score)) {
-            if (s->rank != 3 || s->K != 2)
-                return;
-            /* rank 3: a window less than a slot's at its own interval's
-             * ends and middle takes that slot (the worse score of two) */
-            int loc[2];
-            double um = 0.5 * (b0 + b1);
-            double n0 = sl_at(b0, b0, b1, px, py, sigma), nm = sl_at(um, b0, b1, px, py, sigma),
-                   n1 = sl_at(b1, b0, b1, px, py, sigma);
-            for (int i = 0; i < 2; i++)
-                loc[i] = n0 < sl_at(b0, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma) &&
-                         nm < sl_at(um, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma) &&
-                         n1 < sl_at(b1, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma);
-            if (!loc[0] && !loc[1])
-                return;
-            if (!(loc[0] && loc[1]))
-                at = loc[0] ? 0 : 1;
-            s->info.local++;
-        }
     }
-    w[at] = (sl_win){b0, b1, px, py, sigma, score, g0, g1};
+    w[at] = (sl_win){b0, b1, px, py, sigma, g0, g1};
     s->info.kept++;
     sl_key(s, g, b0, b1, px, py, sigma);
-    if (s->passed[g] && s->late_mode) {
+    if (s->passed[g]) {
         /* kept after its half-edge was passed: crossed at once */
         s->info.late++;
         sl_win c = w[at];
@@ -538,11 +439,11 @@ static void sl_cross(mfmm_slots *s, int32_t h, const sl_win *w)
     if (tc >= b0 - tol && tc <= b1 + tol) {
         double ex = cx - px, ey = cy - py;
         sl_update(s, vc, sigma + sqrt(ex * ex + ey * ey), 1);
-    } else if (s->endpath || (tc >= b0 - EX_GRAZE * L && tc <= b1 + EX_GRAZE * L)) {
+    } else {
         /* C beside the window: the ray to the interval's nearer end, then
-         * straight across the face (a path; with bit 11 wherever C is, else
-         * at a graze): a vertex at the tip of thin faces otherwise gets only
-         * the edge relaxation, an edge's length off */
+         * straight across the face (a path, wherever C is): a vertex at
+         * the tip of thin faces otherwise gets only the edge relaxation, an
+         * edge's length off */
         double e = tc < b0 ? b0 : b1;
         double ie = sqrt((e - px) * (e - px) + py * py), ec = sqrt((cx - e) * (cx - e) + cy * cy);
         sl_update(s, vc, sigma + ie + ec, 0);
@@ -576,10 +477,7 @@ static void sl_pass(mfmm_slots *s, int32_t h)
 {
     if (s->passed[h])
         return;
-    if (s->rule == 1 && s->fpassed[h / 3])
-        return;
     s->passed[h] = 1;
-    s->fpassed[h / 3] = 1;
     int n = s->n_slot[h];
     /* (a window kept while another is crossed cannot land in the same slot:
      * the children go to the face's other edges) */
@@ -595,7 +493,6 @@ static void sl_reset(mfmm_slots *s)
     memset(&s->info, 0, sizeof s->info);
     memset(s->n_slot, 0, nh);
     memset(s->passed, 0, nh);
-    memset(s->fpassed, 0, (size_t)s->nf);
     memset(s->h.label, 0, nv);
     memset(s->e.label, 0, nh);
     s->e.heap_size = 0;
@@ -620,7 +517,7 @@ static void sl_loop(mfmm_slots *s, double level, int32_t n_tgt)
             break;
         if (s->e.heap_size > 0 &&
             (s->h.heap_size == 0 || s->e.heap_key[0] <= s->h.heap_key[0])) {
-            /* rule bit 8: the half-edge whose windows come next */
+            /* the half-edge whose windows come next */
             int32_t g = mfmm_heap_pop(&s->e);
             s->e.label[g] = 2;
             sl_pass(s, g);
@@ -629,7 +526,7 @@ static void sl_loop(mfmm_slots *s, double level, int32_t n_tgt)
         int32_t v = mfmm_heap_pop(&s->h);
         s->h.label[v] = 2;
 #ifdef __GNUC__
-        if (s->prefetch && s->h.heap_size > 0) {
+        if (s->h.heap_size > 0) {
             /* the face records of the vertex likely to settle next: they
              * are the solve's misses (a record is first read when a corner
              * settles) */
@@ -662,11 +559,10 @@ static void sl_loop(mfmm_slots *s, double level, int32_t n_tgt)
                 }
                 continue;
             }
-            if ((s->ablate & 1) || (s->needed && s->ray[v] && !s->need[v] && (!(s->needed & 2) || s->flat[v]))) {
-                /* no offers (ablate), or not needed: a vertex reached by a
-                 * window's ray, that bends no shortest path (not a saddle,
-                 * not at a wall), has the windows beside it carry its paths
-                 * on; the edges only */
+            if (s->ray[v] && s->flat[v]) {
+                /* not needed: a vertex reached by a window's ray whose
+                 * neighbourhood unfolds flat has the windows beside it
+                 * carry its paths on; the edges only */
                 sl_update(s, r->v[ex_next[k]], dv + r->len[ex_prev[k]], 0);
                 sl_update(s, r->v[ex_prev[k]], dv + r->len[ex_next[k]], 0);
                 if (!s->is_src[v])
@@ -674,21 +570,6 @@ static void sl_loop(mfmm_slots *s, double level, int32_t n_tgt)
             }
             sl_emit(s, c, 0.0, r->len[k], 0.0, r->len[k], r->cx[k], r->cy[k], dv,
                     s->is_src[v] ? 2 : 1);
-        }
-        if ((s->ablate & 2) || s->order)
-            continue;
-        for (int32_t i = i0; i < i1; i++) {
-            int32_t c = ex_corner(s->vf_corner, s->face_in, i);
-            const ex_face *r = fr + c / 3;
-            int k = c % 3;
-            if (r->skip)
-                continue;
-            int32_t f3 = c - k;
-            /* edge v - v[k+2] is half-edge k+1; edge v - v[k+1] is k+2 */
-            if (s->h.label[r->v[ex_prev[k]]] == 2)
-                sl_pass(s, f3 + ex_next[k]);
-            if (s->h.label[r->v[ex_next[k]]] == 2)
-                sl_pass(s, f3 + ex_prev[k]);
         }
     }
 }

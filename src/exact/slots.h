@@ -2,7 +2,7 @@
  * propagation keeping K windows in place on each half-edge ("slots"), in
  * distance order. Every value it writes is the length of a path on the
  * surface, so never below the exact solver's beyond rounding. The design:
- * slots.c; the rules below are kept for bench/micro/bench_slots.c. */
+ * slots.c. */
 #ifndef MFMM_EXACT_SLOTS_H
 #define MFMM_EXACT_SLOTS_H
 
@@ -18,42 +18,8 @@ void mfmm_slots_destroy(mfmm_slots *s);
 /* About the bytes a workspace holds on `mesh` (K = 2), its tables apart. */
 size_t mfmm_slots_bytes(const mfmm_mesh *mesh);
 
-/* The pass rule: bit 0 clear (default) passes the windows entering a face
- * through an edge once both of the edge's ends have settled (each half-edge
- * once); set, only the first such edge of each face. Bit 1 set: a window
- * kept in a slot after its half-edge was passed is crossed at once (else it
- * waits for nothing: it is dropped). Bit 2 set: a third window takes a
- * slot only from a window it dominates (no longer at the slot's interval's
- * ends and middle; the worse score where it dominates both), else the least
- * score rank (sum of the values at the edge's ends and middle) decides.
- * Bits 2-3 = 2: the score is that of the window's function over the whole
- * edge (its interval ignored); = 3: the least score, and a window less than
- * a slot's at its own interval's ends and middle takes that slot too. Bits 4-5, to measure what the parts cost:
- * bit 4 no vertex offers but the source's (edge relaxation instead), bit 5
- * no passes (offers and relaxation only). Bit 6: prefetch the face records
- * of the vertex at the heap's top. Bit 7: a vertex offers windows only
- * where needed: a saddle, a vertex at a wall, or one whose distance did not
- * come from a window's ray (edge relaxation, a window's end). */
-void mfmm_slots_set_rule(mfmm_slots *s, int rule);
-/* Bit 8: a half-edge is passed when the front reaches its windows' least
- * value (a second heap, of half-edges, beside the vertices'), not when its
- * ends have settled; a window that comes later is crossed at once (bit 1).
- * Bit 9 (with bit 7): only a vertex reached by a ray whose neighbourhood
- * unfolds flat (angle sum 2 pi, or a wall's vertex of pi or less) skips its
- * offers. Bit 10: a window over K on a half-edge drops, of the K + 1, the
- * one whose loss raises the least the sum over 9 points of the edge of the
- * lowest value there (the envelope), not the worst score. Bit 11: a window crossing a face lowers the far corner, where the
- * corner is beside the window's interval, over the interval's nearer end
- * (the ray to it, then straight across the face: a path), not only at a
- * graze; the corner offers (it was not reached by a ray). The main rule,
- * 3906 (bits 1, 6-11), set by mfmm_slots_create: exact on triangulations
- * of convex planar regions and on developable surfaces (cylinders, a
- * cube). Rule 834 (bits 1, 6-9): the same without bits 10 and 11. */
-#define SL_RULE_MAIN 3906
-
-/* K windows per half-edge instead of 2 (1 to 8; ranks 1 and 3 of the rule
- * need 2, and fall back to rank 0). 0 when out of memory or K is out of
- * range. */
+/* K windows per half-edge instead of 2 (1 to 8). 0 when out of memory or
+ * K is out of range. */
 int mfmm_slots_set_k(mfmm_slots *s, int K);
 
 /* Distances from internal vertex `source` to every vertex, in internal
@@ -95,7 +61,6 @@ typedef struct mfmm_slots_info {
     int64_t late_vertex; /* lowerings of a settled vertex */
     int64_t settled;
     int64_t narrow, trimmed, evicted; /* offers dropped: too narrow, trimmed away, one of three */
-    int64_t local;     /* slots taken by rank 3's local rule */
     int64_t merged;    /* offers joined to a slot with the same pseudo-source */
 } mfmm_slots_info;
 void mfmm_slots_get_info(const mfmm_slots *s, mfmm_slots_info *info);

@@ -113,10 +113,10 @@ def test_books(pages):
     """Flat pages sharing one spine edge (tests/python/oracles.py's book
     oracle, clean pages), windows crossing the spine into every other page:
     never below the geodesic distance, and exact (1e-12 relative) but at
-    a few vertices where pieces of one window that went round a vertex by
-    different faces do not join (their rays between were not all traced):
-    measured on 2 pages, 12 books, 3 vertices at most 2.0 % over; 3 and 4
-    pages exact."""
+    a few vertices where a window of the source was dropped for two pieces
+    of a spine end's that reached the edge by routes whose rays between
+    were never traced (so they may not join): measured on 2 pages, 12
+    books, 2 vertices at most 7.7e-6 over; 3 and 4 pages exact."""
     from oracles import random_book, reference
 
     rng = np.random.default_rng(100 + pages)
@@ -130,7 +130,9 @@ def test_books(pages):
         pos = ref > 0
         rel = (w[pos] - ref[pos]) / ref[pos]
         assert np.all(np.isfinite(w)) and rel.min() >= -BELOW
-        assert np.count_nonzero(rel > 1e-12) <= 2 and rel.max() <= 0.025
+        assert np.count_nonzero(rel > 1e-12) <= 2 and rel.max() <= 1e-5
+        if pages > 2:
+            assert rel.max() <= 1e-12
 
 
 def test_beetle_non_manifold_never_below_the_exact_solver():
