@@ -174,16 +174,3 @@ void ex_keep(mfmm_exact_ws *ws, int32_t slot, double b0, double b1, double px, d
     ws->nm_head[slot] = ws->rec_n++;
 }
 
-/* The slot of half-edge g in nm_he (binary search), -1 if none. */
-int32_t ex_nm_slot(const mfmm_exact_ws *ws, int32_t g)
-{
-    int32_t lo = 0, hi = ws->n_nm - 1;
-    while (lo < hi) {
-        int32_t mid = lo + (hi - lo) / 2;
-        if (ws->nm_he[mid] < g)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return ws->n_nm > 0 && ws->nm_he[lo] == g ? lo : -1;
-}

@@ -22,7 +22,4 @@ int ex_dominate(const mfmm_exact_ws *ws, int32_t slot, double L, double *s0p,
 void ex_keep(mfmm_exact_ws *ws, int32_t slot, double b0, double b1, double px, double py,
                     double sigma);
 
-/* The slot of half-edge g in nm_he (binary search), -1 if none. */
-int32_t ex_nm_slot(const mfmm_exact_ws *ws, int32_t g);
-
 #endif

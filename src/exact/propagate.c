@@ -229,12 +229,12 @@ static void ex_fan_out(mfmm_exact_ws *ws, int32_t h, int32_t va, int32_t vb, dou
     double tol = EX_POS_TOL * L;
     if (ws->walls || (iy <= tol && (fabs(ix) <= tol || fabs(ix - L) <= tol)))
         return;
-    int32_t i = ex_nm_slot(ws, h);
+    int32_t i = ex_nm_find(ws->nm_he, ws->n_nm, h);
     for (int32_t n = 0; i >= 0 && n < ws->n_nm; n++) {
         int32_t g = ws->nm_next[i];
         if (g == h)
             return;
-        i = ex_nm_slot(ws, g);
+        i = ex_nm_find(ws->nm_he, ws->n_nm, g);
         const ex_face *q = ws->fr + g / 3;
         int fl = q->v[ex_next[g % 3]] != va;
         /* in g's frame (its ends swapped when it runs from vb to va) */

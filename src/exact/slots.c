@@ -341,21 +341,6 @@ static void sl_keep(mfmm_slots *s, int32_t g, int fl, double L, double s0, doubl
     }
 }
 
-/* the index of half-edge g in the non-manifold lists (tables' nm_he), -1 if
- * it is on none */
-static int32_t sl_nm_slot(const mfmm_exact_tables *t, int32_t g)
-{
-    int32_t lo = 0, hi = t->n_nm - 1;
-    while (lo < hi) {
-        int32_t mid = lo + (hi - lo) / 2;
-        if (t->nm_he[mid] < g)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return t->n_nm > 0 && t->nm_he[lo] == g ? lo : -1;
-}
-
 /* A window leaving face h / 3 through half-edge h: rays across [s0, s1]
  * of the edge, traced across [t0, t1] (sl_win), from (ix, iy) in h's frame
  * (iy >= 0, on the face's side); offer: 0 a window's child, 1 a vertex's
@@ -411,12 +396,12 @@ static void sl_emit(mfmm_slots *s, int32_t h, double s0, double s1, double t0, d
     if (iy <= tol && (fabs(ix) <= tol || fabs(ix - L) <= tol))
         return;
     const mfmm_exact_tables *t = s->t;
-    int32_t i = sl_nm_slot(t, h);
+    int32_t i = ex_nm_find(t->nm_he, t->n_nm, h);
     for (int32_t n = 0; i >= 0 && n < t->n_nm; n++) {
         int32_t q = t->nm_next[i];
         if (q == h)
             return;
-        i = sl_nm_slot(t, q);
+        i = ex_nm_find(t->nm_he, t->n_nm, q);
         const ex_face *rq = s->fr + q / 3;
         if (!rq->skip)
             sl_keep(s, q, rq->v[ex_next[q % 3]] != va, L, s0, s1, t0, t1, ix, iy, sigma);

@@ -206,6 +206,21 @@ static inline int32_t ex_corner(const int32_t *vf_corner, const int32_t *face_in
     return 3 * face_in[MFMM_WEDGE_FACE(w)] + MFMM_WEDGE_K(w);
 }
 
+/* The slot of half-edge h in the sorted non-manifold half-edges nm_he
+ * (n_nm of them), -1 where it is on no non-manifold edge. */
+static inline int32_t ex_nm_find(const int32_t *nm_he, int32_t n_nm, int32_t h)
+{
+    int32_t lo = 0, hi = n_nm - 1;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (nm_he[mid] < h)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return n_nm > 0 && nm_he[lo] == h ? lo : -1;
+}
+
 static inline int ex_corner_of(const int32_t *fv, int32_t v)
 {
     return fv[0] == v ? 0 : fv[1] == v ? 1 : fv[2] == v ? 2 : -1;

@@ -138,20 +138,6 @@ static int ex_link_nonmanifold(mfmm_exact_tables *t)
     return 0;
 }
 
-/* Whether half-edge h is on a non-manifold edge (nm_he, sorted). */
-static int ex_is_nonmanifold(const mfmm_exact_tables *t, int32_t h)
-{
-    int32_t lo = 0, hi = t->n_nm;
-    while (lo < hi) {
-        int32_t mid = lo + (hi - lo) / 2;
-        if (t->nm_he[mid] < h)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < t->n_nm && t->nm_he[lo] == h;
-}
-
 /* The longest edge of the faces at v, from the coordinates as the records
  * have them (ex_build_faces). */
 static double ex_reach(const mfmm_exact_tables *t, int32_t v)
@@ -304,7 +290,7 @@ static void ex_build_faces(mfmm_exact_tables *t, int32_t T)
                     }
                 }
             }
-            if (r->across[k] == -1 && t->n_nm > 0 && ex_is_nonmanifold(t, 3 * i + k))
+            if (r->across[k] == -1 && ex_nm_find(t->nm_he, t->n_nm, 3 * i + k) >= 0)
                 r->flip[k] = 2;
             ex_wall_short_edge(t, r, k);
         }
