@@ -4,12 +4,11 @@
 
 #include "mesh.h"
 
-/* Building the spokes costs about seven marches' worth of what they save a
- * march (1M-vertex sine surface: 0.34 s to build, 0.16 s a march without
- * them, 0.11 s with): marches without them until they have settled this
- * many times nv vertices, so that a program that asks a few fields never
- * pays for them, and one that asks many pays at most twice the least it
- * could (rent or buy). */
+/* Building the spokes costs about what they save seven full marches
+ * (docs/performance.md, Memory): marches go without them until they have
+ * settled this many times nv vertices, so that a program that asks a few
+ * fields never pays for them, and one that asks many pays at most about
+ * twice the least it could (rent or buy). */
 #define MFMM_SPOKES_AFTER 8
 
 /* The mesh's spokes for the march (march.h: F = 1, unfolding on), built
