@@ -381,9 +381,10 @@ mfmm_status mfmm_rows_threads(const mfmm_rows_job *job, int32_t start, mfmm_erro
             pthread_cond_wait(&p.cv_main, &p.mu);
         if (p.stop)
             break;
+        /* read under the lock: the workers are adding the next block's */
+        job->info->vertices_settled = p.settled;
         pthread_mutex_unlock(&p.mu);
         int32_t first = start + b * p.block;
-        job->info->vertices_settled = p.settled;
         mfmm_status bst;
         int cancel = deliver_block(job, first, n, row_dest(&p, first), &bst);
         pthread_mutex_lock(&p.mu);
