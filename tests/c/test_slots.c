@@ -27,17 +27,38 @@
 
 #define TS_PI 3.14159265358979323846
 
+/* A mesh with an exact solver and a window workspace on it. */
+typedef struct sl_fx {
+    mfmm_mesh *mesh;
+    mfmm_exact_solver *ex;
+    mfmm_slots *sl;
+} sl_fx;
+
+static sl_fx fx_open(const double *V, int32_t nv, const int32_t *F, int32_t nf)
+{
+    sl_fx fx = {NULL, NULL, NULL};
+    mfmm_error err;
+    assert_int_equal(mfmm_mesh_create(V, nv, F, nf, NULL, &fx.mesh, &err), MFMM_OK);
+    assert_int_equal(mfmm_exact_solver_create(fx.mesh, &fx.ex), MFMM_OK);
+    assert_int_equal(mfmm_slots_create(fx.mesh, &fx.sl), MFMM_OK);
+    return fx;
+}
+
+static void fx_close(sl_fx *fx)
+{
+    mfmm_slots_destroy(fx->sl);
+    mfmm_exact_solver_destroy(fx->ex);
+    mfmm_mesh_destroy(fx->mesh);
+}
+
 /* max |slots - exact| over three sources, with the lower-bound and reach
  * checks asserted */
 static double check_mesh(const double *V, int32_t nv, const int32_t *F, int32_t nf)
 {
-    mfmm_mesh *mesh = NULL;
-    mfmm_exact_solver *ex = NULL;
-    mfmm_slots *sl = NULL;
-    mfmm_error err;
-    assert_int_equal(mfmm_mesh_create(V, nv, F, nf, NULL, &mesh, &err), MFMM_OK);
-    assert_int_equal(mfmm_exact_solver_create(mesh, &ex), MFMM_OK);
-    assert_int_equal(mfmm_slots_create(mesh, &sl), MFMM_OK);
+    sl_fx fx = fx_open(V, nv, F, nf);
+    mfmm_mesh *mesh = fx.mesh;
+    mfmm_exact_solver *ex = fx.ex;
+    mfmm_slots *sl = fx.sl;
     double *e = malloc((size_t)nv * sizeof *e), *d = malloc((size_t)nv * sizeof *d);
     assert_non_null(e);
     assert_non_null(d);
@@ -58,9 +79,7 @@ static double check_mesh(const double *V, int32_t nv, const int32_t *F, int32_t 
     }
     free(e);
     free(d);
-    mfmm_slots_destroy(sl);
-    mfmm_exact_solver_destroy(ex);
-    mfmm_mesh_destroy(mesh);
+    fx_close(&fx);
     return worst;
 }
 
@@ -81,13 +100,10 @@ static void gen_check(mfmm_gen_mesh g, int flat)
 static void flat_exact(mfmm_gen_mesh g, int convex, int K)
 {
     assert_true(g.nv > 0);
-    mfmm_mesh *mesh = NULL;
-    mfmm_exact_solver *ex = NULL;
-    mfmm_slots *sl = NULL;
-    mfmm_error err;
-    assert_int_equal(mfmm_mesh_create(g.V, g.nv, g.F, g.nf, NULL, &mesh, &err), MFMM_OK);
-    assert_int_equal(mfmm_exact_solver_create(mesh, &ex), MFMM_OK);
-    assert_int_equal(mfmm_slots_create(mesh, &sl), MFMM_OK);
+    sl_fx fx = fx_open(g.V, g.nv, g.F, g.nf);
+    mfmm_mesh *mesh = fx.mesh;
+    mfmm_exact_solver *ex = fx.ex;
+    mfmm_slots *sl = fx.sl;
     assert_true(mfmm_slots_set_k(sl, K));
     double *e = malloc((size_t)g.nv * sizeof *e), *d = malloc((size_t)g.nv * sizeof *d);
     assert_non_null(e);
@@ -115,9 +131,7 @@ static void flat_exact(mfmm_gen_mesh g, int convex, int K)
     }
     free(e);
     free(d);
-    mfmm_slots_destroy(sl);
-    mfmm_exact_solver_destroy(ex);
-    mfmm_mesh_destroy(mesh);
+    fx_close(&fx);
     mfmm_gen_free(&g);
 }
 
@@ -201,13 +215,10 @@ static void test_flat_hole(void **state)
 static void sources_check(mfmm_gen_mesh g, int flat)
 {
     assert_true(g.nv > 0);
-    mfmm_mesh *mesh = NULL;
-    mfmm_exact_solver *ex = NULL;
-    mfmm_slots *sl = NULL;
-    mfmm_error err;
-    assert_int_equal(mfmm_mesh_create(g.V, g.nv, g.F, g.nf, NULL, &mesh, &err), MFMM_OK);
-    assert_int_equal(mfmm_exact_solver_create(mesh, &ex), MFMM_OK);
-    assert_int_equal(mfmm_slots_create(mesh, &sl), MFMM_OK);
+    sl_fx fx = fx_open(g.V, g.nv, g.F, g.nf);
+    mfmm_mesh *mesh = fx.mesh;
+    mfmm_exact_solver *ex = fx.ex;
+    mfmm_slots *sl = fx.sl;
     size_t nv = (size_t)g.nv;
     double *e = malloc(nv * sizeof *e), *d = malloc(nv * sizeof *d), *m = malloc(nv * sizeof *m);
     double *one = malloc(nv * sizeof *one);
@@ -281,9 +292,7 @@ static void sources_check(mfmm_gen_mesh g, int flat)
     free(d);
     free(m);
     free(one);
-    mfmm_slots_destroy(sl);
-    mfmm_exact_solver_destroy(ex);
-    mfmm_mesh_destroy(mesh);
+    fx_close(&fx);
     mfmm_gen_free(&g);
 }
 
@@ -443,13 +452,10 @@ static void test_cylinder(void **state)
             mfmm_gen_mesh g = cylinder(cs[ci].nu, cs[ci].nz, cs[ci].r, cs[ci].h, cs[ci].alt, &x);
             double P = cs[ci].nu * 2.0 * cs[ci].r * sin(TS_PI / cs[ci].nu);
             double scale = 0.5 * P + cs[ci].h;
-            mfmm_mesh *mesh = NULL;
-            mfmm_exact_solver *ex = NULL;
-            mfmm_slots *sl = NULL;
-            mfmm_error err;
-            assert_int_equal(mfmm_mesh_create(g.V, g.nv, g.F, g.nf, NULL, &mesh, &err), MFMM_OK);
-            assert_int_equal(mfmm_exact_solver_create(mesh, &ex), MFMM_OK);
-            assert_int_equal(mfmm_slots_create(mesh, &sl), MFMM_OK);
+            sl_fx fx = fx_open(g.V, g.nv, g.F, g.nf);
+            mfmm_mesh *mesh = fx.mesh;
+            mfmm_exact_solver *ex = fx.ex;
+            mfmm_slots *sl = fx.sl;
             assert_true(mfmm_slots_set_k(sl, K));
             double *e = malloc((size_t)g.nv * sizeof *e), *d = malloc((size_t)g.nv * sizeof *d);
             assert_non_null(e);
@@ -476,9 +482,7 @@ static void test_cylinder(void **state)
             free(e);
             free(d);
             free(x);
-            mfmm_slots_destroy(sl);
-            mfmm_exact_solver_destroy(ex);
-            mfmm_mesh_destroy(mesh);
+            fx_close(&fx);
             mfmm_gen_free(&g);
         }
 }
@@ -699,13 +703,10 @@ static void test_cube(void **state)
             int n = ns[ni];
             int32_t *id = NULL;
             mfmm_gen_mesh g = cube(n, &id);
-            mfmm_mesh *mesh = NULL;
-            mfmm_exact_solver *ex = NULL;
-            mfmm_slots *sl = NULL;
-            mfmm_error err;
-            assert_int_equal(mfmm_mesh_create(g.V, g.nv, g.F, g.nf, NULL, &mesh, &err), MFMM_OK);
-            assert_int_equal(mfmm_exact_solver_create(mesh, &ex), MFMM_OK);
-            assert_int_equal(mfmm_slots_create(mesh, &sl), MFMM_OK);
+            sl_fx fx = fx_open(g.V, g.nv, g.F, g.nf);
+            mfmm_mesh *mesh = fx.mesh;
+            mfmm_exact_solver *ex = fx.ex;
+            mfmm_slots *sl = fx.sl;
             assert_true(mfmm_slots_set_k(sl, K));
             double *e = malloc((size_t)g.nv * sizeof *e), *d = malloc((size_t)g.nv * sizeof *d);
             double *ref = malloc((size_t)g.nv * sizeof *ref);
@@ -746,9 +747,7 @@ static void test_cube(void **state)
             free(d);
             free(ref);
             free(id);
-            mfmm_slots_destroy(sl);
-            mfmm_exact_solver_destroy(ex);
-            mfmm_mesh_destroy(mesh);
+            fx_close(&fx);
             mfmm_gen_free(&g);
         }
 }
