@@ -27,6 +27,8 @@ void mfmm_exact_tables_destroy(mfmm_exact_tables *t)
     free(t->tile_state);
     free(t->vertex_done);
     free(t->tile_box);
+    free(t->group_box);
+    free(t->group_left);
     free(t);
 }
 
@@ -426,6 +428,7 @@ static void ex_build_tile(mfmm_exact_tables *t, int32_t T)
     }
     t->tile_state[T] |= EX_TILE_READY;
     t->n_ready++;
+    t->group_left[T / EX_GROUP]--;
 }
 
 size_t mfmm_exact_tables_bytes(const mfmm_mesh *mesh)
@@ -434,7 +437,8 @@ size_t mfmm_exact_tables_bytes(const mfmm_mesh *mesh)
     size_t n_tiles = (nv + EX_TILE - 1) / EX_TILE;
     return sizeof(mfmm_exact_tables) + nf * sizeof(ex_face) + 64 +
            nf * ((mesh->piece_next ? 2 : 1) * sizeof(int32_t) + 3 * sizeof(double)) +
-           nv * (2 + 2 * sizeof(double)) + n_tiles * (sizeof(int32_t) + 1 + 6 * sizeof(double));
+           nv * (2 + 2 * sizeof(double)) + n_tiles * (sizeof(int32_t) + 1 + 6 * sizeof(double)) +
+           (n_tiles / EX_GROUP + 1) * (sizeof(int32_t) + 6 * sizeof(double));
 }
 
 mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **out)
@@ -473,8 +477,12 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
     t->tile_state = calloc(n_tiles ? n_tiles : 1, 1);
     t->vertex_done = calloc(nv ? nv : 1, 1);
     t->tile_box = malloc((n_tiles ? n_tiles : 1) * 6 * sizeof *t->tile_box);
+    t->n_groups = (int32_t)((n_tiles + EX_GROUP - 1) / EX_GROUP);
+    t->group_box = malloc((t->n_groups ? (size_t)t->n_groups : 1) * 6 * sizeof *t->group_box);
+    t->group_left = malloc((t->n_groups ? (size_t)t->n_groups : 1) * sizeof *t->group_left);
     if (!t->fr_block || !t->face_in || !t->pseudo || !t->fan_a0 || !t->fan_total ||
-        !t->height || !t->tile_rec || !t->tile_state || !t->vertex_done || !t->tile_box) {
+        !t->height || !t->tile_rec || !t->tile_state || !t->vertex_done || !t->tile_box ||
+        !t->group_box || !t->group_left) {
         mfmm_exact_tables_destroy(t);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
@@ -536,6 +544,20 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
                 b[3 + j] = fmax(b[3 + j], mesh->xyz[3 * v + j]);
             }
     }
+    for (int32_t G = 0; G < t->n_groups; G++) {
+        double *b = t->group_box + 6 * G;
+        int32_t T1 = (G + 1) * EX_GROUP < t->n_tiles ? (G + 1) * EX_GROUP : t->n_tiles;
+        for (int j = 0; j < 3; j++) {
+            b[j] = INFINITY;
+            b[3 + j] = -INFINITY;
+        }
+        for (int32_t T = G * EX_GROUP; T < T1; T++)
+            for (int j = 0; j < 3; j++) {
+                b[j] = fmin(b[j], t->tile_box[6 * T + j]);
+                b[3 + j] = fmax(b[3 + j], t->tile_box[6 * T + 3 + j]);
+            }
+        t->group_left[G] = T1 - G * EX_GROUP;
+    }
     /* a tile's records lie within an edge of its vertices, the faces and
      * vertices they lead to within another, and a window may pass through
      * EX_MAX_PASS zero-area faces in a row (ex_pass) */
@@ -580,14 +602,20 @@ void mfmm_exact_tables_ensure(const mfmm_exact_tables *tables, const double *poi
     if (t->n_ready < t->n_tiles) {
         double reach = radius + t->pad;
         int all = !points || !(reach < INFINITY);
-        for (int32_t T = 0; T < t->n_tiles; T++) {
-            if (t->tile_state[T] & EX_TILE_READY)
-                continue;
+        for (int32_t G = 0; G < t->n_groups; G++) {
             int near = all;
-            for (int32_t i = 0; i < n && !near; i++)
-                near = ex_box_distance(t->tile_box + 6 * T, points + 3 * i) <= reach;
-            if (near)
-                ex_build_tile(t, T);
+            for (int32_t i = 0; i < n && !near && t->group_left[G] > 0; i++)
+                near = ex_box_distance(t->group_box + 6 * G, points + 3 * i) <= reach;
+            int32_t T1 = (G + 1) * EX_GROUP < t->n_tiles ? (G + 1) * EX_GROUP : t->n_tiles;
+            for (int32_t T = G * EX_GROUP; near && t->group_left[G] > 0 && T < T1; T++) {
+                if (t->tile_state[T] & EX_TILE_READY)
+                    continue;
+                int in = all;
+                for (int32_t i = 0; i < n && !in; i++)
+                    in = ex_box_distance(t->tile_box + 6 * T, points + 3 * i) <= reach;
+                if (in)
+                    ex_build_tile(t, T);
+            }
         }
         if (m->exact_tables == t)
             m->exact_tables_bytes = t->bytes;

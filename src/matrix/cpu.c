@@ -166,6 +166,23 @@ static mfmm_status block_failed(mfmm_status st, int32_t first, mfmm_error *err)
                      (int)first);
 }
 
+/* The exact tables a job's rows read: the mesh's, made now, and built
+ * everywhere at once when its rows' patches (a few hundred vertices each)
+ * would reach most tiles anyway, so that no row looks for the tiles it
+ * needs. 0, or -1 when out of memory. */
+static int cpu_exact_tables(const mfmm_rows_job *job)
+{
+    if (!mfmm_exact_start_on(job->opt->exact_start_radius) &&
+        job->opt->method != MFMM_METHOD_WINDOWS)
+        return 0;
+    const mfmm_exact_tables *tables = NULL;
+    if (mfmm_exact_tables_of(job->mesh, &tables) != MFMM_OK)
+        return -1;
+    if ((int64_t)job->n_sources * 256 >= job->mesh->nv)
+        mfmm_exact_tables_ensure(tables, NULL, 0, INFINITY);
+    return 0;
+}
+
 mfmm_status mfmm_rows_serial(const mfmm_rows_job *job, int32_t start, mfmm_error *err)
 {
     size_t row_bytes = job->slot_bytes;
@@ -173,6 +190,8 @@ mfmm_status mfmm_rows_serial(const mfmm_rows_job *job, int32_t start, mfmm_error
     int32_t block = cpu_block_rows(job, 1, direct ? 0 : 1);
     mfmm_solver *solver = NULL;
     char *buf = NULL;
+    if (cpu_exact_tables(job) != 0)
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the exact start");
     mfmm_status st = mfmm_solver_create(job->mesh, &solver);
     if (st != MFMM_OK)
         return mfmm_fail(err, st, -1, "could not create a solver");
@@ -334,11 +353,7 @@ mfmm_status mfmm_rows_threads(const mfmm_rows_job *job, int32_t start, mfmm_erro
             return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1,
                              "out of memory for two blocks of %d rows", (int)p.block);
     }
-    /* the exact start's tables: the mesh's, built now if not yet (exact.h) */
-    const mfmm_exact_tables *tables = NULL;
-    if ((mfmm_exact_start_on(job->opt->exact_start_radius) ||
-         job->opt->method == MFMM_METHOD_WINDOWS) &&
-        mfmm_exact_tables_of(job->mesh, &tables) != MFMM_OK) {
+    if (cpu_exact_tables(job) != 0) {
         free(p.ring);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the exact start");
     }
