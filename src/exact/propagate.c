@@ -22,10 +22,12 @@ int ex_update(mfmm_exact_ws *ws, int32_t v, double dist, int force)
     double old = ws->d[v];
     if (!(dist < old))
         return 0;
-    if (old == INFINITY)
+    if (old == INFINITY) {
         ws->touched[ws->n_touched++] = v;
+        ws->emitted[v] = INFINITY;
+    }
     ws->d[v] = dist;
-    int gain = !(dist >= old - EX_TIE * old);
+    int gain = old == INFINITY || !(dist >= old - EX_TIE * old);
     if (gain)
         ws->in_angle[v] = NAN;
     if ((ws->pseudo[v] || force) && dist <= ws->max_d) {

@@ -44,6 +44,15 @@ static void ex_reset(mfmm_exact_ws *ws)
     ws->peak_bytes = ex_bytes(ws, ws->heap_cap);
 }
 
+/* Sets d to +inf on tile T's vertices (ex_tiles_visit). */
+static void ex_clear_tile(void *ctx, int32_t T)
+{
+    mfmm_exact_ws *ws = ctx;
+    int32_t v1 = (T + 1) * EX_TILE < ws->nv ? (T + 1) * EX_TILE : ws->nv;
+    for (int32_t v = T * EX_TILE; v < v1; v++)
+        ws->d[v] = INFINITY;
+}
+
 /* Whether the windows created so far are past what the vertices reached
  * so far can need: budget (1 + sqrt(n) / 8) a vertex, n vertices reached
  * (plus 64 budget), budget 64: 12-20 times what a solve needs on camelhead
@@ -251,7 +260,11 @@ mfmm_status ex_run(mfmm_exact_ws *ws, const mfmm_source *sources, int32_t n_sour
             w[k] /= sum;
         mfmm_bary_to_xyz(ws->mesh, s->face, w, p + 3 * i);
     }
-    mfmm_exact_tables_ensure(ws->t, p, n_sources, p ? max_d - least : INFINITY);
+    double radius = p ? max_d - least : INFINITY;
+    mfmm_exact_tables_ensure(ws->t, p, n_sources, radius);
+    if (ws->n_init < ws->t->n_tiles)
+        ws->n_init += ex_tiles_visit(ws->t, ws->tile_init, 1, ws->group_init_left, p, n_sources,
+                                     radius + ws->t->pad, ex_clear_tile, ws);
     if (p != few)
         free(p);
     ws->walls = 0;

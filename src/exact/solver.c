@@ -124,6 +124,8 @@ void mfmm_exact_ws_destroy(mfmm_exact_ws *ws)
     free(ws->touched);
     free(ws->patch_d);
     free(ws->in_patch);
+    free(ws->tile_init);
+    free(ws->group_init_left);
     free(ws->heap);
     free(ws->bhead);
     free(ws->nm_head);
@@ -138,8 +140,10 @@ void mfmm_exact_solver_destroy(mfmm_exact_solver *solver)
 
 size_t mfmm_exact_ws_bytes(const mfmm_mesh *mesh)
 {
+    size_t n_tiles = ((size_t)mesh->nv + EX_TILE - 1) / EX_TILE;
     return sizeof(mfmm_exact_ws) + (size_t)mesh->nv * (4 * sizeof(double) + sizeof(int32_t) + 1) +
-           3 * EX_NB * sizeof(int32_t);
+           3 * EX_NB * sizeof(int32_t) + n_tiles +
+           (n_tiles + EX_GROUP - 1) / EX_GROUP * sizeof(int32_t);
 }
 
 mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *t, mfmm_exact_ws **out)
@@ -178,15 +182,23 @@ mfmm_status mfmm_exact_ws_create_shared(const mfmm_exact_tables *t, mfmm_exact_w
     ws->in_patch = calloc(nv ? nv : 1, sizeof *ws->in_patch);
     ws->bhead = malloc(3 * EX_NB * sizeof *ws->bhead);
     ws->nm_head = malloc((ws->n_nm ? (size_t)ws->n_nm : 1) * sizeof *ws->nm_head);
+    ws->tile_init = calloc(t->n_tiles ? (size_t)t->n_tiles : 1, 1);
+    ws->group_init_left =
+        malloc((t->n_groups ? (size_t)t->n_groups : 1) * sizeof *ws->group_init_left);
     if (!ws->d || !ws->emitted || !ws->touched || !ws->patch_d || !ws->in_angle ||
-        !ws->in_patch || !ws->bhead || !ws->nm_head) {
+        !ws->in_patch || !ws->bhead || !ws->nm_head || !ws->tile_init || !ws->group_init_left) {
         mfmm_exact_ws_destroy(ws);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
-    for (size_t v = 0; v < nv; v++) {
-        ws->d[v] = INFINITY;
-        ws->emitted[v] = INFINITY;
-        ws->in_angle[v] = NAN;
+#if MFMM_POISON_UNBUILT
+    /* NaN: a run that reads a vertex outside the tiles it set never lowers it */
+    memset(ws->d, 0xff, (nv ? nv : 1) * sizeof *ws->d);
+    memset(ws->emitted, 0xff, (nv ? nv : 1) * sizeof *ws->emitted);
+    memset(ws->in_angle, 0xff, (nv ? nv : 1) * sizeof *ws->in_angle);
+#endif
+    for (int32_t G = 0; G < t->n_groups; G++) {
+        int32_t T1 = (G + 1) * EX_GROUP < t->n_tiles ? (G + 1) * EX_GROUP : t->n_tiles;
+        ws->group_init_left[G] = T1 - G * EX_GROUP;
     }
     for (int32_t i = 0; i < 3 * EX_NB; i++)
         ws->bhead[i] = -1;

@@ -109,7 +109,7 @@ struct mfmm_exact_tables {
     int32_t nv, nf;
     const int32_t *vf_offset;
     const int32_t *vf_corner; /* the mesh's vertex -> face CSR, MFMM_WEDGE entries (ex_corner) */
-    int32_t *face_in;   /* (nf,) the mesh's face id -> its record */
+    int32_t *face_in;   /* (nf,) the mesh's face id -> its record (set with the record) */
     /* per face, its three half-edges 3f+k (the edge opposite corner k, from
      * corner k+1 to k+2) in one record, so that crossing a face reads one or
      * two cache lines: see ex_face */
@@ -137,7 +137,8 @@ struct mfmm_exact_tables {
      * is one of them (records tile_rec[T] to tile_rec[T + 1] - 1) */
     int32_t n_tiles, n_ready;
     int32_t *tile_rec;   /* (n_tiles + 1,) */
-    int32_t *rec_face;   /* (nf,) a record's mesh face (face_in's inverse) */
+    int32_t *rec_face;   /* (nf,) a record's mesh face (face_in's inverse); NULL: the
+                            identity (no pieces of faces: faces already in this order) */
     uint8_t *tile_state; /* (n_tiles,) EX_TILE_FACES | EX_TILE_READY */
     uint8_t *vertex_done; /* (nv,) 1 once a vertex's fan and flags are built */
     double *tile_box;    /* (n_tiles, 6) the bounding box of the tile's vertices */
@@ -163,9 +164,16 @@ struct mfmm_exact_solver {
     const int32_t *nm_he, *nm_next;
     int32_t n_nm;
     double inv_w;
+    /* d is set to +inf a tile at a time, where runs reach (the tables'
+     * tiles: ex_run), so that a workspace on a large mesh writes only its
+     * patch's share; in_angle and emitted are set when a vertex is first
+     * touched */
     double *in_angle;  /* (nv,) direction (fan angle) back along the path that gave d */
     double *d;         /* (nv,) best distance so far, +inf untouched */
     double *emitted;   /* (nv,) the distance a pseudo-source was started with */
+    uint8_t *tile_init;       /* (n_tiles,) 1 once the tile's d is set */
+    int32_t *group_init_left; /* (n_groups,) tiles of the group whose d is not set */
+    int32_t n_init;           /* tiles whose d is set */
     int32_t *touched;  /* vertices with finite d, in order of first touch */
     int32_t n_touched;
     double *patch_d;   /* (nv,) distances of mfmm_exact_patch */
@@ -205,6 +213,15 @@ static inline double vdist(const double *p, const double *q)
     double a = p[0] - q[0], b = p[1] - q[1], c = p[2] - q[2];
     return sqrt(a * a + b * b + c * c);
 }
+
+/* Calls visit(ctx, T) for every tile T within `reach` of any of the n
+ * points (n, 3) (every tile when points is NULL or reach is not finite)
+ * whose state lacks `bit`, then sets the bit; group_left (n_groups,) counts
+ * each group's tiles without it, so that groups done are skipped. Returns
+ * the tiles visited. */
+int32_t ex_tiles_visit(const mfmm_exact_tables *t, uint8_t *state, uint8_t bit,
+                       int32_t *group_left, const double *points, int32_t n, double reach,
+                       void (*visit)(void *ctx, int32_t T), void *ctx);
 
 /* Entry i of the vertex -> face CSR, as corner 3 * record + k. */
 static inline int32_t ex_corner(const int32_t *vf_corner, const int32_t *face_in, int32_t i)

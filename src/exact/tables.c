@@ -21,8 +21,7 @@ void mfmm_exact_tables_destroy(mfmm_exact_tables *t)
     free(t->height);
     free(t->nm_he);
     free(t->nm_next);
-    if (t->rec_face != t->face_in)
-        free(t->rec_face);
+    free(t->rec_face);
     free(t->tile_rec);
     free(t->tile_state);
     free(t->vertex_done);
@@ -57,6 +56,26 @@ static int ex_i32_pair_cmp(const void *pa, const void *pb)
  * copy. The records' own test also checks their frames, which the mesh's
  * test of zero area implies (mesh/build.c: twice the area above 64 eps
  * times the longest edge squared leaves every height above 60 eps times it). */
+/* Record i's mesh face, and face f's record: the identity unless pieces
+ * of faces cut at T-junctions moved them (rec_face NULL then; face_in's
+ * entries are then set tile by tile, for the workspaces' reads). */
+static int32_t ex_face_of(const mfmm_exact_tables *t, int32_t i)
+{
+    return t->rec_face ? t->rec_face[i] : i;
+}
+
+static int32_t ex_record_of(const mfmm_exact_tables *t, int32_t f)
+{
+    return t->rec_face ? t->face_in[f] : f;
+}
+
+/* ex_corner for the tables' builders, which read records not built yet. */
+static int32_t ex_corner_of_entry(const mfmm_exact_tables *t, int32_t i)
+{
+    int32_t w = t->vf_corner[i];
+    return 3 * ex_record_of(t, MFMM_WEDGE_FACE(w)) + MFMM_WEDGE_K(w);
+}
+
 static int ex_mesh_skip(const mfmm_mesh *mesh, int32_t f)
 {
     return mfmm_mesh_degenerate(mesh, f) ? 1 : mfmm_mesh_copy(mesh, f) ? 2 : 0;
@@ -93,7 +112,7 @@ static int ex_link_nonmanifold(mfmm_exact_tables *t)
             int32_t a = fv[ex_next[k]], b = fv[ex_prev[k]];
             w[n].lo = a < b ? a : b;
             w[n].hi = a < b ? b : a;
-            w[n].h = 3 * t->face_in[f] + k;
+            w[n].h = 3 * ex_record_of(t, f) + k;
             n++;
         }
     }
@@ -214,7 +233,7 @@ static int32_t ex_tile_first(mfmm_exact_tables *t, int32_t T)
     int32_t v0 = T * EX_TILE, lo = 0, hi = t->nf;
     while (lo < hi) {
         int32_t mid = lo + (hi - lo) / 2;
-        const int32_t *fv = t->mesh->face_records[t->rec_face[mid]].v;
+        const int32_t *fv = t->mesh->face_records[ex_face_of(t, mid)].v;
         int32_t least = fv[0] < fv[1] ? fv[0] : fv[1];
         if ((least < fv[2] ? least : fv[2]) < v0)
             lo = mid + 1;
@@ -227,7 +246,7 @@ static int32_t ex_tile_first(mfmm_exact_tables *t, int32_t T)
 /* The tile of record i: its face's least vertex's. */
 static int32_t ex_tile_of_record(const mfmm_exact_tables *t, int32_t i)
 {
-    const int32_t *fv = t->mesh->face_records[t->rec_face[i]].v;
+    const int32_t *fv = t->mesh->face_records[ex_face_of(t, i)].v;
     int32_t least = fv[0] < fv[1] ? fv[0] : fv[1];
     return (least < fv[2] ? least : fv[2]) / EX_TILE;
 }
@@ -243,8 +262,10 @@ static void ex_build_faces(mfmm_exact_tables *t, int32_t T)
     const mfmm_face *F = mesh->face_records;
     int32_t i0 = ex_tile_first(t, T), i1 = T + 1 < t->n_tiles ? ex_tile_first(t, T + 1) : t->nf;
     for (int32_t i = i0; i < i1; i++) {
-        int32_t f = t->rec_face[i];
+        int32_t f = ex_face_of(t, i);
         const int32_t *fv = F[f].v;
+        if (!t->rec_face)
+            t->face_in[f] = f;
         int bad = mfmm_mesh_degenerate(mesh, f);
         ex_face *r = t->fr + i;
         memset(r, 0, sizeof *r);
@@ -286,7 +307,7 @@ static void ex_build_faces(mfmm_exact_tables *t, int32_t T)
                 for (int m = 0; m < 3; m++) {
                     if (gv[m] != a && gv[m] != b) {
                         /* into a zero-area face: -2 - its half-edge (ex_pass) */
-                        int32_t hg = 3 * t->face_in[g] + m;
+                        int32_t hg = 3 * ex_record_of(t, g) + m;
                         r->across[k] = gskip ? -2 - hg : hg;
                         r->flip[k] = gv[(m + 1) % 3] != a;
                     }
@@ -304,7 +325,8 @@ static void ex_build_faces(mfmm_exact_tables *t, int32_t T)
             }
     }
     t->tile_state[T] |= EX_TILE_FACES;
-    t->bytes += (size_t)(i1 - i0) * (sizeof(ex_face) + 3 * sizeof(double));
+    t->bytes += (size_t)(i1 - i0) *
+                (sizeof(ex_face) + 3 * sizeof(double) + (t->rec_face ? 0 : sizeof(int32_t)));
 }
 
 /* Walks the fan of v through the faces across its edges, giving each
@@ -317,7 +339,7 @@ static void ex_build_fan(mfmm_exact_tables *t, int32_t v)
     int ok = 1;
     t->fan_total[v] = NAN;
     for (int32_t i = t->vf_offset[v]; i < t->vf_offset[v + 1]; i++) {
-        int32_t c = ex_corner(t->vf_corner, t->face_in, i);
+        int32_t c = ex_corner_of_entry(t, i);
         if (t->fr[c / 3].skip == 1)
             ok = 0;
         if (t->fr[c / 3].skip == 0) {
@@ -380,11 +402,11 @@ static void ex_build_vertex(mfmm_exact_tables *t, int32_t v)
     if (t->vertex_done[v])
         return;
     for (int32_t i = t->vf_offset[v]; i < t->vf_offset[v + 1]; i++)
-        ex_build_faces(t, ex_tile_of_record(t, ex_corner(t->vf_corner, t->face_in, i) / 3));
+        ex_build_faces(t, ex_tile_of_record(t, ex_corner_of_entry(t, i) / 3));
     int pseudo = 0;
     double sum = 0.0, h = INFINITY;
     for (int32_t i = t->vf_offset[v]; i < t->vf_offset[v + 1]; i++) {
-        int32_t c = ex_corner(t->vf_corner, t->face_in, i);
+        int32_t c = ex_corner_of_entry(t, i);
         const ex_face *r = t->fr + c / 3;
         int k = c % 3;
         if (r->skip == 1) {
@@ -413,8 +435,6 @@ static void ex_build_vertex(mfmm_exact_tables *t, int32_t v)
  * vertices (and so the records of every face at those). */
 static void ex_build_tile(mfmm_exact_tables *t, int32_t T)
 {
-    if (t->tile_state[T] & EX_TILE_READY)
-        return;
     int32_t i0 = ex_tile_first(t, T), i1 = T + 1 < t->n_tiles ? ex_tile_first(t, T + 1) : t->nf;
     ex_build_faces(t, T);
     for (int32_t i = i0; i < i1; i++)
@@ -426,9 +446,6 @@ static void ex_build_tile(mfmm_exact_tables *t, int32_t T)
         for (int k = 0; k < 3; k++)
             r->tie |= (uint8_t)((t->pseudo[r->v[k]] ? 0 : 1) << k);
     }
-    t->tile_state[T] |= EX_TILE_READY;
-    t->n_ready++;
-    t->group_left[T / EX_GROUP]--;
 }
 
 size_t mfmm_exact_tables_bytes(const mfmm_mesh *mesh)
@@ -501,9 +518,9 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
     if (!mesh->piece_next) {
         /* faces are in the order of their least vertex (order.h): records
          * in face order, found per tile when built (ex_tile_first) */
-        for (size_t f = 0; f < nf; f++)
-            t->face_in[f] = (int32_t)f;
-        t->rec_face = t->face_in;
+#if MFMM_POISON_UNBUILT
+        memset(t->face_in, 0xff, (nf ? nf : 1) * sizeof *t->face_in);
+#endif
     } else {
         /* pieces of faces cut at T-junctions follow the faces: a counting
          * sort of the faces by their least vertex, so that a patch's
@@ -533,16 +550,17 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
         free(cnt);
     }
     for (size_t T = 0; T < n_tiles; T++) {
-        double *b = t->tile_box + 6 * T;
-        for (int j = 0; j < 3; j++) {
-            b[j] = INFINITY;
-            b[3 + j] = -INFINITY;
-        }
+        /* comparisons, not fmin/fmax: those are calls (a third of the
+         * first solve's set-up on a large mesh); coordinates are finite */
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (size_t v = T * EX_TILE; v < (T + 1) * EX_TILE && v < nv; v++)
             for (int j = 0; j < 3; j++) {
-                b[j] = fmin(b[j], mesh->xyz[3 * v + j]);
-                b[3 + j] = fmax(b[3 + j], mesh->xyz[3 * v + j]);
+                double x = mesh->xyz[3 * v + j];
+                lo[j] = x < lo[j] ? x : lo[j];
+                hi[j] = x > hi[j] ? x : hi[j];
             }
+        memcpy(t->tile_box + 6 * T, lo, sizeof lo);
+        memcpy(t->tile_box + 6 * T + 3, hi, sizeof hi);
     }
     for (int32_t G = 0; G < t->n_groups; G++) {
         double *b = t->group_box + 6 * G;
@@ -553,8 +571,9 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
         }
         for (int32_t T = G * EX_GROUP; T < T1; T++)
             for (int j = 0; j < 3; j++) {
-                b[j] = fmin(b[j], t->tile_box[6 * T + j]);
-                b[3 + j] = fmax(b[3 + j], t->tile_box[6 * T + 3 + j]);
+                double lo = t->tile_box[6 * T + j], hi = t->tile_box[6 * T + 3 + j];
+                b[j] = lo < b[j] ? lo : b[j];
+                b[3 + j] = hi > b[3 + j] ? hi : b[3 + j];
             }
         t->group_left[G] = T1 - G * EX_GROUP;
     }
@@ -575,7 +594,8 @@ mfmm_status mfmm_exact_tables_create(const mfmm_mesh *mesh, mfmm_exact_tables **
         return MFMM_ERR_OUT_OF_MEMORY;
     }
     t->full_bytes = mfmm_exact_tables_bytes(mesh) + 2 * (size_t)t->n_nm * sizeof(int32_t);
-    t->bytes = t->full_bytes - nf * (sizeof(ex_face) + 3 * sizeof(double)) -
+    t->bytes = t->full_bytes -
+               nf * (sizeof(ex_face) + 3 * sizeof(double) + (t->rec_face ? 0 : sizeof(int32_t))) -
                nv * (2 + 2 * sizeof(double));
     *out = t;
     return MFMM_OK;
@@ -592,6 +612,39 @@ static double ex_box_distance(const double *b, const double *p)
     return sqrt(s);
 }
 
+int32_t ex_tiles_visit(const mfmm_exact_tables *t, uint8_t *state, uint8_t bit,
+                       int32_t *group_left, const double *points, int32_t n, double reach,
+                       void (*visit)(void *ctx, int32_t T), void *ctx)
+{
+    int all = !points || !(reach < INFINITY);
+    int32_t visited = 0;
+    for (int32_t G = 0; G < t->n_groups; G++) {
+        int near = all;
+        for (int32_t i = 0; i < n && !near && group_left[G] > 0; i++)
+            near = ex_box_distance(t->group_box + 6 * G, points + 3 * i) <= reach;
+        int32_t T1 = (G + 1) * EX_GROUP < t->n_tiles ? (G + 1) * EX_GROUP : t->n_tiles;
+        for (int32_t T = G * EX_GROUP; near && group_left[G] > 0 && T < T1; T++) {
+            if (state[T] & bit)
+                continue;
+            int in = all;
+            for (int32_t i = 0; i < n && !in; i++)
+                in = ex_box_distance(t->tile_box + 6 * T, points + 3 * i) <= reach;
+            if (in) {
+                visit(ctx, T);
+                state[T] |= bit;
+                group_left[G]--;
+                visited++;
+            }
+        }
+    }
+    return visited;
+}
+
+static void ex_build_tile_visit(void *t, int32_t T)
+{
+    ex_build_tile(t, T);
+}
+
 void mfmm_exact_tables_ensure(const mfmm_exact_tables *tables, const double *points, int32_t n,
                               double radius)
 {
@@ -600,23 +653,8 @@ void mfmm_exact_tables_ensure(const mfmm_exact_tables *tables, const double *poi
     mfmm_mesh *m = (mfmm_mesh *)(uintptr_t)t->mesh;
     pthread_mutex_lock(&m->cache_lock);
     if (t->n_ready < t->n_tiles) {
-        double reach = radius + t->pad;
-        int all = !points || !(reach < INFINITY);
-        for (int32_t G = 0; G < t->n_groups; G++) {
-            int near = all;
-            for (int32_t i = 0; i < n && !near && t->group_left[G] > 0; i++)
-                near = ex_box_distance(t->group_box + 6 * G, points + 3 * i) <= reach;
-            int32_t T1 = (G + 1) * EX_GROUP < t->n_tiles ? (G + 1) * EX_GROUP : t->n_tiles;
-            for (int32_t T = G * EX_GROUP; near && t->group_left[G] > 0 && T < T1; T++) {
-                if (t->tile_state[T] & EX_TILE_READY)
-                    continue;
-                int in = all;
-                for (int32_t i = 0; i < n && !in; i++)
-                    in = ex_box_distance(t->tile_box + 6 * T, points + 3 * i) <= reach;
-                if (in)
-                    ex_build_tile(t, T);
-            }
-        }
+        t->n_ready += ex_tiles_visit(t, t->tile_state, EX_TILE_READY, t->group_left, points, n,
+                                     radius + t->pad, ex_build_tile_visit, t);
         if (m->exact_tables == t)
             m->exact_tables_bytes = t->bytes;
     }
