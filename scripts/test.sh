@@ -5,7 +5,8 @@
 # nothing beside it, so that a test depending on a file outside the
 # repository (or not committed) fails here: the C tests (ctest: cmocka,
 # command line, consumer), the C tests again under AddressSanitizer and
-# UndefinedBehaviorSanitizer, the Python tests (pytest) against the clone's
+# UndefinedBehaviorSanitizer, the tests that run threads under
+# ThreadSanitizer, the Python tests (pytest) against the clone's
 # library, and the wheel (scripts/build_wheel.sh: built with the OpenCL
 # backend, repaired to a manylinux tag, installed into the clean .venv-wheel
 # and the Python tests run there against it). After the C tests, the product
@@ -58,6 +59,13 @@ cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Debug -DMESHFMM_SANITIZE=ON \
       -DMESHFMM_BUILD_BENCH=OFF >/dev/null
 cmake --build build-sanitize -j"$jobs" >/dev/null
 ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-sanitize --output-on-failure -j"$jobs"
+
+echo "== Threaded C tests under ThreadSanitizer"
+cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMESHFMM_TSAN=ON \
+      -DMESHFMM_BUILD_BENCH=OFF >/dev/null
+cmake --build build-tsan -j"$jobs" >/dev/null
+TSAN_OPTIONS=halt_on_error=1 ctest --test-dir build-tsan --output-on-failure -j"$jobs" \
+    -R '^test_(matrix|exact|exact_start|windows|slots|spokes|solve|workflows|shared_meshes|job_inputs)$'
 
 echo "== Python tests (pytest, against this tree's build)"
 MESHFMM_LIBRARY="$PWD/build/libmeshfmm.so" PYTHONPATH="$PWD/bindings/python" \
