@@ -31,13 +31,11 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh->face_neighbor);
     free(mesh->vertex_face_offset);
     free(mesh->vertex_wedge);
-    free(mesh->full);
     free(mesh->face_block);
     free(mesh->virts);
     free(mesh->virt_first);
     free(mesh->virt_strip);
     free(mesh->strip);
-    free(mesh->build_steps);
     if (mesh->exact_tables)
         mesh->exact_tables_free(mesh->exact_tables);
     free(mesh->spoke_offset);
@@ -46,92 +44,133 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh);
 }
 
-/* A half-edge key: the corner opposite the edge (lo, hi). */
-typedef struct half_edge {
-    int32_t lo, hi, corner;
-} half_edge;
-
-/* Face adjacency across edges, boundary and non-manifold counts, edge-length
- * statistics. */
-static mfmm_status build_edges(mfmm_mesh *m)
+/* Vertex -> corner CSR, each vertex's corners ascending (so by face), and
+ * the most corners at one vertex. */
+static mfmm_status build_vertex_corners(mfmm_mesh *m, int32_t *dmax)
 {
-    size_t nc = (size_t)m->nf * 3;
-    half_edge *he = malloc((nc ? nc : 1) * sizeof *he);
-    int32_t *lo = malloc((nc ? nc : 1) * sizeof *lo), *hi = malloc((nc ? nc : 1) * sizeof *hi);
-    int32_t *perm = malloc((nc ? nc : 1) * sizeof *perm), *tmp = malloc((nc ? nc : 1) * sizeof *tmp);
-    int32_t *count = malloc(((size_t)m->nv + 1) * sizeof *count);
-    if (!he || !lo || !hi || !perm || !tmp || !count) {
-        free(he);
-        free(lo);
-        free(hi);
-        free(perm);
-        free(tmp);
-        free(count);
+    size_t nf = (size_t)m->nf;
+    int32_t *off = calloc((size_t)m->nv + 1, sizeof *off);
+    int32_t *list = malloc(3 * nf * sizeof *list);
+    if (!off || !list) {
+        free(off);
+        free(list);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
-    for (size_t c = 0; c < nc; c++) {
-        size_t f = c / 3, k = c % 3;
-        int32_t u = m->face_records[f].v[(k + 1) % 3], v = m->face_records[f].v[(k + 2) % 3];
-        lo[c] = u < v ? u : v;
-        hi[c] = u < v ? v : u;
-        perm[c] = (int32_t)c;
+    m->vertex_face_offset = off;
+    m->vertex_wedge = list;
+    for (size_t f = 0; f < nf; f++)
+        for (int k = 0; k < 3; k++)
+            off[m->face_records[f].v[k] + 1]++;
+    int32_t d = 0;
+    for (int32_t v = 0; v < m->nv; v++) {
+        d = off[v + 1] > d ? off[v + 1] : d;
+        off[v + 1] += off[v];
     }
-    /* by (lo, hi, corner): two stable counting passes */
-    mfmm_order_counting(hi, m->nv, perm, tmp, nc, count);
-    mfmm_order_counting(lo, m->nv, tmp, perm, nc, count);
-    for (size_t i = 0; i < nc; i++)
-        he[i] = (half_edge){lo[perm[i]], hi[perm[i]], perm[i]};
-    free(lo);
-    free(hi);
-    free(perm);
-    free(tmp);
-    free(count);
+    *dmax = d;
+    for (size_t f = 0; f < nf; f++)
+        for (int k = 0; k < 3; k++)
+            list[off[m->face_records[f].v[k]]++] = (int32_t)(3 * f + (size_t)k);
+    for (int32_t v = m->nv; v > 0; v--)
+        off[v] = off[v - 1];
+    off[0] = 0;
+    return MFMM_OK;
+}
+
+static int u64_cmp(const void *pa, const void *pb)
+{
+    uint64_t a = *(const uint64_t *)pa, b = *(const uint64_t *)pb;
+    return (a > b) - (a < b);
+}
+
+/* Ascending: insertion for the few keys of a typical vertex, qsort for a
+ * large fan. */
+static void sort_u64(uint64_t *key, int32_t n)
+{
+    if (n > 32) {
+        qsort(key, (size_t)n, sizeof *key, u64_cmp);
+        return;
+    }
+    for (int32_t i = 1; i < n; i++) {
+        uint64_t x = key[i];
+        int32_t j = i;
+        for (; j > 0 && key[j - 1] > x; j--)
+            key[j] = key[j - 1];
+        key[j] = x;
+    }
+}
+
+/* Face adjacency across edges, boundary and non-manifold counts, edge-length
+ * statistics, from the vertex -> corner CSR (build_vertex_corners): the
+ * half-edges (lo, hi) of each vertex lo, by hi and then by the corner
+ * opposite, from its own corners, so that no sort runs over all of them. */
+static mfmm_status build_edges(mfmm_mesh *m, int32_t dmax)
+{
+    /* per half-edge: hi << 33 | the corner opposite << 1 | its face a copy */
+    uint64_t *key = malloc((2 * (size_t)dmax + 1) * sizeof *key);
+    if (!key)
+        return MFMM_ERR_OUT_OF_MEMORY;
+    const int32_t *off = m->vertex_face_offset, *list = m->vertex_wedge;
     double sum = 0.0, lmin = INFINITY, lmax = 0.0;
     int32_t n_edges = 0, n_boundary = 0, n_nonmanifold = 0;
-    for (size_t i = 0; i < nc;) {
-        size_t j = i + 1;
-        while (j < nc && he[j].lo == he[i].lo && he[j].hi == he[i].hi)
-            j++;
-        n_edges++;
-        const double *p = m->xyz + 3 * (size_t)he[i].lo, *q = m->xyz + 3 * (size_t)he[i].hi;
-        double len = sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
-                          (p[2] - q[2]) * (p[2] - q[2]));
-        sum += len;
-        lmin = fmin(lmin, len);
-        lmax = fmax(lmax, len);
-        /* copies of a face stand aside: the edge is what the other faces
-         * make it (two copies of a face made its edges walls) */
-        size_t real[2] = {0, 0}, n_real = 0;
-        for (size_t t = i; t < j; t++)
-            if (!mfmm_mesh_copy(m, he[t].corner / 3)) {
-                if (n_real < 2)
-                    real[n_real] = t;
-                n_real++;
+    for (int32_t x = 0; x < m->nv; x++) {
+        int32_t n = 0;
+        for (int32_t i = off[x]; i < off[x + 1]; i++) {
+            int32_t f = list[i] / 3, k = list[i] % 3;
+            int32_t k1 = k == 2 ? 0 : k + 1, k2 = k1 == 2 ? 0 : k1 + 1;
+            const int32_t *fv = m->face_records[f].v;
+            uint64_t copy = (uint64_t)mfmm_mesh_copy(m, f);
+            if (fv[k1] > x)
+                key[n++] = (uint64_t)fv[k1] << 33 | (uint64_t)(3 * f + k2) << 1 | copy;
+            if (fv[k2] > x)
+                key[n++] = (uint64_t)fv[k2] << 33 | (uint64_t)(3 * f + k1) << 1 | copy;
+        }
+        sort_u64(key, n);
+        for (int32_t i = 0; i < n;) {
+            int32_t j = i + 1;
+            while (j < n && key[j] >> 33 == key[i] >> 33)
+                j++;
+            n_edges++;
+            const double *p = m->xyz + 3 * (size_t)x, *q = m->xyz + 3 * (size_t)(key[i] >> 33);
+            double len = sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                              (p[2] - q[2]) * (p[2] - q[2]));
+            sum += len;
+            lmin = fmin(lmin, len);
+            lmax = fmax(lmax, len);
+            /* copies of a face stand aside: the edge is what the other faces
+             * make it (two copies of a face made its edges walls) */
+            int32_t real[2] = {0, 0}, n_real = 0;
+            for (int32_t t = i; t < j; t++)
+                if (!(key[t] & 1)) {
+                    if (n_real < 2)
+                        real[n_real] = (int32_t)(key[t] >> 1 & 0xffffffffu);
+                    n_real++;
+                }
+            if (n_real == 2) {
+                m->face_neighbor[real[0]] = real[1] / 3;
+                m->face_neighbor[real[1]] = real[0] / 3;
+            } else {
+                /* boundary, or non-manifold: the walk of section 4.2 stops here */
+                for (int32_t t = i; t < j; t++)
+                    m->face_neighbor[key[t] >> 1 & 0xffffffffu] = -1;
+                if (n_real == 1)
+                    n_boundary++;
+                else
+                    n_nonmanifold++;
             }
-        if (n_real == 2) {
-            m->face_neighbor[he[real[0]].corner] = he[real[1]].corner / 3;
-            m->face_neighbor[he[real[1]].corner] = he[real[0]].corner / 3;
-        } else {
-            /* boundary, or non-manifold: the walk of section 4.2 stops here */
-            for (size_t t = i; t < j; t++)
-                m->face_neighbor[he[t].corner] = -1;
-            if (n_real == 1)
-                n_boundary++;
-            else
-                n_nonmanifold++;
+            /* a copy's edge leads where its original's does: copies follow
+             * their original in face order, hence in the group (O(faces), even
+             * for a million copies of one face) */
+            for (int32_t t = i, s = i; t < j; t++) {
+                if (!(key[t] & 1))
+                    s = t;
+                else
+                    m->face_neighbor[key[t] >> 1 & 0xffffffffu] =
+                        m->face_neighbor[key[s] >> 1 & 0xffffffffu];
+            }
+            i = j;
         }
-        /* a copy's edge leads where its original's does: copies follow
-         * their original in face order, hence in the group (O(faces), even
-         * for a million copies of one face) */
-        for (size_t t = i, s = i; t < j; t++) {
-            if (!mfmm_mesh_copy(m, he[t].corner / 3))
-                s = t;
-            else
-                m->face_neighbor[he[t].corner] = m->face_neighbor[he[s].corner];
-        }
-        i = j;
     }
-    free(he);
+    free(key);
     int32_t n_copies = 0;
     for (int32_t f = 1; f < m->nf; f++)
         n_copies += mfmm_mesh_copy(m, f);
@@ -146,7 +185,7 @@ static mfmm_status build_edges(mfmm_mesh *m)
 }
 
 /* The corner of face f in x's corner list list[0..n) (sorted by face, as
- * build_vertex_faces makes it), or -1. */
+ * build_vertex_corners makes it), or -1. */
 static int32_t find_corner(const int32_t *list, int32_t n, int32_t f)
 {
     int32_t lo = 0, hi = n;
@@ -160,20 +199,16 @@ static int32_t find_corner(const int32_t *list, int32_t n, int32_t f)
     return lo < n && list[lo] / 3 == f ? lo : -1;
 }
 
-/* Puts each vertex's corners in fan order: face (x, p, q) is followed by
- * the face across edge xq when that face has x, q in the same orientation
- * (its vertex after x is q), so that consecutive faces share a neighbour
- * of x: the march (march.h) then meets x's settled neighbours in runs, which
- * its branches predict, and offers a shared neighbour once. Fans start at a
- * face with no predecessor (a boundary, non-manifold or flipped edge);
- * closed fans follow. Any order is correct: this one saves work. */
-static mfmm_status fan_order(mfmm_mesh *m)
+/* Puts each vertex's corners in fan order, as wedges (MFMM_WEDGE): face
+ * (x, p, q) is followed by the face across edge xq when that face has x, q
+ * in the same orientation (its vertex after x is q), so that consecutive
+ * faces share a neighbour of x: the march (march.h) then meets x's settled
+ * neighbours in runs, which its branches predict, and offers a shared
+ * neighbour once. Fans start at a face with no predecessor (a boundary,
+ * non-manifold or flipped edge); closed fans follow. Any order is correct:
+ * this one saves work. dmax: the most corners at one vertex. */
+static mfmm_status fan_order(mfmm_mesh *m, int32_t dmax)
 {
-    int32_t dmax = 0;
-    for (int32_t v = 0; v < m->nv; v++) {
-        int32_t d = m->vertex_face_offset[v + 1] - m->vertex_face_offset[v];
-        dmax = d > dmax ? d : dmax;
-    }
     int32_t *next = malloc(((size_t)dmax + 1) * 3 * sizeof *next);
     if (!next)
         return MFMM_ERR_OUT_OF_MEMORY;
@@ -204,45 +239,13 @@ static mfmm_status fan_order(mfmm_mesh *m)
                 if (has_prev[i] == 2 || (pass == 0 && has_prev[i]))
                     continue;
                 for (int32_t j = i; j >= 0 && has_prev[j] != 2; j = next[j]) {
-                    out[n_out++] = list[j];
+                    out[n_out++] = MFMM_WEDGE(list[j] / 3, list[j] % 3);
                     has_prev[j] = 2;
                 }
             }
         memcpy(list, out, (size_t)n * sizeof *list);
     }
     free(next);
-    return MFMM_OK;
-}
-
-/* Vertex -> corner CSR. */
-static mfmm_status build_vertex_faces(mfmm_mesh *m)
-{
-    size_t nc = (size_t)m->nf * 3;
-    int32_t *off = calloc((size_t)m->nv + 1, sizeof *off);
-    int32_t *list = malloc(nc * sizeof *list);
-    if (!off || !list) {
-        free(off);
-        free(list);
-        return MFMM_ERR_OUT_OF_MEMORY;
-    }
-    for (size_t c = 0; c < nc; c++)
-        off[mfmm_mesh_corner_vertex(m, (int32_t)c) + 1]++;
-    for (int32_t v = 0; v < m->nv; v++)
-        off[v + 1] += off[v];
-    for (size_t c = 0; c < nc; c++) {
-        int32_t v = mfmm_mesh_corner_vertex(m, (int32_t)c);
-        list[off[v]++] = (int32_t)c;
-    }
-    for (int32_t v = m->nv; v > 0; v--)
-        off[v] = off[v - 1];
-    off[0] = 0;
-    m->vertex_face_offset = off;
-    m->vertex_wedge = list;
-    mfmm_status st = fan_order(m);
-    if (st != MFMM_OK)
-        return st;
-    for (size_t i = 0; i < nc; i++)
-        list[i] = MFMM_WEDGE(list[i] / 3, list[i] % 3);
     return MFMM_OK;
 }
 
@@ -354,13 +357,37 @@ static double dot3(const double *a, const double *b)
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/* Corner lengths and angles; degenerate faces; obtuse corners; the face
- * records' lengths and cosines. */
-static void build_corners(mfmm_mesh *m)
+/* A growable list of the obtuse corners, in corner order. */
+typedef struct obtuse_list {
+    mfmm_obtuse *at;
+    int32_t n, cap;
+} obtuse_list;
+
+static int obtuse_push(obtuse_list *l, int32_t corner)
 {
-    int32_t n_degenerate = 0, n_obtuse = 0;
+    if (l->n == l->cap) {
+        if (l->cap > INT32_MAX / 2)
+            return 0;
+        int32_t cap = l->cap ? 2 * l->cap : 1024;
+        mfmm_obtuse *p = realloc(l->at, (size_t)cap * sizeof *p);
+        if (!p)
+            return 0;
+        l->at = p;
+        l->cap = cap;
+    }
+    l->at[l->n++].corner = corner;
+    return 1;
+}
+
+/* The face records' lengths and cosines (NaN: zero area,
+ * mfmm_mesh_degenerate), no virtual edge yet; degenerate faces; the obtuse
+ * corners, listed in ob. */
+static mfmm_status build_corners(mfmm_mesh *m, obtuse_list *ob)
+{
+    int32_t n_degenerate = 0;
     for (int32_t f = 0; f < m->nf; f++) {
-        const int32_t *fv = m->face_records[f].v;
+        mfmm_face *r = m->face_records + f;
+        const int32_t *fv = r->v;
         double e[3][3], len[3]; /* e[k]: edge opposite corner k, from k+1 to k+2 */
         for (int k = 0; k < 3; k++) {
             sub3(e[k], m->xyz + 3 * (size_t)fv[(k + 2) % 3], m->xyz + 3 * (size_t)fv[(k + 1) % 3]);
@@ -383,59 +410,45 @@ static void build_corners(mfmm_mesh *m)
             degenerate = !(sine > 64.0 * DBL_EPSILON * (lmax / len[0]) * (lmax / len[1]));
         }
         n_degenerate += degenerate;
-        for (int k = 0; k < 3; k++) {
-            mfmm_corner_full *c = m->full + 3 * (size_t)f + k;
-            int ka = (k + 1) % 3, kb = (k + 2) % 3;
-            c->face = f;
-            c->a = fv[ka];
-            c->b = fv[kb];
-            c->len_a = len[ka]; /* |BC| is opposite A */
-            c->len_b = len[kb]; /* |AC| is opposite B */
-            c->cos_c = 0.0;
-            c->virt = degenerate ? MFMM_VIRT_DEGENERATE : MFMM_VIRT_NONE;
-            c->virt_len = 0.0;
-            c->virt_cos_a = 0.0;
-            c->virt_cos_b = 0.0;
-            if (degenerate)
-                continue;
-            /* cos at C from the edge vectors C->A = e[kb], C->B = -e[ka] */
-            double cosv = -dot3(e[kb], e[ka]) / (len[kb] * len[ka]);
-            c->cos_c = fmax(-1.0, fmin(1.0, cosv));
-            if (c->cos_c < MFMM_OBTUSE_COS) {
-                c->virt = MFMM_VIRT_FAILED; /* until unfolding finds its virtual edge */
-                n_obtuse++;
-            }
-        }
-        /* the march's record (NaN cosines: zero area, mfmm_mesh_degenerate),
-         * which unfolding reads already */
-        mfmm_face *r = m->face_records + f;
+        r->virt = 3;
         for (int k = 0; k < 3; k++) {
             r->len[k] = len[k];
-            r->cosv[k] = degenerate ? NAN : m->full[3 * (size_t)f + k].cos_c;
+            if (degenerate) {
+                r->cosv[k] = NAN;
+                continue;
+            }
+            int ka = (k + 1) % 3, kb = (k + 2) % 3;
+            /* cos at C from the edge vectors C->A = e[kb], C->B = -e[ka] */
+            double cosv = -dot3(e[kb], e[ka]) / (len[kb] * len[ka]);
+            r->cosv[k] = fmax(-1.0, fmin(1.0, cosv));
+            /* until unfolding finds its virtual edge */
+            if (r->cosv[k] < MFMM_OBTUSE_COS && !obtuse_push(ob, 3 * f + k))
+                return MFMM_ERR_OUT_OF_MEMORY;
         }
     }
     m->info.n_degenerate_faces = n_degenerate;
-    m->info.n_obtuse_corners = n_obtuse;
+    m->info.n_obtuse_corners = ob->n;
+    return MFMM_OK;
 }
 
-/* The march's records from the build's corners: each face record's obtuse
- * corner (its vertices, lengths and cosines are in place: mesh creation,
- * build_corners), and one mfmm_virt per obtuse corner whose
- * virtual edge unfolding found, sorted by V (counting sort, so by corner
- * within one V), the face naming V (the march reads the record from V's
- * list once V is Alive). The strips' vertices (for the
+/* The march's records from the obtuse corners (in corner order): each face
+ * record's obtuse corner with a virtual edge (its vertices, lengths and
+ * cosines are in place: mesh creation, build_corners), and one mfmm_virt per
+ * obtuse corner whose virtual edge unfolding found, sorted by V (counting
+ * sort, so by corner within one V), the face naming V (the march reads the
+ * record from V's list once V is Alive). The strips' vertices (for the
  * virtual stencils' cost test) per virtual edge but V, in virts' order (the
- * strips' other fields are re-walked when needed, mfmm_strip_next). Frees
- * m->full and m->build_steps. */
-static mfmm_status build_records(mfmm_mesh *m)
+ * strips' other fields are re-walked when needed, mfmm_strip_next), from
+ * far, the strips' vertices as unfolding found them. */
+static mfmm_status build_records(mfmm_mesh *m, const mfmm_obtuse *ob, int32_t n_ob,
+                                 const int32_t *far)
 {
-    size_t nf = (size_t)m->nf, nc = 3 * nf;
     size_t n_steps = 0;
     size_t n_virts = 0;
-    for (size_t c = 0; c < nc; c++)
-        if (m->full[c].virt >= 0) {
+    for (int32_t i = 0; i < n_ob; i++)
+        if (ob[i].virt >= 0) {
             n_virts++;
-            n_steps += (size_t)m->full[c].strip_n - 1; /* (V aside) */
+            n_steps += (size_t)ob[i].strip_n - 1; /* (V aside) */
         }
     if (n_steps > (size_t)INT32_MAX)
         return MFMM_ERR_BAD_COUNT;
@@ -447,48 +460,46 @@ static mfmm_status build_records(mfmm_mesh *m)
     m->virt_first = calloc((size_t)m->nv + 1, sizeof *m->virt_first);
     m->virt_strip = malloc((n_virts + 1) * sizeof *m->virt_strip);
     m->strip = malloc((n_steps ? n_steps : 1) * sizeof *m->strip);
-    if (!m->virts || !m->virt_first || !m->virt_strip || !m->strip)
+    /* each virtual edge's obtuse corner */
+    int32_t *from = malloc((n_virts ? n_virts : 1) * sizeof *from);
+    if (!m->virts || !m->virt_first || !m->virt_strip || !m->strip || !from) {
+        free(from);
         return MFMM_ERR_OUT_OF_MEMORY;
+    }
     int32_t *first = m->virt_first;
-    for (size_t c = 0; c < nc; c++)
-        if (m->full[c].virt >= 0)
-            first[m->full[c].virt + 1]++;
+    for (int32_t i = 0; i < n_ob; i++)
+        if (ob[i].virt >= 0)
+            first[ob[i].virt + 1]++;
     for (int32_t v = 0; v < m->nv; v++)
         first[v + 1] += first[v];
-    for (size_t f = 0; f < nf; f++) {
-        mfmm_face *r = m->face_records + f;
-        r->virt = 3;
-        for (int k = 0; k < 3; k++) {
-            const mfmm_corner_full *x = m->full + 3 * f + k;
-            if (x->virt < 0)
-                continue;
-            /* (a face has at most one obtuse corner) */
-            int32_t at = first[x->virt]++;
-            mfmm_virt *vr = m->virts + at;
-            vr->corner = (int32_t)(3 * f + (size_t)k);
-            vr->c = m->face_records[f].v[k];
-            vr->len = x->virt_len;
-            vr->cos_a = x->virt_cos_a;
-            vr->cos_b = x->virt_cos_b;
-            r->virt = 4 * x->virt + k;
-            m->virt_strip[at + 1] = x->strip_n - 1;
-        }
+    for (int32_t i = 0; i < n_ob; i++) {
+        const mfmm_obtuse *x = ob + i;
+        if (x->virt < 0)
+            continue;
+        int32_t f = x->corner / 3, k = x->corner % 3;
+        int32_t at = first[x->virt]++;
+        mfmm_virt *vr = m->virts + at;
+        vr->corner = x->corner;
+        vr->c = m->face_records[f].v[k];
+        vr->len = x->len;
+        vr->cos_a = x->cos_a;
+        vr->cos_b = x->cos_b;
+        m->face_records[f].virt = 4 * x->virt + k;
+        m->virt_strip[at + 1] = x->strip_n - 1;
+        from[at] = i;
     }
     for (int32_t v = m->nv; v > 0; v--)
         first[v] = first[v - 1];
     first[0] = 0;
     m->virt_strip[0] = 0;
     for (size_t j = 0; j < n_virts; j++) {
-        const mfmm_corner_full *x = m->full + m->virts[j].corner;
+        const mfmm_obtuse *x = ob + from[j];
         int32_t at = m->virt_strip[j];
         for (int32_t i = 0; i < x->strip_n - 1; i++)
-            m->strip[at + i] = m->build_steps[x->strip_at + i].far;
+            m->strip[at + i] = far[x->strip_at + i];
         m->virt_strip[j + 1] += at;
     }
-    free(m->full);
-    m->full = NULL;
-    free(m->build_steps);
-    m->build_steps = NULL;
+    free(from);
     return MFMM_OK;
 }
 
@@ -518,9 +529,7 @@ mfmm_status mfmm_mesh_build(const double *vertices, int32_t nv, const int32_t *f
         m->face_records = (mfmm_face *)(void *)((char *)m->face_block +
                                                 (64 - (uintptr_t)m->face_block % 64) % 64);
     m->face_neighbor = malloc(nc * sizeof *m->face_neighbor);
-    m->full = malloc(nc * sizeof *m->full);
-    if (!m->xyz || !m->face_block || !m->face_neighbor ||
-        !m->full) {
+    if (!m->xyz || !m->face_block || !m->face_neighbor) {
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
     }
@@ -546,17 +555,24 @@ mfmm_status mfmm_mesh_build(const double *vertices, int32_t nv, const int32_t *f
     m->info.n_vertices = nv;
     m->info.n_faces = nf;
 
-    st = build_edges(m);
+    int32_t dmax = 0;
+    obtuse_list ob = {NULL, 0, 0};
+    int32_t *far = NULL;
+    st = build_vertex_corners(m, &dmax);
     if (st == MFMM_OK)
-        st = build_vertex_faces(m);
+        st = build_edges(m, dmax);
+    if (st == MFMM_OK)
+        st = fan_order(m, dmax);
     if (st == MFMM_OK)
         st = build_components(m);
-    if (st == MFMM_OK) {
-        build_corners(m);
-        st = mfmm_mesh_unfold_obtuse(m, opt.max_unfold_steps);
-    }
     if (st == MFMM_OK)
-        st = build_records(m);
+        st = build_corners(m, &ob);
+    if (st == MFMM_OK)
+        st = mfmm_mesh_unfold_obtuse(m, opt.max_unfold_steps, ob.at, ob.n, &far);
+    if (st == MFMM_OK)
+        st = build_records(m, ob.at, ob.n, far);
+    free(ob.at);
+    free(far);
     if (st != MFMM_OK) {
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, st, -1, NULL);
