@@ -17,6 +17,18 @@
  * underflow). */
 #define MFMM_MIN_DIAGONAL 1e-100
 
+/* fmin and fmax of numbers (no NaN), inline: as calls they cost as much as
+ * the loops over every edge and vertex that use them. */
+static double min_d(double x, double y)
+{
+    return y < x ? y : x;
+}
+
+static double max_d(double x, double y)
+{
+    return y > x ? y : x;
+}
+
 void mfmm_mesh_destroy(mfmm_mesh *mesh)
 {
     if (!mesh)
@@ -44,35 +56,48 @@ void mfmm_mesh_destroy(mfmm_mesh *mesh)
     free(mesh);
 }
 
-/* Vertex -> corner CSR, each vertex's corners ascending (so by face), and
- * the most corners at one vertex. */
-static mfmm_status build_vertex_corners(mfmm_mesh *m, int32_t *dmax)
+/* The face records' vertices in internal face order, from the mapped input
+ * faces (face_neighbor, input order); which faces copy the one before
+ * (mfmm_mesh_copy: *copy, malloc'd) and their count; the vertex -> corner
+ * CSR, each vertex's corners ascending (so by face), and the most corners at
+ * one vertex: one pass over the faces for all that reads them in order. */
+static mfmm_status build_faces(mfmm_mesh *m, int32_t *dmax, uint8_t **copy_out)
 {
     size_t nf = (size_t)m->nf;
     int32_t *off = calloc((size_t)m->nv + 1, sizeof *off);
     int32_t *list = malloc(3 * nf * sizeof *list);
-    if (!off || !list) {
+    uint8_t *copy = malloc(nf);
+    if (!off || !list || !copy) {
         free(off);
         free(list);
+        free(copy);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
     m->vertex_face_offset = off;
     m->vertex_wedge = list;
-    for (size_t f = 0; f < nf; f++)
+    int32_t n_copies = 0;
+    for (size_t f = 0; f < nf; f++) {
+        int32_t *fv = m->face_records[f].v;
+        memcpy(fv, m->face_neighbor + 3 * (size_t)m->face_to_external[f], 3 * sizeof *fv);
+        copy[f] = (uint8_t)mfmm_mesh_copy(m, (int32_t)f);
+        n_copies += copy[f];
         for (int k = 0; k < 3; k++)
-            off[m->face_records[f].v[k] + 1]++;
+            off[fv[k] + 1]++;
+    }
     int32_t d = 0;
     for (int32_t v = 0; v < m->nv; v++) {
         d = off[v + 1] > d ? off[v + 1] : d;
         off[v + 1] += off[v];
     }
-    *dmax = d;
     for (size_t f = 0; f < nf; f++)
         for (int k = 0; k < 3; k++)
             list[off[m->face_records[f].v[k]]++] = (int32_t)(3 * f + (size_t)k);
     for (int32_t v = m->nv; v > 0; v--)
         off[v] = off[v - 1];
     off[0] = 0;
+    *dmax = d;
+    *copy_out = copy;
+    m->info.n_duplicate_faces = n_copies;
     return MFMM_OK;
 }
 
@@ -99,16 +124,81 @@ static void sort_u64(uint64_t *key, int32_t n)
     }
 }
 
+/* The corner of face f in x's corner list list[0..n) (sorted by face, as
+ * build_faces makes it), or -1. */
+static int32_t find_corner(const int32_t *list, int32_t n, int32_t f)
+{
+    int32_t lo = 0, hi = n;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (list[mid] / 3 < f)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < n && list[lo] / 3 == f ? lo : -1;
+}
+
+/* Puts vertex x's corners in fan order, as wedges (MFMM_WEDGE), once the
+ * face_neighbor entries of its edges are set: face (x, p, q) is followed by
+ * the face across edge xq when that face has x, q in the same orientation
+ * (its vertex after x is q), so that consecutive faces share a neighbour of
+ * x: the march (march.h) then meets x's settled neighbours in runs, which
+ * its branches predict, and offers a shared neighbour once. Fans start at a
+ * face with no predecessor (a boundary, non-manifold or flipped edge);
+ * closed fans follow. Any order is correct: this one saves work. next,
+ * has_prev, out: scratch of x's corner count. */
+static void fan_vertex(mfmm_mesh *m, int32_t x, int32_t *next, int32_t *has_prev, int32_t *out)
+{
+    int32_t *list = m->vertex_wedge + m->vertex_face_offset[x];
+    int32_t n = m->vertex_face_offset[x + 1] - m->vertex_face_offset[x];
+    for (int32_t i = 0; i < n; i++)
+        has_prev[i] = 0;
+    for (int32_t i = 0; i < n; i++) {
+        int32_t c = list[i], f = c / 3, k = c % 3;
+        int32_t kp = k == 2 ? 0 : k + 1, kq = kp == 2 ? 0 : kp + 1;
+        int32_t q = m->face_records[f].v[kq];
+        int32_t g = m->face_neighbor[3 * f + kp]; /* across edge x q */
+        int32_t j = g >= 0 ? find_corner(list, n, g) : -1;
+        next[i] = -1;
+        if (j >= 0 && j != i && !has_prev[j]) {
+            int32_t kg = list[j] % 3;
+            if (m->face_records[g].v[kg == 2 ? 0 : kg + 1] == q) {
+                next[i] = j;
+                has_prev[j] = 1;
+            }
+        }
+    }
+    int32_t n_out = 0;
+    for (int pass = 0; pass < 2; pass++)
+        for (int32_t i = 0; i < n; i++) {
+            if (has_prev[i] == 2 || (pass == 0 && has_prev[i]))
+                continue;
+            for (int32_t j = i; j >= 0 && has_prev[j] != 2; j = next[j]) {
+                out[n_out++] = MFMM_WEDGE(list[j] / 3, list[j] % 3);
+                has_prev[j] = 2;
+            }
+        }
+    memcpy(list, out, (size_t)n * sizeof *list);
+}
+
 /* Face adjacency across edges, boundary and non-manifold counts, edge-length
- * statistics, from the vertex -> corner CSR (build_vertex_corners): the
- * half-edges (lo, hi) of each vertex lo, by hi and then by the corner
- * opposite, from its own corners, so that no sort runs over all of them. */
-static mfmm_status build_edges(mfmm_mesh *m, int32_t dmax)
+ * statistics, and each vertex's fan order (fan_vertex), from the vertex ->
+ * corner CSR and the copy flags (build_faces): the half-edges (lo, hi) of
+ * each vertex lo, by hi and then by the corner opposite, from its own
+ * corners, so that no sort runs over all of them; a vertex's fan once the
+ * edges of every vertex up to it are done, which are all of its own. */
+static mfmm_status build_edges(mfmm_mesh *m, int32_t dmax, const uint8_t *copy)
 {
     /* per half-edge: hi << 33 | the corner opposite << 1 | its face a copy */
     uint64_t *key = malloc((2 * (size_t)dmax + 1) * sizeof *key);
-    if (!key)
+    int32_t *next = malloc(((size_t)dmax + 1) * 3 * sizeof *next);
+    if (!key || !next) {
+        free(key);
+        free(next);
         return MFMM_ERR_OUT_OF_MEMORY;
+    }
+    int32_t *has_prev = next + dmax + 1, *out = has_prev + dmax + 1;
     const int32_t *off = m->vertex_face_offset, *list = m->vertex_wedge;
     double sum = 0.0, lmin = INFINITY, lmax = 0.0;
     int32_t n_edges = 0, n_boundary = 0, n_nonmanifold = 0;
@@ -118,11 +208,10 @@ static mfmm_status build_edges(mfmm_mesh *m, int32_t dmax)
             int32_t f = list[i] / 3, k = list[i] % 3;
             int32_t k1 = k == 2 ? 0 : k + 1, k2 = k1 == 2 ? 0 : k1 + 1;
             const int32_t *fv = m->face_records[f].v;
-            uint64_t copy = (uint64_t)mfmm_mesh_copy(m, f);
             if (fv[k1] > x)
-                key[n++] = (uint64_t)fv[k1] << 33 | (uint64_t)(3 * f + k2) << 1 | copy;
+                key[n++] = (uint64_t)fv[k1] << 33 | (uint64_t)(3 * f + k2) << 1 | copy[f];
             if (fv[k2] > x)
-                key[n++] = (uint64_t)fv[k2] << 33 | (uint64_t)(3 * f + k1) << 1 | copy;
+                key[n++] = (uint64_t)fv[k2] << 33 | (uint64_t)(3 * f + k1) << 1 | copy[f];
         }
         sort_u64(key, n);
         for (int32_t i = 0; i < n;) {
@@ -134,8 +223,8 @@ static mfmm_status build_edges(mfmm_mesh *m, int32_t dmax)
             double len = sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
                               (p[2] - q[2]) * (p[2] - q[2]));
             sum += len;
-            lmin = fmin(lmin, len);
-            lmax = fmax(lmax, len);
+            lmin = min_d(lmin, len);
+            lmax = max_d(lmax, len);
             /* copies of a face stand aside: the edge is what the other faces
              * make it (two copies of a face made its edges walls) */
             int32_t real[2] = {0, 0}, n_real = 0;
@@ -169,83 +258,16 @@ static mfmm_status build_edges(mfmm_mesh *m, int32_t dmax)
             }
             i = j;
         }
+        fan_vertex(m, x, next, has_prev, out);
     }
     free(key);
-    int32_t n_copies = 0;
-    for (int32_t f = 1; f < m->nf; f++)
-        n_copies += mfmm_mesh_copy(m, f);
-    m->info.n_duplicate_faces = n_copies;
+    free(next);
     m->info.n_edges = n_edges;
     m->info.n_boundary_edges = n_boundary;
     m->info.n_nonmanifold_edges = n_nonmanifold;
     m->info.min_edge_length = lmin;
     m->info.max_edge_length = lmax;
     m->info.mean_edge_length = n_edges ? sum / n_edges : 0.0;
-    return MFMM_OK;
-}
-
-/* The corner of face f in x's corner list list[0..n) (sorted by face, as
- * build_vertex_corners makes it), or -1. */
-static int32_t find_corner(const int32_t *list, int32_t n, int32_t f)
-{
-    int32_t lo = 0, hi = n;
-    while (lo < hi) {
-        int32_t mid = lo + (hi - lo) / 2;
-        if (list[mid] / 3 < f)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < n && list[lo] / 3 == f ? lo : -1;
-}
-
-/* Puts each vertex's corners in fan order, as wedges (MFMM_WEDGE): face
- * (x, p, q) is followed by the face across edge xq when that face has x, q
- * in the same orientation (its vertex after x is q), so that consecutive
- * faces share a neighbour of x: the march (march.h) then meets x's settled
- * neighbours in runs, which its branches predict, and offers a shared
- * neighbour once. Fans start at a face with no predecessor (a boundary,
- * non-manifold or flipped edge); closed fans follow. Any order is correct:
- * this one saves work. dmax: the most corners at one vertex. */
-static mfmm_status fan_order(mfmm_mesh *m, int32_t dmax)
-{
-    int32_t *next = malloc(((size_t)dmax + 1) * 3 * sizeof *next);
-    if (!next)
-        return MFMM_ERR_OUT_OF_MEMORY;
-    int32_t *has_prev = next + dmax + 1, *out = has_prev + dmax + 1;
-    for (int32_t v = 0; v < m->nv; v++) {
-        int32_t *list = m->vertex_wedge + m->vertex_face_offset[v];
-        int32_t n = m->vertex_face_offset[v + 1] - m->vertex_face_offset[v];
-        for (int32_t i = 0; i < n; i++)
-            has_prev[i] = 0;
-        for (int32_t i = 0; i < n; i++) {
-            int32_t c = list[i], f = c / 3, k = c % 3;
-            int32_t kp = k == 2 ? 0 : k + 1, kq = kp == 2 ? 0 : kp + 1;
-            int32_t q = m->face_records[f].v[kq];
-            int32_t g = m->face_neighbor[3 * f + kp]; /* across edge x q */
-            int32_t j = g >= 0 ? find_corner(list, n, g) : -1;
-            next[i] = -1;
-            if (j >= 0 && j != i && !has_prev[j]) {
-                int32_t kg = list[j] % 3;
-                if (m->face_records[g].v[kg == 2 ? 0 : kg + 1] == q) {
-                    next[i] = j;
-                    has_prev[j] = 1;
-                }
-            }
-        }
-        int32_t n_out = 0;
-        for (int pass = 0; pass < 2; pass++)
-            for (int32_t i = 0; i < n; i++) {
-                if (has_prev[i] == 2 || (pass == 0 && has_prev[i]))
-                    continue;
-                for (int32_t j = i; j >= 0 && has_prev[j] != 2; j = next[j]) {
-                    out[n_out++] = MFMM_WEDGE(list[j] / 3, list[j] % 3);
-                    has_prev[j] = 2;
-                }
-            }
-        memcpy(list, out, (size_t)n * sizeof *list);
-    }
-    free(next);
     return MFMM_OK;
 }
 
@@ -396,7 +418,7 @@ static mfmm_status build_corners(mfmm_mesh *m, obtuse_list *ob)
         /* zero area up to rounding (twice the area |e0 x e1| <= 64 eps lmax^2),
          * tested on unit vectors so that no length is squared twice: no
          * triangle update there, edges only */
-        double lmax = fmax(len[0], fmax(len[1], len[2]));
+        double lmax = max_d(len[0], max_d(len[1], len[2]));
         int degenerate = !(len[0] > 0.0 && len[1] > 0.0);
         if (!degenerate) {
             double u0[3], u1[3];
@@ -420,7 +442,9 @@ static mfmm_status build_corners(mfmm_mesh *m, obtuse_list *ob)
             int ka = (k + 1) % 3, kb = (k + 2) % 3;
             /* cos at C from the edge vectors C->A = e[kb], C->B = -e[ka] */
             double cosv = -dot3(e[kb], e[ka]) / (len[kb] * len[ka]);
-            r->cosv[k] = fmax(-1.0, fmin(1.0, cosv));
+            /* (NaN, where the lengths' product underflows, to 1, as fmin) */
+            cosv = cosv < 1.0 ? cosv : 1.0;
+            r->cosv[k] = max_d(-1.0, cosv);
             /* until unfolding finds its virtual edge */
             if (r->cosv[k] < MFMM_OBTUSE_COS && !obtuse_push(ob, 3 * f + k))
                 return MFMM_ERR_OUT_OF_MEMORY;
@@ -523,7 +547,8 @@ mfmm_status mfmm_mesh_build(const double *vertices, int32_t nv, const int32_t *f
     size_t nc = (size_t)nf * 3;
     m->xyz = malloc((size_t)nv * 3 * sizeof *m->xyz);
     /* the face records, on cache-line boundaries (one record, one line):
-     * their vertices now, the rest once the corners are known */
+     * their vertices once the faces are ordered, the rest once the corners
+     * are known */
     m->face_block = malloc((size_t)nf * sizeof *m->face_records + 64);
     if (m->face_block)
         m->face_records = (mfmm_face *)(void *)((char *)m->face_block +
@@ -535,7 +560,7 @@ mfmm_status mfmm_mesh_build(const double *vertices, int32_t nv, const int32_t *f
     }
     /* renumbered: coordinates in internal order, faces' vertex ids mapped
      * (face_neighbor holds them in input face order until the faces are
-     * ordered by them) */
+     * ordered by them and build_faces copies them) */
     if (mfmm_order_build(vertices, nv, &m->to_internal, &m->to_external) != MFMM_OK) {
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
@@ -544,25 +569,22 @@ mfmm_status mfmm_mesh_build(const double *vertices, int32_t nv, const int32_t *f
         memcpy(m->xyz + 3 * (size_t)v, vertices + 3 * (size_t)m->to_external[v], 3 * sizeof *m->xyz);
     for (size_t c = 0; c < nc; c++)
         m->face_neighbor[c] = m->to_internal[faces[c]];
-    if (mfmm_order_faces(m->face_neighbor, nf, &m->face_to_internal, &m->face_to_external) !=
+    if (mfmm_order_faces(m->face_neighbor, nf, nv, &m->face_to_internal, &m->face_to_external) !=
         MFMM_OK) {
         mfmm_mesh_destroy(m);
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
     }
-    for (int32_t f = 0; f < nf; f++)
-        memcpy(m->face_records[f].v, m->face_neighbor + 3 * (size_t)m->face_to_external[f],
-               sizeof m->face_records[f].v);
     m->info.n_vertices = nv;
     m->info.n_faces = nf;
 
     int32_t dmax = 0;
     obtuse_list ob = {NULL, 0, 0};
     int32_t *far = NULL;
-    st = build_vertex_corners(m, &dmax);
+    uint8_t *copy = NULL;
+    st = build_faces(m, &dmax, &copy);
     if (st == MFMM_OK)
-        st = build_edges(m, dmax);
-    if (st == MFMM_OK)
-        st = fan_order(m, dmax);
+        st = build_edges(m, dmax, copy);
+    free(copy);
     if (st == MFMM_OK)
         st = build_components(m);
     if (st == MFMM_OK)
@@ -582,8 +604,8 @@ mfmm_status mfmm_mesh_build(const double *vertices, int32_t nv, const int32_t *f
         if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1])
             continue; /* unreferenced */
         for (int k = 0; k < 3; k++) {
-            lo[k] = fmin(lo[k], m->xyz[3 * (size_t)v + k]);
-            hi[k] = fmax(hi[k], m->xyz[3 * (size_t)v + k]);
+            lo[k] = min_d(lo[k], m->xyz[3 * (size_t)v + k]);
+            hi[k] = max_d(hi[k], m->xyz[3 * (size_t)v + k]);
         }
     }
     /* hypot: squares of 1e-200 underflow to 0 */
