@@ -280,20 +280,14 @@ static int32_t uf_find(int32_t *parent, int32_t x)
     return x;
 }
 
-/* Referenced vertices at the position of another (texture seams, unmerged
- * STL corners): their count, and the components the surface would have
- * with each such group welded into one vertex. `parent` is the
- * union-find of the face components (build_components), reused. */
-static mfmm_status coincident_vertices(mfmm_mesh *m, int32_t *parent)
+/* The referenced vertices in [a, b) at the position of an earlier one
+ * there: their count, each joined in `parent` to the first at its
+ * position; a table of cap (a power of two) slots, -1 when empty. */
+static int32_t coincident_hashed(mfmm_mesh *m, int32_t *parent, int32_t a, int32_t b,
+                                 int32_t *table, size_t cap)
 {
-    size_t cap = mfmm_position_table_size((size_t)m->nv);
-    int32_t *table = malloc(cap * sizeof *table);
-    if (!table)
-        return MFMM_ERR_OUT_OF_MEMORY;
-    for (size_t i = 0; i < cap; i++)
-        table[i] = -1;
-    int32_t n_coincident = 0;
-    for (int32_t v = 0; v < m->nv; v++) {
+    int32_t n = 0;
+    for (int32_t v = a; v < b; v++) {
         if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1])
             continue; /* unreferenced: counted apart */
         const double *p = m->xyz + 3 * (size_t)v;
@@ -306,14 +300,63 @@ static mfmm_status coincident_vertices(mfmm_mesh *m, int32_t *parent)
             }
             const double *q = m->xyz + 3 * (size_t)w;
             if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) {
-                n_coincident++;
-                int32_t a = uf_find(parent, v), b = uf_find(parent, w);
-                if (a != b)
-                    parent[a] = b;
+                n++;
+                int32_t ra = uf_find(parent, v), rb = uf_find(parent, w);
+                if (ra != rb)
+                    parent[ra] = rb;
                 break;
             }
             i = (i + 1) & (cap - 1);
         }
+    }
+    return n;
+}
+
+/* Referenced vertices at the position of another (texture seams, unmerged
+ * STL corners): their count, and the components the surface would have
+ * with each such group welded into one vertex. `parent` is the
+ * union-find of the face components (build_components), reused. Vertices
+ * at one position lie in one run of equal order keys (mfmm_order_build;
+ * key NULL: all vertices one run), which is searched only when it holds
+ * more than one vertex: pairwise when short, else by a hash table. */
+static mfmm_status coincident_vertices(mfmm_mesh *m, int32_t *parent, const uint64_t *key)
+{
+    int32_t n_coincident = 0, *table = NULL;
+    size_t table_cap = 0;
+    for (int32_t a = 0, b; a < m->nv; a = b) {
+        b = a + 1;
+        while (b < m->nv && (!key || key[b] == key[a]))
+            b++;
+        if (b - a <= 16) {
+            for (int32_t v = a + 1; v < b; v++) {
+                if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1])
+                    continue;
+                const double *p = m->xyz + 3 * (size_t)v;
+                for (int32_t w = a; w < v; w++) {
+                    const double *q = m->xyz + 3 * (size_t)w;
+                    if (m->vertex_face_offset[w] == m->vertex_face_offset[w + 1] ||
+                        !(p[0] == q[0] && p[1] == q[1] && p[2] == q[2]))
+                        continue;
+                    n_coincident++;
+                    int32_t ra = uf_find(parent, v), rb = uf_find(parent, w);
+                    if (ra != rb)
+                        parent[ra] = rb;
+                    break;
+                }
+            }
+            continue;
+        }
+        size_t cap = mfmm_position_table_size((size_t)(b - a));
+        if (cap > table_cap) {
+            free(table);
+            table = malloc(cap * sizeof *table);
+            table_cap = cap;
+            if (!table)
+                return MFMM_ERR_OUT_OF_MEMORY;
+        }
+        for (size_t i = 0; i < cap; i++)
+            table[i] = -1;
+        n_coincident += coincident_hashed(m, parent, a, b, table, cap);
     }
     free(table);
     int32_t n_welded = 0;
@@ -326,16 +369,14 @@ static mfmm_status coincident_vertices(mfmm_mesh *m, int32_t *parent)
 }
 
 /* Connected components (through faces) of referenced vertices: their count
- * (the ids are not kept). */
-static mfmm_status build_components(mfmm_mesh *m)
+ * (the ids are not kept), as the roots of the faces' union-find (an
+ * unreferenced vertex stays a root of its own); then coincident_vertices,
+ * with the vertices' order keys. */
+static mfmm_status build_components(mfmm_mesh *m, const uint64_t *key)
 {
     int32_t *parent = malloc((size_t)m->nv * sizeof *parent);
-    int32_t *component = malloc((size_t)m->nv * sizeof *component);
-    if (!parent || !component) {
-        free(parent);
-        free(component);
+    if (!parent)
         return MFMM_ERR_OUT_OF_MEMORY;
-    }
     for (int32_t v = 0; v < m->nv; v++)
         parent[v] = v;
     for (int32_t f = 0; f < m->nf; f++) {
@@ -347,22 +388,15 @@ static mfmm_status build_components(mfmm_mesh *m)
         }
     }
     int32_t n_comp = 0, n_unref = 0;
-    for (int32_t v = 0; v < m->nv; v++)
-        component[v] = -1;
     for (int32_t v = 0; v < m->nv; v++) {
-        if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1]) {
+        if (m->vertex_face_offset[v] == m->vertex_face_offset[v + 1])
             n_unref++;
-            continue;
-        }
-        int32_t r = uf_find(parent, v);
-        if (component[r] < 0)
-            component[r] = n_comp++;
-        component[v] = component[r];
+        else
+            n_comp += uf_find(parent, v) == v;
     }
-    free(component);
     m->info.n_components = n_comp;
     m->info.n_unreferenced_vertices = n_unref;
-    mfmm_status st = coincident_vertices(m, parent);
+    mfmm_status st = coincident_vertices(m, parent, key);
     free(parent);
     return st;
 }
@@ -561,18 +595,16 @@ mfmm_status mfmm_mesh_build(const double *vertices, int32_t nv, const int32_t *f
     /* renumbered: coordinates in internal order, faces' vertex ids mapped
      * (face_neighbor holds them in input face order until the faces are
      * ordered by them and build_faces copies them) */
-    if (mfmm_order_build(vertices, nv, &m->to_internal, &m->to_external) != MFMM_OK) {
-        mfmm_mesh_destroy(m);
-        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
-    }
-    for (int32_t v = 0; v < nv; v++)
-        memcpy(m->xyz + 3 * (size_t)v, vertices + 3 * (size_t)m->to_external[v], 3 * sizeof *m->xyz);
-    for (size_t c = 0; c < nc; c++)
-        m->face_neighbor[c] = m->to_internal[faces[c]];
-    if (mfmm_order_faces(m->face_neighbor, nf, nv, &m->face_to_internal, &m->face_to_external) !=
-        MFMM_OK) {
-        mfmm_mesh_destroy(m);
-        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, NULL);
+    uint64_t *vkey = NULL; /* the vertices' order keys, until build_components */
+    st = mfmm_order_build(vertices, nv, &m->to_internal, &m->to_external, &vkey);
+    if (st == MFMM_OK) {
+        for (int32_t v = 0; v < nv; v++)
+            memcpy(m->xyz + 3 * (size_t)v, vertices + 3 * (size_t)m->to_external[v],
+                   3 * sizeof *m->xyz);
+        for (size_t c = 0; c < nc; c++)
+            m->face_neighbor[c] = m->to_internal[faces[c]];
+        st = mfmm_order_faces(m->face_neighbor, nf, nv, &m->face_to_internal,
+                              &m->face_to_external);
     }
     m->info.n_vertices = nv;
     m->info.n_faces = nf;
@@ -581,12 +613,14 @@ mfmm_status mfmm_mesh_build(const double *vertices, int32_t nv, const int32_t *f
     obtuse_list ob = {NULL, 0, 0};
     int32_t *far = NULL;
     uint8_t *copy = NULL;
-    st = build_faces(m, &dmax, &copy);
+    if (st == MFMM_OK)
+        st = build_faces(m, &dmax, &copy);
     if (st == MFMM_OK)
         st = build_edges(m, dmax, copy);
     free(copy);
     if (st == MFMM_OK)
-        st = build_components(m);
+        st = build_components(m, vkey);
+    free(vkey);
     if (st == MFMM_OK)
         st = build_corners(m, &ob);
     if (st == MFMM_OK)

@@ -77,8 +77,9 @@ static int radix_sort(uint64_t *key, int32_t *id, uint64_t *key2, int32_t *id2, 
 }
 
 mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_internal,
-                             int32_t **to_external)
+                             int32_t **to_external, uint64_t **sorted_keys)
 {
+    *sorted_keys = NULL;
     int32_t *in = malloc((size_t)nv * sizeof *in);
     int32_t *ex = malloc((size_t)nv * sizeof *ex);
     uint64_t *keys = MFMM_VERTEX_ORDER ? malloc(2 * (size_t)nv * sizeof *keys) : NULL;
@@ -134,8 +135,12 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_interna
         }
         if (!radix_sort(keys, in, keys + nv, ex, (size_t)nv, count))
             memcpy(ex, in, (size_t)nv * sizeof *ex);
-        free(keys);
+        else
+            memcpy(keys, keys + nv, (size_t)nv * sizeof *keys);
         free(count);
+        /* (a failed shrink leaves the block as it was) */
+        uint64_t *shrunk = realloc(keys, (size_t)nv * sizeof *keys);
+        *sorted_keys = shrunk ? shrunk : keys;
     }
     for (int32_t i = 0; i < nv; i++)
         in[ex[i]] = i;

@@ -15,9 +15,12 @@
 /* The internal order of a mesh's vertices: *to_external (nv,) lists the
  * input ids in internal order, *to_internal (nv,) is its inverse (both
  * malloc'd). Deterministic: a function of the coordinates and the input
- * ids only. MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
+ * ids only. *sorted_keys (nv,): each internal vertex's key in that order
+ * (malloc'd), where vertices at one position (==) have one key, so that
+ * they lie in one run of equal keys; NULL where the order is the input's
+ * (MFMM_VERTEX_ORDER 0). MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
 mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_internal,
-                             int32_t **to_external);
+                             int32_t **to_external, uint64_t **sorted_keys);
 
 /* The internal order of a mesh's faces, given their corners' internal
  * vertex ids (each in [0, nv)) in input face order, faces (nf, 3): by least

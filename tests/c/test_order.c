@@ -599,15 +599,16 @@ static void check_build(const mfmm_mesh *m, int32_t n_fan_at_0)
 /* The sorts' rare paths: a fan of 100 faces and a book of 40 pages on
  * vertex 0 (more faces and half-edges at one vertex than the insertion
  * sorts take), copies of faces, two more vertices at vertex 0's position
- * and one at a rim vertex's (ties of the vertex order), an unreferenced
- * vertex; then a sine surface and a shared mesh. */
+ * and one at a rim vertex's (ties of the vertex order), 20 referenced and 2
+ * unreferenced at another's (a run of equal keys that coincident_vertices
+ * hashes), an unreferenced vertex; then a sine surface and a shared mesh. */
 static void test_build_against_reference(void **state)
 {
     (void)state;
-    enum { RIM = 101, PAGES = 40 };
-    int32_t nv = 1 + RIM + PAGES + 4, nf = 0;
+    enum { RIM = 101, PAGES = 40, STACK = 22 };
+    int32_t nv = 1 + RIM + PAGES + 4 + STACK, nf = 0;
     double *V = malloc(3 * (size_t)nv * sizeof *V);
-    int32_t *F = malloc(3 * 200 * sizeof *F);
+    int32_t *F = malloc(3 * 250 * sizeof *F);
     assert_true(V && F);
     memset(V, 0, 3 * (size_t)nv * sizeof *V);
     for (int32_t i = 0; i < RIM; i++) {
@@ -621,6 +622,9 @@ static void test_build_against_reference(void **state)
     int32_t z0 = 1 + RIM + PAGES, z1 = z0 + 1, q = z0 + 2, unref = z0 + 3;
     memcpy(V + 3 * q, V + 3 * (1 + 50), 3 * sizeof *V);
     V[3 * unref] = V[3 * unref + 1] = V[3 * unref + 2] = 0.3;
+    int32_t stack = unref + 1;
+    for (int32_t i = 0; i < STACK; i++)
+        memcpy(V + 3 * (stack + i), V + 3 * (1 + 70), 3 * sizeof *V);
 #define FACE(a, b, c) (F[3 * nf] = (a), F[3 * nf + 1] = (b), F[3 * nf + 2] = (c), nf++)
     for (int32_t i = 0; i + 1 < RIM; i++)
         FACE(0, 1 + i, 2 + i);
@@ -633,14 +637,16 @@ static void test_build_against_reference(void **state)
     FACE(z0, 1 + RIM, 2 + RIM);
     FACE(z1, q, 1 + RIM + 5);
     FACE(q, 61, 1 + RIM + 7);
+    for (int32_t i = 0; i < STACK - 2; i++)
+        FACE(stack + i, 81, 1 + RIM + 10);
 #undef FACE
     mfmm_mesh *m = NULL;
     mfmm_error err;
     assert_int_equal(mfmm_mesh_create(V, nv, F, nf, NULL, &m, &err), MFMM_OK);
     assert_int_equal(m->to_external[0], 0);
     assert_true(m->info.n_nonmanifold_edges > 0 && m->info.n_duplicate_faces == 4);
-    assert_int_equal(m->info.n_coincident_vertices, 3);
-    assert_int_equal(m->info.n_unreferenced_vertices, 1);
+    assert_int_equal(m->info.n_coincident_vertices, 3 + STACK - 2);
+    assert_int_equal(m->info.n_unreferenced_vertices, 3);
     check_build(m, RIM - 1 + PAGES);
     mfmm_mesh_destroy(m);
     free(V);
