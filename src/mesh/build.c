@@ -184,10 +184,11 @@ static void fan_vertex(mfmm_mesh *m, int32_t x, int32_t *next, int32_t *has_prev
 
 /* Face adjacency across edges, boundary and non-manifold counts, edge-length
  * statistics, and each vertex's fan order (fan_vertex), from the vertex ->
- * corner CSR and the copy flags (build_faces): the half-edges (lo, hi) of
- * each vertex lo, by hi and then by the corner opposite, from its own
- * corners, so that no sort runs over all of them; a vertex's fan once the
- * edges of every vertex up to it are done, which are all of its own. */
+ * corner CSR, the copy flags (build_faces) and the face records' lengths
+ * (build_corners): the half-edges (lo, hi) of each vertex lo, by hi and
+ * then by the corner opposite, from its own corners, so that no sort runs
+ * over all of them; a vertex's fan once the edges of every vertex up to it
+ * are done, which are all of its own. */
 static mfmm_status build_edges(mfmm_mesh *m, int32_t dmax, const uint8_t *copy)
 {
     /* per half-edge: hi << 33 | the corner opposite << 1 | its face a copy */
@@ -219,9 +220,10 @@ static mfmm_status build_edges(mfmm_mesh *m, int32_t dmax, const uint8_t *copy)
             while (j < n && key[j] >> 33 == key[i] >> 33)
                 j++;
             n_edges++;
-            const double *p = m->xyz + 3 * (size_t)x, *q = m->xyz + 3 * (size_t)(key[i] >> 33);
-            double len = sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
-                              (p[2] - q[2]) * (p[2] - q[2]));
+            /* the edge's length as build_corners measured it for the corner
+             * opposite (the same sum of the same squares) */
+            int32_t c0 = (int32_t)(key[i] >> 1 & 0xffffffffu);
+            double len = m->face_records[c0 / 3].len[c0 % 3];
             sum += len;
             lmin = min_d(lmin, len);
             lmax = max_d(lmax, len);
@@ -616,13 +618,13 @@ mfmm_status mfmm_mesh_build(const double *vertices, int32_t nv, const int32_t *f
     if (st == MFMM_OK)
         st = build_faces(m, &dmax, &copy);
     if (st == MFMM_OK)
+        st = build_corners(m, &ob);
+    if (st == MFMM_OK)
         st = build_edges(m, dmax, copy);
     free(copy);
     if (st == MFMM_OK)
         st = build_components(m, vkey);
     free(vkey);
-    if (st == MFMM_OK)
-        st = build_corners(m, &ob);
     if (st == MFMM_OK)
         st = mfmm_mesh_unfold_obtuse(m, opt.max_unfold_steps, ob.at, ob.n, &far);
     if (st == MFMM_OK)
