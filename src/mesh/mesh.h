@@ -43,7 +43,7 @@ struct mfmm_mesh {
                                   -1 at a boundary or non-manifold edge */
     int32_t *vertex_face_offset; /* (nv+1,) CSR: each vertex's faces, as
                                     MFMM_WEDGE(f, k) (local_update.h), in fan
-                                    order (build.c fan_order) */
+                                    order (build.c fan_vertex) */
     int32_t *vertex_wedge;
     mfmm_face *face_records;   /* (nf,) for the march (local_update.h), 64-byte aligned;
                                   face f's vertices: face_records[f].v (the
