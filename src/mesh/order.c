@@ -39,14 +39,17 @@ static uint64_t spread3(uint64_t x)
     return x;
 }
 
+/* The vertex keys' radix sort: 6 digits of 11 bits cover their 63. */
+enum { RADIX_PASSES = 6 };
+
 /* Sorts key (n,) ascending, carrying id along, stably: least significant
- * digit first, 11 bits a pass, a pass skipped where every key has the same
- * digit. key2, id2: scratch of n; the result may end in either pair, the
- * one returned (0: key, id; 1: key2, id2). */
+ * digit first, a pass skipped where every key has the same digit. key2,
+ * id2: scratch of n; count: RADIX_PASSES tables; the result may end in
+ * either pair, the one returned (0: key, id; 1: key2, id2). */
 static int radix_sort(uint64_t *key, int32_t *id, uint64_t *key2, int32_t *id2, size_t n,
                       uint32_t (*count)[2048])
 {
-    enum { PASSES = 6 };
+    enum { PASSES = RADIX_PASSES };
     memset(count, 0, PASSES * sizeof *count);
     for (size_t i = 0; i < n; i++)
         for (int p = 0; p < PASSES; p++)
@@ -83,7 +86,7 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_interna
     int32_t *in = malloc((size_t)nv * sizeof *in);
     int32_t *ex = malloc((size_t)nv * sizeof *ex);
     uint64_t *keys = MFMM_VERTEX_ORDER ? malloc(2 * (size_t)nv * sizeof *keys) : NULL;
-    uint32_t(*count)[2048] = MFMM_VERTEX_ORDER ? malloc(6 * sizeof *count) : NULL;
+    uint32_t(*count)[2048] = MFMM_VERTEX_ORDER ? malloc(RADIX_PASSES * sizeof *count) : NULL;
     if (!in || !ex || (MFMM_VERTEX_ORDER && (!keys || !count))) {
         free(in);
         free(ex);
