@@ -18,20 +18,6 @@ typedef struct mfmm_virt_step {
     double t;       /* CV crosses it at e1 + t (e2 - e1) */
 } mfmm_virt_step;
 
-/* A corner while the mesh is built (build.c, unfold.c), by corner id 3f+k;
- * the march gets records per face (mfmm_face, mfmm_virt) from these. virt:
- * V's id >= 0 (the obtuse corner is split by the virtual edge to V), or one
- * of the MFMM_VIRT_ codes. */
-#define MFMM_VIRT_NONE (-1)       /* not obtuse: the plain stencil */
-#define MFMM_VIRT_FAILED (-2)     /* obtuse, walk failed: plain stencil */
-#define MFMM_VIRT_DEGENERATE (-3) /* zero-area face: edge updates only */
-typedef struct mfmm_corner_full {
-    int32_t face, a, b, virt;
-    int32_t strip_at, strip_n; /* its strip's steps in the build's buffer */
-    double len_a, len_b, cos_c;
-    double virt_len, virt_cos_a, virt_cos_b;
-} mfmm_corner_full;
-
 struct mfmm_mesh {
     /* nf: the faces built; nf_in: the faces as given (info.n_faces). They
      * differ where T-junctions were closed (tjunction.c): a zero-area needle
@@ -57,9 +43,8 @@ struct mfmm_mesh {
                                   -1 at a boundary or non-manifold edge */
     int32_t *vertex_face_offset; /* (nv+1,) CSR: each vertex's faces, as
                                     MFMM_WEDGE(f, k) (local_update.h), in fan
-                                    order (build.c fan_order) */
+                                    order (build.c fan_vertex) */
     int32_t *vertex_wedge;
-    mfmm_corner_full *full;    /* (3 nf,) while building only, then NULL */
     mfmm_face *face_records;   /* (nf,) for the march (local_update.h), 64-byte aligned;
                                   face f's vertices: face_records[f].v (the
                                   mesh's only copy of the faces) */
@@ -73,7 +58,6 @@ struct mfmm_mesh {
                                   crossed at each step but the last (whose is V),
                                   for the march's cost test (mfmm_march_mesh.strip;
                                   the strip's faces and crossings: mfmm_strip_next) */
-    mfmm_virt_step *build_steps; /* while building only (corner order), then NULL */
     mfmm_mesh_info info;
     /* The exact solver's read-only tables (exact/exact.h: face frames, fans),
      * built on the first exact solve or exact start and then shared by every

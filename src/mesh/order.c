@@ -15,20 +15,16 @@
 #define MFMM_VERTEX_ORDER 1
 #endif
 
-typedef struct order_key {
-    uint64_t key;  /* the cell's curve key */
-    uint64_t fine; /* inside the cell: y, then x, then z (rows) */
-    int32_t id;
-} order_key;
-
-static int order_key_cmp(const void *pa, const void *pb)
+/* fmin and fmax of numbers (no NaN), inline: as calls they cost as much as
+ * the loops over every edge and vertex that use them. */
+static double min_d(double x, double y)
 {
-    const order_key *a = pa, *b = pb;
-    if (a->key != b->key)
-        return a->key < b->key ? -1 : 1;
-    if (a->fine != b->fine)
-        return a->fine < b->fine ? -1 : 1;
-    return (a->id > b->id) - (a->id < b->id);
+    return y < x ? y : x;
+}
+
+static double max_d(double x, double y)
+{
+    return y > x ? y : x;
 }
 
 /* 21 bits of x spread to every third bit */
@@ -43,16 +39,59 @@ static uint64_t spread3(uint64_t x)
     return x;
 }
 
-mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_internal,
-                             int32_t **to_external)
+/* The vertex keys' radix sort: 6 digits of 11 bits cover their 63. */
+enum { RADIX_PASSES = 6 };
+
+/* Sorts key (n,) ascending, carrying id along, stably: least significant
+ * digit first, a pass skipped where every key has the same digit. key2,
+ * id2: scratch of n; count: RADIX_PASSES tables; the result may end in
+ * either pair, the one returned (0: key, id; 1: key2, id2). */
+static int radix_sort(uint64_t *key, int32_t *id, uint64_t *key2, int32_t *id2, size_t n,
+                      uint32_t (*count)[2048])
 {
+    enum { PASSES = RADIX_PASSES };
+    memset(count, 0, PASSES * sizeof *count);
+    for (size_t i = 0; i < n; i++)
+        for (int p = 0; p < PASSES; p++)
+            count[p][key[i] >> (11 * p) & 2047]++;
+    int in2 = 0;
+    for (int p = 0; p < PASSES; p++) {
+        uint32_t *c = count[p];
+        if (n == 0 || c[key[0] >> (11 * p) & 2047] == n)
+            continue;
+        uint32_t at = 0;
+        for (int d = 0; d < 2048; d++) {
+            uint32_t t = c[d];
+            c[d] = at;
+            at += t;
+        }
+        const uint64_t *k_in = in2 ? key2 : key;
+        const int32_t *i_in = in2 ? id2 : id;
+        uint64_t *k_out = in2 ? key : key2;
+        int32_t *i_out = in2 ? id : id2;
+        for (size_t i = 0; i < n; i++) {
+            uint32_t to = c[k_in[i] >> (11 * p) & 2047]++;
+            k_out[to] = k_in[i];
+            i_out[to] = i_in[i];
+        }
+        in2 = !in2;
+    }
+    return in2;
+}
+
+mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_internal,
+                             int32_t **to_external, uint64_t **sorted_keys)
+{
+    *sorted_keys = NULL;
     int32_t *in = malloc((size_t)nv * sizeof *in);
     int32_t *ex = malloc((size_t)nv * sizeof *ex);
-    order_key *keys = MFMM_VERTEX_ORDER ? malloc((size_t)nv * sizeof *keys) : NULL;
-    if (!in || !ex || (MFMM_VERTEX_ORDER && !keys)) {
+    uint64_t *keys = MFMM_VERTEX_ORDER ? malloc(2 * (size_t)nv * sizeof *keys) : NULL;
+    uint32_t(*count)[2048] = MFMM_VERTEX_ORDER ? malloc(RADIX_PASSES * sizeof *count) : NULL;
+    if (!in || !ex || (MFMM_VERTEX_ORDER && (!keys || !count))) {
         free(in);
         free(ex);
         free(keys);
+        free(count);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
     if (!keys) {
@@ -62,10 +101,10 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_interna
         double lo[3] = {INFINITY, INFINITY, INFINITY}, ext = 0.0;
         for (int32_t v = 0; v < nv; v++)
             for (int k = 0; k < 3; k++)
-                lo[k] = fmin(lo[k], xyz[3 * (size_t)v + k]);
+                lo[k] = min_d(lo[k], xyz[3 * (size_t)v + k]);
         for (int32_t v = 0; v < nv; v++)
             for (int k = 0; k < 3; k++)
-                ext = fmax(ext, xyz[3 * (size_t)v + k] - lo[k]);
+                ext = max_d(ext, xyz[3 * (size_t)v + k] - lo[k]);
         /* one cube (not a box per axis), so the curve keeps the shape's
          * proportions; 21 bits per axis */
         double scale = ext > 0.0 ? 2097151.0 / ext : 0.0;
@@ -75,28 +114,36 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_interna
         if (!isfinite(scale))
             scale = 0.0;
         /* cells of ~64 vertices (a surface has about nv / 4^L cells at
-         * level L) along the curve; inside a cell, rows by position, which
-         * beat the curve's own order at that scale */
+         * level L) along the curve; inside a cell, rows by position (y,
+         * then x, then z), which beat the curve's own order at that scale */
         int L = 0;
         while (L < 21 && ((double)nv / 64.0) > (double)(1u << L) * (double)(1u << L))
             L++;
         int shift = 21 - L;
+        uint32_t low = (1u << shift) - 1;
+        /* one key of 63 bits: the cell's 3 L curve bits above the 3 (21 -
+         * L) bits the cell leaves, rows' order; ties in input order */
         for (int32_t v = 0; v < nv; v++) {
             uint32_t u[3];
             for (int k = 0; k < 3; k++) {
                 double q = (xyz[3 * (size_t)v + k] - lo[k]) * scale;
                 u[k] = !(q > 0.0) ? 0u : q > 2097151.0 ? 2097151u : (uint32_t)q;
             }
-            keys[v].fine = (uint64_t)u[1] << 42 | (uint64_t)u[0] << 21 | u[2];
-            for (int k = 0; k < 3; k++)
-                u[k] >>= shift;
-            keys[v].key = spread3(u[0]) | spread3(u[1]) << 1 | spread3(u[2]) << 2;
-            keys[v].id = v;
+            uint64_t cell = spread3(u[0] >> shift) | spread3(u[1] >> shift) << 1 |
+                            spread3(u[2] >> shift) << 2;
+            uint64_t fine = (uint64_t)(u[1] & low) << (2 * shift) |
+                            (uint64_t)(u[0] & low) << shift | (u[2] & low);
+            keys[v] = cell << (3 * shift) | fine;
+            in[v] = v;
         }
-        qsort(keys, (size_t)nv, sizeof *keys, order_key_cmp);
-        for (int32_t i = 0; i < nv; i++)
-            ex[i] = keys[i].id;
-        free(keys);
+        if (!radix_sort(keys, in, keys + nv, ex, (size_t)nv, count))
+            memcpy(ex, in, (size_t)nv * sizeof *ex);
+        else
+            memcpy(keys, keys + nv, (size_t)nv * sizeof *keys);
+        free(count);
+        /* (a failed shrink leaves the block as it was) */
+        uint64_t *shrunk = realloc(keys, (size_t)nv * sizeof *keys);
+        *sorted_keys = shrunk ? shrunk : keys;
     }
     for (int32_t i = 0; i < nv; i++)
         in[ex[i]] = i;
@@ -105,37 +152,44 @@ mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_interna
     return MFMM_OK;
 }
 
-void mfmm_order_counting(const int32_t *key, int32_t n_keys, const int32_t *in, int32_t *out,
-                         size_t n, int32_t *count)
+/* A face's other two vertex ids (b < c) as b << 32 | c, with its input id. */
+typedef struct face_key {
+    uint64_t bc;
+    int32_t id;
+} face_key;
+
+static int face_key_cmp(const void *pa, const void *pb)
 {
-    memset(count, 0, ((size_t)n_keys + 1) * sizeof *count);
-    for (size_t i = 0; i < n; i++)
-        count[key[in[i]] + 1]++;
-    for (int32_t k = 0; k < n_keys; k++)
-        count[k + 1] += count[k];
-    for (size_t i = 0; i < n; i++)
-        out[count[key[in[i]]]++] = in[i];
+    const face_key *a = pa, *b = pb;
+    if (a->bc != b->bc)
+        return a->bc < b->bc ? -1 : 1;
+    return (a->id > b->id) - (a->id < b->id);
 }
 
-mfmm_status mfmm_order_faces(const int32_t *faces, int32_t nf, int32_t **to_internal,
-                             int32_t **to_external)
+mfmm_status mfmm_order_faces(const int32_t *faces, int32_t nf, int32_t nv,
+                             int32_t **to_internal, int32_t **to_external)
 {
     size_t n = (size_t)nf;
-    int32_t n_keys = 0;
-    for (size_t i = 0; i < 3 * n; i++)
-        n_keys = faces[i] + 1 > n_keys ? faces[i] + 1 : n_keys;
     int32_t *in = malloc((n ? n : 1) * sizeof *in);
     int32_t *ex = malloc((n ? n : 1) * sizeof *ex);
-    int32_t *v = calloc(n ? 3 * n : 1, sizeof *v);
-    int32_t *count = malloc(((size_t)n_keys + 1) * sizeof *count);
-    if (!in || !ex || !v || !count) {
+    face_key *key = malloc((n ? n : 1) * sizeof *key);
+    int32_t *count = calloc((size_t)nv + 1, sizeof *count);
+    if (!in || !ex || !key || !count) {
         free(in);
         free(ex);
-        free(v);
+        free(key);
         free(count);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
-    /* the faces' vertex ids ascending, as three columns */
+    /* by least vertex (a counting sort, stable), then within each least
+     * vertex's few faces by the other two and the input id */
+    for (size_t f = 0; f < n; f++) {
+        int32_t a = faces[3 * f], b = faces[3 * f + 1], c = faces[3 * f + 2];
+        int32_t lo = a < b ? a : b;
+        count[(lo < c ? lo : c) + 1]++;
+    }
+    for (int32_t v = 0; v < nv; v++)
+        count[v + 1] += count[v];
     for (size_t f = 0; f < n; f++) {
         int32_t a = faces[3 * f], b = faces[3 * f + 1], c = faces[3 * f + 2], t;
         if (a > b)
@@ -144,19 +198,33 @@ mfmm_status mfmm_order_faces(const int32_t *faces, int32_t nf, int32_t **to_inte
             t = b, b = c, c = t;
         if (a > b)
             t = a, a = b, b = t;
-        v[f] = a;
-        v[n + f] = b;
-        v[2 * n + f] = c;
-        in[f] = (int32_t)f;
+        int32_t to = count[a]++;
+        key[to].bc = (uint64_t)b << 32 | (uint32_t)c;
+        key[to].id = (int32_t)f;
     }
-    /* by least vertex, then the other two, then input id */
-    mfmm_order_counting(v + 2 * n, n_keys, in, ex, n, count);
-    mfmm_order_counting(v + n, n_keys, ex, in, n, count);
-    mfmm_order_counting(v, n_keys, in, ex, n, count);
-    free(v);
+    for (int32_t v = 0, at = 0; v < nv; v++) {
+        int32_t end = count[v], m = end - at;
+        face_key *k = key + at;
+        if (m > 32) {
+            qsort(k, (size_t)m, sizeof *k, face_key_cmp);
+        } else {
+            /* ids ascend in a bucket (the scatter is stable): by bc alone */
+            for (int32_t i = 1; i < m; i++) {
+                face_key x = k[i];
+                int32_t j = i;
+                for (; j > 0 && k[j - 1].bc > x.bc; j--)
+                    k[j] = k[j - 1];
+                k[j] = x;
+            }
+        }
+        at = end;
+    }
+    for (size_t i = 0; i < n; i++) {
+        ex[i] = key[i].id;
+        in[key[i].id] = (int32_t)i;
+    }
+    free(key);
     free(count);
-    for (size_t i = 0; i < n; i++)
-        in[ex[i]] = (int32_t)i;
     *to_internal = in;
     *to_external = ex;
     return MFMM_OK;

@@ -15,26 +15,21 @@
 /* The internal order of a mesh's vertices: *to_external (nv,) lists the
  * input ids in internal order, *to_internal (nv,) is its inverse (both
  * malloc'd). Deterministic: a function of the coordinates and the input
- * ids only. MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
+ * ids only. *sorted_keys (nv,): each internal vertex's key in that order
+ * (malloc'd), where vertices at one position (==) have one key, so that
+ * they lie in one run of equal keys; NULL where the order is the input's
+ * (MFMM_VERTEX_ORDER 0). MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
 mfmm_status mfmm_order_build(const double *xyz, int32_t nv, int32_t **to_internal,
-                             int32_t **to_external);
+                             int32_t **to_external, uint64_t **sorted_keys);
 
 /* The internal order of a mesh's faces, given their corners' internal
- * vertex ids in input face order, faces (nf, 3): by least vertex id, then
- * the other two (smaller first), then input id, so that it depends on the
- * faces only, not on their input order. *to_external (nf,) lists the input
- * face ids in internal order, *to_internal (nf,) is its inverse (both
- * malloc'd). MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
-/* Stable counting sort of indices: out (n,) holds in's indices ordered by
- * key[index] (each in [0, n_keys)), those with equal keys in their order in
- * `in`; count is scratch of n_keys + 1. Passes from the last key to the
- * first sort by all of them in O(n + n_keys) each, where a comparison sort
- * of a million-vertex mesh's half-edges took 1.5 s. */
-void mfmm_order_counting(const int32_t *key, int32_t n_keys, const int32_t *in, int32_t *out,
-                         size_t n, int32_t *count);
-
-mfmm_status mfmm_order_faces(const int32_t *faces, int32_t nf, int32_t **to_internal,
-                             int32_t **to_external);
+ * vertex ids (each in [0, nv)) in input face order, faces (nf, 3): by least
+ * vertex id, then the other two (smaller first), then input id, so that it
+ * depends on the faces only, not on their input order. *to_external (nf,)
+ * lists the input face ids in internal order, *to_internal (nf,) is its
+ * inverse (both malloc'd). MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
+mfmm_status mfmm_order_faces(const int32_t *faces, int32_t nf, int32_t nv,
+                             int32_t **to_internal, int32_t **to_external);
 
 /* Internal id of input face f (checked to be in range): its first piece
  * where it was split at a T-junction, -1 for a needle dropped there

@@ -123,31 +123,32 @@ static double crossing_t(vec2 pv, vec2 u, vec2 v)
     return t > 0.0 ? (t < 1.0 ? t : 1.0) : 0.0;
 }
 
-/* The strip of one walk: a step per face entered, and the unfolded ends of
- * the edge it was entered through (to place CV's crossings once V is known). */
+/* The strips of the walks: per step, the vertex off the edge crossed, and
+ * the unfolded ends of the edge it was entered through (to test the
+ * segment C V against once V is known). */
 typedef struct strip_buf {
-    mfmm_virt_step *step;
+    int32_t *far;
     vec2 *end; /* 2 per step */
     int32_t n, cap;
 } strip_buf;
 
-static int strip_push(strip_buf *sb, mfmm_virt_step st, vec2 p1, vec2 p2)
+static int strip_push(strip_buf *sb, int32_t far, vec2 p1, vec2 p2)
 {
     if (sb->n == sb->cap) {
         if (sb->cap > INT32_MAX / 2)
             return 0;
         int32_t cap = sb->cap ? 2 * sb->cap : 256;
-        mfmm_virt_step *s = realloc(sb->step, (size_t)cap * sizeof *s);
+        int32_t *s = realloc(sb->far, (size_t)cap * sizeof *s);
         if (!s)
             return 0;
-        sb->step = s;
+        sb->far = s;
         vec2 *e = realloc(sb->end, 2 * (size_t)cap * sizeof *e);
         if (!e)
             return 0;
         sb->end = e;
         sb->cap = cap;
     }
-    sb->step[sb->n] = st;
+    sb->far[sb->n] = far;
     sb->end[2 * sb->n] = p1;
     sb->end[2 * sb->n + 1] = p2;
     sb->n++;
@@ -180,23 +181,36 @@ static int strip_holds(const strip_buf *sb, int32_t first, vec2 pv)
     return 1;
 }
 
-/* Walks from obtuse corner k of face f; returns 1 and fills the corner's
- * virtual edge and appends its strip to sb, 0 if the walk fails (boundary,
- * non-manifold edge, degenerate face, or more than max_steps faces), -1 when
- * out of memory. */
-static int unfold_corner(mfmm_mesh *m, int32_t corner, int32_t max_steps, strip_buf *sb)
+/* (A strip is walked from the face record, which holds the lengths and
+ * the cosine of the corner.) */
+static void strip_init(mfmm_strip_walk *w)
+{
+    const mfmm_mesh *m = w->m;
+    int32_t corner = w->corner, k = corner % 3;
+    const mfmm_face *fr = m->face_records + corner / 3;
+    int ka = (k + 1) % 3, kb = (k + 2) % 3;
+    walk_init(w, m, corner, fr->v[ka], fr->v[kb], fr->len[ka], fr->len[kb], fr->cosv[k]);
+}
+
+/* Walks from the obtuse corner ob; returns 1 and fills its virtual edge and
+ * appends its strip to sb, 0 if the walk fails (boundary, non-manifold edge,
+ * degenerate face, or more than max_steps faces), -1 when out of memory. */
+static int unfold_corner(const mfmm_mesh *m, mfmm_obtuse *ob, int32_t max_steps, strip_buf *sb)
 {
     int32_t first = sb->n;
-    mfmm_corner_full *cr = m->full + corner;
+    const mfmm_face *fr = m->face_records + ob->corner / 3;
+    int k = ob->corner % 3;
+    double len_a = fr->len[(k + 1) % 3], len_b = fr->len[(k + 2) % 3];
     mfmm_strip_walk w;
-    walk_init(&w, m, corner, cr->a, cr->b, cr->len_a, cr->len_b, cr->cos_c);
+    w.m = m;
+    w.corner = ob->corner;
+    strip_init(&w);
     for (int32_t step = 0; step < max_steps; step++) {
         int32_t g, q;
         vec2 pq;
         if (!walk_cross(&w, &g, &q, &pq))
             break;
-        mfmm_virt_step rec = {g, q, w.e1, w.e2, 0.0};
-        if (!strip_push(sb, rec, w.p1, w.p2))
+        if (!strip_push(sb, q, w.p1, w.p2))
             return -1;
         double qa = dot2(pq, w.pa), qb = dot2(pq, w.pb);
         if (qa >= 0.0 && qb >= 0.0) {
@@ -204,14 +218,12 @@ static int unfold_corner(mfmm_mesh *m, int32_t corner, int32_t max_steps, strip_
             double l = sqrt(dot2(pq, pq));
             if (!(l > 0.0) || !strip_holds(sb, first, pq))
                 break;
-            for (int32_t i = first; i < sb->n; i++)
-                sb->step[i].t = crossing_t(pq, sb->end[2 * i], sb->end[2 * i + 1]);
-            cr->virt = q;
-            cr->virt_len = l;
-            cr->virt_cos_a = fmin(1.0, qa / (l * cr->len_b));
-            cr->virt_cos_b = fmin(1.0, qb / (l * cr->len_a));
-            cr->strip_at = first;
-            cr->strip_n = sb->n - first;
+            ob->virt = q;
+            ob->len = l;
+            ob->cos_a = fmin(1.0, qa / (l * len_b));
+            ob->cos_b = fmin(1.0, qb / (l * len_a));
+            ob->strip_at = first;
+            ob->strip_n = sb->n - first;
             return 1;
         }
         if (qa < 0.0 && qb < 0.0)
@@ -220,17 +232,6 @@ static int unfold_corner(mfmm_mesh *m, int32_t corner, int32_t max_steps, strip_
     }
     sb->n = first;
     return 0;
-}
-
-/* (A strip is re-walked from the face record, which holds the lengths and
- * the cosine the build walked with.) */
-static void strip_init(mfmm_strip_walk *w)
-{
-    const mfmm_mesh *m = w->m;
-    int32_t corner = w->corner, k = corner % 3;
-    const mfmm_face *fr = m->face_records + corner / 3;
-    int ka = (k + 1) % 3, kb = (k + 2) % 3;
-    walk_init(w, m, corner, fr->v[ka], fr->v[kb], fr->len[ka], fr->len[kb], fr->cosv[k]);
 }
 
 void mfmm_strip_begin(mfmm_strip_walk *w, const mfmm_mesh *mesh, int32_t j)
@@ -270,19 +271,18 @@ int mfmm_strip_next(mfmm_strip_walk *w, mfmm_virt_step *step)
     return 1;
 }
 
-mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *m, int32_t max_steps)
+mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *m, int32_t max_steps, mfmm_obtuse *obtuse,
+                                    int32_t n, int32_t **strip_far)
 {
     int32_t made = 0, failed = 0;
-    size_t nc = 3 * (size_t)m->nf;
     strip_buf sb = {NULL, NULL, 0, 0};
-    for (size_t c = 0; c < nc; c++) {
-        m->full[c].strip_at = sb.n;
-        m->full[c].strip_n = 0;
-        if (m->full[c].virt != MFMM_VIRT_FAILED)
-            continue;
-        int r = unfold_corner(m, (int32_t)c, max_steps, &sb);
+    for (int32_t i = 0; i < n; i++) {
+        obtuse[i].virt = MFMM_VIRT_FAILED;
+        obtuse[i].strip_at = sb.n;
+        obtuse[i].strip_n = 0;
+        int r = unfold_corner(m, obtuse + i, max_steps, &sb);
         if (r < 0) {
-            free(sb.step);
+            free(sb.far);
             free(sb.end);
             return MFMM_ERR_OUT_OF_MEMORY;
         }
@@ -293,12 +293,12 @@ mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *m, int32_t max_steps)
     }
     free(sb.end);
     /* never a NULL array, so that readers need no special case */
-    if (!sb.step) {
-        sb.step = malloc(sizeof *sb.step);
-        if (!sb.step)
+    if (!sb.far) {
+        sb.far = malloc(sizeof *sb.far);
+        if (!sb.far)
             return MFMM_ERR_OUT_OF_MEMORY;
     }
-    m->build_steps = sb.step;
+    *strip_far = sb.far;
     m->info.n_virtual_edges = made;
     m->info.n_unfold_failures = failed;
     return MFMM_OK;

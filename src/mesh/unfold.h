@@ -5,13 +5,27 @@
 
 #include "mesh.h"
 
-/* Finds the virtual edge of every obtuse corner by unfolding (section 4.2);
- * fills full[].virt, virt_len, virt_cos_a, virt_cos_b, strip_at, strip_n, the
- * strips' steps (build_steps, corner order) and the counts.
- * Needs the face records' vertices, lengths and cosines, xyz, face_neighbor
- * and the corners (full, corner 3f+k), as mesh creation has them then.
+/* An obtuse corner while the mesh is built (build.c, unfold.c): what
+ * unfolding found for it. virt: V's id (the corner is split by the virtual
+ * edge to V), or MFMM_VIRT_FAILED (the plain stencil); strip_at, strip_n:
+ * its strip's steps in the build's buffer; len, cos_a, cos_b: as in
+ * mfmm_virt. */
+#define MFMM_VIRT_FAILED (-2)
+typedef struct mfmm_obtuse {
+    int32_t corner, virt;
+    int32_t strip_at, strip_n;
+    double len, cos_a, cos_b;
+} mfmm_obtuse;
+
+/* Finds the virtual edge of each of the n obtuse corners by unfolding
+ * (section 4.2): fills their virt, len, cos_a, cos_b, strip_at and
+ * strip_n, the counts in the mesh's info, and *strip_far (malloc'd, never
+ * NULL): each strip's steps' vertices off the edge crossed, the last one V.
+ * Needs the face records' vertices, lengths and cosines, xyz and
+ * face_neighbor, as mesh creation has them then.
  * MFMM_ERR_OUT_OF_MEMORY or MFMM_OK. */
-mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *mesh, int32_t max_steps);
+mfmm_status mfmm_mesh_unfold_obtuse(mfmm_mesh *mesh, int32_t max_steps, mfmm_obtuse *obtuse,
+                                    int32_t n, int32_t **strip_far);
 
 /* A walk along a virtual edge's strip, rebuilding its steps as the build
  * found them (bit for bit): mfmm_strip_begin, then mfmm_strip_next per step.

@@ -432,6 +432,235 @@ static void test_fan_order(void **state)
     mfmm_mesh_destroy(m);
 }
 
+/* The build's sorts (src/mesh/order.c, build.c) against plain ones. The
+ * vertex order: Morton cells' key, then rows inside the cell, then input
+ * id, by qsort. */
+typedef struct ref_vkey {
+    uint64_t key, fine;
+    int32_t id;
+} ref_vkey;
+
+static int ref_vkey_cmp(const void *pa, const void *pb)
+{
+    const ref_vkey *a = pa, *b = pb;
+    if (a->key != b->key)
+        return a->key < b->key ? -1 : 1;
+    if (a->fine != b->fine)
+        return a->fine < b->fine ? -1 : 1;
+    return (a->id > b->id) - (a->id < b->id);
+}
+
+static uint64_t ref_spread3(uint64_t x)
+{
+    uint64_t r = 0;
+    for (int b = 0; b < 21; b++)
+        r |= (x >> b & 1) << (3 * b);
+    return r;
+}
+
+static void ref_vertex_order(const double *xyz, int32_t nv, int32_t *ex)
+{
+    ref_vkey *keys = malloc((size_t)nv * sizeof *keys);
+    assert_non_null(keys);
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, ext = 0.0;
+    for (int32_t v = 0; v < nv; v++)
+        for (int k = 0; k < 3; k++)
+            lo[k] = fmin(lo[k], xyz[3 * v + k]);
+    for (int32_t v = 0; v < nv; v++)
+        for (int k = 0; k < 3; k++)
+            ext = fmax(ext, xyz[3 * v + k] - lo[k]);
+    double scale = ext > 0.0 ? 2097151.0 / ext : 0.0;
+    int L = 0;
+    while (L < 21 && ((double)nv / 64.0) > (double)(1u << L) * (double)(1u << L))
+        L++;
+    for (int32_t v = 0; v < nv; v++) {
+        uint32_t u[3];
+        for (int k = 0; k < 3; k++) {
+            double q = (xyz[3 * v + k] - lo[k]) * scale;
+            u[k] = !(q > 0.0) ? 0u : q > 2097151.0 ? 2097151u : (uint32_t)q;
+        }
+        keys[v].fine = (uint64_t)u[1] << 42 | (uint64_t)u[0] << 21 | u[2];
+        keys[v].key = ref_spread3(u[0] >> (21 - L)) | ref_spread3(u[1] >> (21 - L)) << 1 |
+                      ref_spread3(u[2] >> (21 - L)) << 2;
+        keys[v].id = v;
+    }
+    qsort(keys, (size_t)nv, sizeof *keys, ref_vkey_cmp);
+    for (int32_t i = 0; i < nv; i++)
+        ex[i] = keys[i].id;
+    free(keys);
+}
+
+typedef struct ref_he {
+    int32_t lo, hi, corner;
+} ref_he;
+
+static int ref_he_cmp(const void *pa, const void *pb)
+{
+    const ref_he *a = pa, *b = pb;
+    if (a->lo != b->lo)
+        return a->lo < b->lo ? -1 : 1;
+    if (a->hi != b->hi)
+        return a->hi < b->hi ? -1 : 1;
+    return (a->corner > b->corner) - (a->corner < b->corner);
+}
+
+/* Every half-edge sorted by (lo, hi, corner): each edge's two faces
+ * neighbours (copies aside, and leading where their original does), -1 at
+ * a boundary or non-manifold edge; the counts and the length statistics
+ * summed in that order, bit for bit. */
+static void check_edges(const mfmm_mesh *m)
+{
+    int32_t nc = 3 * m->nf;
+    ref_he *he = malloc((size_t)nc * sizeof *he);
+    int32_t *fn = malloc((size_t)nc * sizeof *fn);
+    assert_true(he && fn);
+    for (int32_t c = 0; c < nc; c++) {
+        const int32_t *fv = m->face_records[c / 3].v;
+        int32_t u = fv[(c % 3 + 1) % 3], v = fv[(c % 3 + 2) % 3];
+        he[c] = (ref_he){u < v ? u : v, u < v ? v : u, c};
+    }
+    qsort(he, (size_t)nc, sizeof *he, ref_he_cmp);
+    double sum = 0.0, lmin = INFINITY, lmax = 0.0;
+    int32_t n_edges = 0, n_boundary = 0, n_nonmanifold = 0;
+    for (int32_t i = 0, j; i < nc; i = j) {
+        for (j = i + 1; j < nc && he[j].lo == he[i].lo && he[j].hi == he[i].hi; j++)
+            ;
+        n_edges++;
+        const double *p = m->xyz + 3 * he[i].lo, *q = m->xyz + 3 * he[i].hi;
+        double len = sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                          (p[2] - q[2]) * (p[2] - q[2]));
+        sum += len;
+        lmin = fmin(lmin, len);
+        lmax = fmax(lmax, len);
+        int32_t real[2] = {0, 0}, n_real = 0;
+        for (int32_t t = i; t < j; t++)
+            if (!mfmm_mesh_copy(m, he[t].corner / 3) && n_real++ < 2)
+                real[n_real - 1] = he[t].corner;
+        for (int32_t t = i, s = i; t < j; t++) {
+            int32_t c = he[t].corner;
+            if (mfmm_mesh_copy(m, c / 3))
+                fn[c] = fn[he[s].corner];
+            else {
+                s = t;
+                fn[c] = n_real != 2 ? -1 : c == real[0] ? real[1] / 3 : real[0] / 3;
+            }
+        }
+        n_boundary += n_real == 1;
+        n_nonmanifold += n_real != 1 && n_real != 2;
+    }
+    assert_memory_equal(fn, m->face_neighbor, (size_t)nc * sizeof *fn);
+    assert_int_equal(m->info.n_edges, n_edges);
+    assert_int_equal(m->info.n_boundary_edges, n_boundary);
+    assert_int_equal(m->info.n_nonmanifold_edges, n_nonmanifold);
+    double mean = sum / n_edges;
+    assert_memory_equal(&m->info.min_edge_length, &lmin, sizeof lmin);
+    assert_memory_equal(&m->info.max_edge_length, &lmax, sizeof lmax);
+    assert_memory_equal(&m->info.mean_edge_length, &mean, sizeof mean);
+    free(he);
+    free(fn);
+}
+
+/* The vertex order as the reference's (from the input positions, which
+ * xyz holds in internal order), faces ascending by their sorted vertices
+ * and then input id, and the edges as check_edges's. */
+static void check_build(const mfmm_mesh *m, int32_t n_fan_at_0)
+{
+    double *V = malloc(3 * (size_t)m->nv * sizeof *V);
+    int32_t *ex = malloc((size_t)m->nv * sizeof *ex);
+    assert_true(V && ex);
+    for (int32_t i = 0; i < m->nv; i++)
+        memcpy(V + 3 * m->to_external[i], m->xyz + 3 * i, 3 * sizeof *V);
+    ref_vertex_order(V, m->nv, ex);
+    assert_memory_equal(ex, m->to_external, (size_t)m->nv * sizeof *ex);
+    int32_t at_0 = 0, prev[4] = {-1, -1, -1, -1};
+    for (int32_t f = 0; f < m->nf; f++) {
+        int32_t t[4], *fv = m->face_records[f].v, x;
+        memcpy(t, fv, 3 * sizeof *t);
+        for (int a = 0; a < 2; a++)
+            for (int b = 0; b < 2 - a; b++)
+                if (t[b] > t[b + 1])
+                    x = t[b], t[b] = t[b + 1], t[b + 1] = x;
+        t[3] = m->face_to_external[f];
+        assert_true(memcmp(t, prev, sizeof t) != 0);
+        for (int k = 0; k < 4; k++)
+            if (t[k] != prev[k]) {
+                assert_true(t[k] > prev[k]);
+                break;
+            }
+        memcpy(prev, t, sizeof t);
+        at_0 += t[0] == 0;
+    }
+    assert_true(at_0 >= n_fan_at_0);
+    check_edges(m);
+    free(V);
+    free(ex);
+}
+
+/* The sorts' rare paths: a fan of 100 faces and a book of 40 pages on
+ * vertex 0 (more faces and half-edges at one vertex than the insertion
+ * sorts take), copies of faces, two more vertices at vertex 0's position
+ * and one at a rim vertex's (ties of the vertex order), 20 referenced and 2
+ * unreferenced at another's (a run of equal keys that coincident_vertices
+ * hashes), an unreferenced vertex; then a sine surface and a shared mesh. */
+static void test_build_against_reference(void **state)
+{
+    (void)state;
+    enum { RIM = 101, PAGES = 40, STACK = 22 };
+    int32_t nv = 1 + RIM + PAGES + 4 + STACK, nf = 0;
+    double *V = malloc(3 * (size_t)nv * sizeof *V);
+    int32_t *F = malloc(3 * 250 * sizeof *F);
+    assert_true(V && F);
+    memset(V, 0, 3 * (size_t)nv * sizeof *V);
+    for (int32_t i = 0; i < RIM; i++) {
+        double a = 1.5707963267948966 * i / (RIM - 1);
+        V[3 * (1 + i)] = cos(a), V[3 * (1 + i) + 1] = sin(a), V[3 * (1 + i) + 2] = 0.05 * (i % 3);
+    }
+    for (int32_t j = 0; j < PAGES; j++) {
+        double *p = V + 3 * (1 + RIM + j);
+        p[0] = 0.5, p[1] = 0.5, p[2] = 0.1 + 0.05 * j;
+    }
+    int32_t z0 = 1 + RIM + PAGES, z1 = z0 + 1, q = z0 + 2, unref = z0 + 3;
+    memcpy(V + 3 * q, V + 3 * (1 + 50), 3 * sizeof *V);
+    V[3 * unref] = V[3 * unref + 1] = V[3 * unref + 2] = 0.3;
+    int32_t stack = unref + 1;
+    for (int32_t i = 0; i < STACK; i++)
+        memcpy(V + 3 * (stack + i), V + 3 * (1 + 70), 3 * sizeof *V);
+#define FACE(a, b, c) (F[3 * nf] = (a), F[3 * nf + 1] = (b), F[3 * nf + 2] = (c), nf++)
+    for (int32_t i = 0; i + 1 < RIM; i++)
+        FACE(0, 1 + i, 2 + i);
+    for (int32_t j = 0; j < PAGES; j++)
+        FACE(0, 1, 1 + RIM + j);
+    FACE(11, 12, 0);  /* copies: rotated, flipped, twice */
+    FACE(0, 22, 21);
+    FACE(31, 0, 32);
+    FACE(32, 31, 0);
+    FACE(z0, 1 + RIM, 2 + RIM);
+    FACE(z1, q, 1 + RIM + 5);
+    FACE(q, 61, 1 + RIM + 7);
+    for (int32_t i = 0; i < STACK - 2; i++)
+        FACE(stack + i, 81, 1 + RIM + 10);
+#undef FACE
+    mfmm_mesh *m = NULL;
+    mfmm_error err;
+    assert_int_equal(mfmm_mesh_create(V, nv, F, nf, NULL, &m, &err), MFMM_OK);
+    assert_int_equal(m->to_external[0], 0);
+    assert_true(m->info.n_nonmanifold_edges > 0 && m->info.n_duplicate_faces == 4);
+    assert_int_equal(m->info.n_coincident_vertices, 3 + STACK - 2);
+    assert_int_equal(m->info.n_unreferenced_vertices, 3);
+    check_build(m, RIM - 1 + PAGES);
+    mfmm_mesh_destroy(m);
+    free(V);
+    free(F);
+    mfmm_gen_mesh g = mfmm_gen_sine(40);
+    m = tm_make(&g);
+    check_build(m, 0);
+    mfmm_mesh_destroy(m);
+    mfmm_gen_free(&g);
+    m = tm_load_data("meshes/camelhead.off", NULL, NULL, NULL);
+    check_build(m, 0);
+    mfmm_mesh_destroy(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -440,6 +669,7 @@ int main(void)
         cmocka_unit_test(test_shuffled_sparse),
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_fan_order),
+        cmocka_unit_test(test_build_against_reference),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
