@@ -235,12 +235,36 @@ static inline void sl_update(mfmm_slots *s, int32_t v, double dist, int ray)
     s->h.label[v] = 1;
 }
 
-/* the distance a window gives at x of its edge: over the nearer end of its
- * interval, then along the edge, outside it */
-static inline double sl_at(double x, double b0, double b1, double px, double py, double sigma)
+/* the distances a window gives at the SL_NS points x (ascending) of its
+ * edge: over the nearer end of its interval, then along the edge, outside
+ * it (each end's segment computed once for all the points beyond it) */
+static inline void sl_vals(const double *x, double b0, double b1, double px, double py,
+                           double sigma, double *v)
 {
-    double c = x < b0 ? b0 : x > b1 ? b1 : x;
-    return sigma + sqrt((c - px) * (c - px) + py * py) + fabs(x - c);
+    int j = 0;
+    if (x[0] < b0) {
+        double e = sigma + sqrt((b0 - px) * (b0 - px) + py * py);
+        for (; j < SL_NS && x[j] < b0; j++)
+            v[j] = e + fabs(x[j] - b0);
+    }
+    for (; j < SL_NS && !(x[j] > b1); j++)
+        v[j] = sigma + sqrt((x[j] - px) * (x[j] - px) + py * py);
+    if (j < SL_NS) {
+        double e = sigma + sqrt((b1 - px) * (b1 - px) + py * py);
+        for (; j < SL_NS; j++)
+            v[j] = e + fabs(x[j] - b1);
+    }
+}
+
+/* the lower of two values, NaN ignored (the envelope's loop) */
+static inline double sl_lo(double a, double b)
+{
+    double lo = INFINITY;
+    if (a < lo)
+        lo = a;
+    if (b < lo)
+        lo = b;
+    return lo;
 }
 
 /* half-edge g (not passed) holds a window whose least value is
@@ -303,27 +327,46 @@ static void sl_keep(mfmm_slots *s, int32_t g, int fl, double L, double s0, doubl
         /* the envelope: of the K + 1 windows (the new one
          * included) drop the one whose loss raises the least least, the
          * sum over SL_NS points of the edge of the lowest value there */
-        double val[SL_NS][9];
-        for (int j = 0; j < SL_NS; j++) {
-            double x = L * j / (SL_NS - 1);
-            for (int i = 0; i < n; i++)
-                val[j][i] = sl_at(x, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma);
-            val[j][n] = sl_at(x, b0, b1, px, py, sigma);
-        }
+        double x[SL_NS], val[9][SL_NS];
+        for (int j = 0; j < SL_NS; j++)
+            x[j] = L * j / (SL_NS - 1);
+        for (int i = 0; i < n; i++)
+            sl_vals(x, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma, val[i]);
+        sl_vals(x, b0, b1, px, py, sigma, val[n]);
         double best = INFINITY;
         at = n;
-        for (int q = n; q >= 0; q--) {
-            double sum = 0.0;
+        if (n == 2) {
+            /* the three sums at once, each in the order of the loop below */
+            double sum2 = 0.0, sum1 = 0.0, sum0 = 0.0;
             for (int j = 0; j < SL_NS; j++) {
-                double lo = INFINITY;
-                for (int i = 0; i <= n; i++)
-                    if (i != q && val[j][i] < lo)
-                        lo = val[j][i];
-                sum += lo;
+                sum2 += sl_lo(val[0][j], val[1][j]);
+                sum1 += sl_lo(val[0][j], val[2][j]);
+                sum0 += sl_lo(val[1][j], val[2][j]);
             }
-            if (sum < best) {
-                best = sum;
-                at = q;
+            if (sum2 < best) {
+                best = sum2;
+                at = 2;
+            }
+            if (sum1 < best) {
+                best = sum1;
+                at = 1;
+            }
+            if (sum0 < best)
+                at = 0;
+        } else {
+            for (int q = n; q >= 0; q--) {
+                double sum = 0.0;
+                for (int j = 0; j < SL_NS; j++) {
+                    double lo = INFINITY;
+                    for (int i = 0; i <= n; i++)
+                        if (i != q && val[i][j] < lo)
+                            lo = val[i][j];
+                    sum += lo;
+                }
+                if (sum < best) {
+                    best = sum;
+                    at = q;
+                }
             }
         }
         s->info.evicted++;
