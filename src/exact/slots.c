@@ -80,7 +80,6 @@ struct mfmm_slots {
     const int32_t *vf_offset, *vf_corner, *face_in;
     sl_win *slot;     /* (2 * 3 nf) */
     uint8_t *n_slot;  /* (3 nf) windows held */
-    uint8_t *passed;  /* (3 nf) */
     double *d;
     uint8_t *need;    /* (nv) a vertex that may bend a path: the exact tables' pseudo-source
                          flag, less vertices at a wall whose angle sum is pi or less */
@@ -119,7 +118,6 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     s->K = 2;
     s->slot = malloc((2 * nh + 1) * sizeof *s->slot);
     s->n_slot = malloc(nh + 1);
-    s->passed = malloc(nh + 1);
     s->d = malloc((nv + 1) * sizeof *s->d);
     s->ray = malloc(nv + 1);
     s->need = malloc(nv + 1);
@@ -135,7 +133,7 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     s->e.heap_vertex = malloc((nh + 1) * sizeof(int32_t));
     s->e.heap_pos = malloc((nh + 1) * sizeof(int32_t));
     if (!s->e.label || !s->e.heap_key || !s->e.heap_vertex || !s->e.heap_pos ||
-        !s->slot || !s->n_slot || !s->passed || !s->d || !s->ray || !s->need || !s->flat || !s->is_src || !s->is_tgt || !s->h.label ||
+        !s->slot || !s->n_slot || !s->d || !s->ray || !s->need || !s->flat || !s->is_src || !s->is_tgt || !s->h.label ||
         !s->h.heap_key || !s->h.heap_vertex || !s->h.heap_pos) {
         mfmm_slots_destroy(s);
         return MFMM_ERR_OUT_OF_MEMORY;
@@ -168,7 +166,7 @@ size_t mfmm_slots_bytes(const mfmm_mesh *mesh)
 {
     size_t nv = (size_t)mesh->nv, nh = 3 * (size_t)mesh->nf;
     /* slots and per-half-edge flags and heap; distances, flags and heap per vertex */
-    return nh * (2 * sizeof(sl_win) + 3 + 1 + sizeof(double) + 2 * sizeof(int32_t)) +
+    return nh * (2 * sizeof(sl_win) + 2 + 1 + sizeof(double) + 2 * sizeof(int32_t)) +
            nv * (sizeof(double) + 6 + sizeof(double) + 2 * sizeof(int32_t));
 }
 
@@ -178,7 +176,6 @@ void mfmm_slots_destroy(mfmm_slots *s)
         return;
     free(s->slot);
     free(s->n_slot);
-    free(s->passed);
     free(s->d);
     free(s->ray);
     free(s->need);
@@ -212,6 +209,18 @@ int mfmm_slots_set_k(mfmm_slots *s, int K)
 void mfmm_slots_get_info(const mfmm_slots *s, mfmm_slots_info *info)
 {
     *info = s->info;
+}
+
+/* fmin and fmax as glibc's (the second operand on ties, a NaN operand
+ * ignored), inlined where libm's are calls on the baseline target */
+static inline double sl_fmin(double a, double b)
+{
+    return a < b ? a : b == b ? b : a;
+}
+
+static inline double sl_fmax(double a, double b)
+{
+    return a > b ? a : b == b ? b : a;
 }
 
 static inline void sl_update(mfmm_slots *s, int32_t v, double dist, int ray)
@@ -304,16 +313,16 @@ static void sl_keep(mfmm_slots *s, int32_t g, int fl, double L, double s0, doubl
         if (fabs(w[i].px - px) > tol || fabs(w[i].py - py) > tol ||
             fabs(w[i].sigma - sigma) > tol || g0 > w[i].g1 + tol || g1 < w[i].g0 - tol)
             continue;
-        w[i].g0 = fmin(g0, w[i].g0);
-        w[i].g1 = fmax(g1, w[i].g1);
+        w[i].g0 = sl_fmin(g0, w[i].g0);
+        w[i].g1 = sl_fmax(g1, w[i].g1);
         if (b0 >= w[i].b0 - tol && b1 <= w[i].b1 + tol)
             return; /* nothing new */
-        double u0 = fmin(b0, w[i].b0), u1 = fmax(b1, w[i].b1);
+        double u0 = sl_fmin(b0, w[i].b0), u1 = sl_fmax(b1, w[i].b1);
         w[i].b0 = u0;
         w[i].b1 = u1;
         s->info.merged++;
         sl_key(s, g, b0, b1, px, py, sigma);
-        if (s->passed[g]) {
+        if (s->e.label[g] == 2) {
             s->info.late++;
             sl_win c = {b0, b1, px, py, sigma, g0, g1};
             sl_cross(s, g, &c);
@@ -376,7 +385,7 @@ static void sl_keep(mfmm_slots *s, int32_t g, int fl, double L, double s0, doubl
     w[at] = (sl_win){b0, b1, px, py, sigma, g0, g1};
     s->info.kept++;
     sl_key(s, g, b0, b1, px, py, sigma);
-    if (s->passed[g]) {
+    if (s->e.label[g] == 2) {
         /* kept after its half-edge was passed: crossed at once */
         s->info.late++;
         sl_win c = w[at];
@@ -400,8 +409,8 @@ static void sl_emit(mfmm_slots *s, int32_t h, double s0, double s1, double t0, d
         s0 = 0.0;
     if (s1 > L)
         s1 = L;
-    t0 = fmax(0.0, fmin(t0, s0));
-    t1 = fmin(L, fmax(t1, s1));
+    t0 = sl_fmax(0.0, sl_fmin(t0, s0));
+    t1 = sl_fmin(L, sl_fmax(t1, s1));
     if (!(s1 - s0 > EX_MIN_WIDTH * L)) {
         s->info.narrow++;
         return;
@@ -503,9 +512,6 @@ static void sl_cross(mfmm_slots *s, int32_t h, const sl_win *w)
 
 static void sl_pass(mfmm_slots *s, int32_t h)
 {
-    if (s->passed[h])
-        return;
-    s->passed[h] = 1;
     int n = s->n_slot[h];
     /* (a window kept while another is crossed cannot land in the same slot:
      * the children go to the face's other edges) */
@@ -520,7 +526,6 @@ static void sl_reset(mfmm_slots *s)
     size_t nv = (size_t)s->nv, nh = 3 * (size_t)s->nf;
     memset(&s->info, 0, sizeof s->info);
     memset(s->n_slot, 0, nh);
-    memset(s->passed, 0, nh);
     memset(s->h.label, 0, nv);
     memset(s->e.label, 0, nh);
     s->e.heap_size = 0;
