@@ -513,6 +513,25 @@ static void sl_cross(mfmm_slots *s, int32_t h, const sl_win *w)
 static void sl_pass(mfmm_slots *s, int32_t h)
 {
     int n = s->n_slot[h];
+#ifdef __GNUC__
+    {
+        /* what the children will read: the slots of the half-edges across
+         * the face's other two edges, and the far corner's distance */
+        const ex_face *r = s->fr + h / 3;
+        int m = h % 3;
+        for (int c = 1; c <= 2; c++) {
+            int32_t g = r->across[(m + c) % 3];
+            if (g >= 0) {
+                const char *p = (const char *)(s->slot + (size_t)s->K * g);
+                __builtin_prefetch(p);
+                __builtin_prefetch(p + 64);
+                __builtin_prefetch(s->n_slot + g);
+                __builtin_prefetch(s->e.label + g);
+            }
+        }
+        __builtin_prefetch(s->d + r->v[m]);
+    }
+#endif
     /* (a window kept while another is crossed cannot land in the same slot:
      * the children go to the face's other edges) */
     for (int i = 0; i < n; i++) {
