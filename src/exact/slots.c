@@ -80,7 +80,6 @@ struct mfmm_slots {
     const int32_t *vf_offset, *vf_corner, *face_in;
     sl_win *slot;     /* (2 * 3 nf) */
     uint8_t *n_slot;  /* (3 nf) windows held */
-    uint8_t *passed;  /* (3 nf) */
     double *d;
     uint8_t *need;    /* (nv) a vertex that may bend a path: the exact tables' pseudo-source
                          flag, less vertices at a wall whose angle sum is pi or less */
@@ -119,7 +118,6 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     s->K = 2;
     s->slot = malloc((2 * nh + 1) * sizeof *s->slot);
     s->n_slot = malloc(nh + 1);
-    s->passed = malloc(nh + 1);
     s->d = malloc((nv + 1) * sizeof *s->d);
     s->ray = malloc(nv + 1);
     s->need = malloc(nv + 1);
@@ -135,7 +133,7 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     s->e.heap_vertex = malloc((nh + 1) * sizeof(int32_t));
     s->e.heap_pos = malloc((nh + 1) * sizeof(int32_t));
     if (!s->e.label || !s->e.heap_key || !s->e.heap_vertex || !s->e.heap_pos ||
-        !s->slot || !s->n_slot || !s->passed || !s->d || !s->ray || !s->need || !s->flat || !s->is_src || !s->is_tgt || !s->h.label ||
+        !s->slot || !s->n_slot || !s->d || !s->ray || !s->need || !s->flat || !s->is_src || !s->is_tgt || !s->h.label ||
         !s->h.heap_key || !s->h.heap_vertex || !s->h.heap_pos) {
         mfmm_slots_destroy(s);
         return MFMM_ERR_OUT_OF_MEMORY;
@@ -168,7 +166,7 @@ size_t mfmm_slots_bytes(const mfmm_mesh *mesh)
 {
     size_t nv = (size_t)mesh->nv, nh = 3 * (size_t)mesh->nf;
     /* slots and per-half-edge flags and heap; distances, flags and heap per vertex */
-    return nh * (2 * sizeof(sl_win) + 3 + 1 + sizeof(double) + 2 * sizeof(int32_t)) +
+    return nh * (2 * sizeof(sl_win) + 2 + 1 + sizeof(double) + 2 * sizeof(int32_t)) +
            nv * (sizeof(double) + 6 + sizeof(double) + 2 * sizeof(int32_t));
 }
 
@@ -178,7 +176,6 @@ void mfmm_slots_destroy(mfmm_slots *s)
         return;
     free(s->slot);
     free(s->n_slot);
-    free(s->passed);
     free(s->d);
     free(s->ray);
     free(s->need);
@@ -214,6 +211,18 @@ void mfmm_slots_get_info(const mfmm_slots *s, mfmm_slots_info *info)
     *info = s->info;
 }
 
+/* fmin and fmax as glibc's (the second operand on ties, a NaN operand
+ * ignored), inlined where libm's are calls on the baseline target */
+static inline double sl_fmin(double a, double b)
+{
+    return a < b ? a : b == b ? b : a;
+}
+
+static inline double sl_fmax(double a, double b)
+{
+    return a > b ? a : b == b ? b : a;
+}
+
 static inline void sl_update(mfmm_slots *s, int32_t v, double dist, int ray)
 {
     if (!(dist < s->d[v])) {
@@ -235,12 +244,36 @@ static inline void sl_update(mfmm_slots *s, int32_t v, double dist, int ray)
     s->h.label[v] = 1;
 }
 
-/* the distance a window gives at x of its edge: over the nearer end of its
- * interval, then along the edge, outside it */
-static inline double sl_at(double x, double b0, double b1, double px, double py, double sigma)
+/* the distances a window gives at the SL_NS points x (ascending) of its
+ * edge: over the nearer end of its interval, then along the edge, outside
+ * it (each end's segment computed once for all the points beyond it) */
+static inline void sl_vals(const double *x, double b0, double b1, double px, double py,
+                           double sigma, double *v)
 {
-    double c = x < b0 ? b0 : x > b1 ? b1 : x;
-    return sigma + sqrt((c - px) * (c - px) + py * py) + fabs(x - c);
+    int j = 0;
+    if (x[0] < b0) {
+        double e = sigma + sqrt((b0 - px) * (b0 - px) + py * py);
+        for (; j < SL_NS && x[j] < b0; j++)
+            v[j] = e + fabs(x[j] - b0);
+    }
+    for (; j < SL_NS && !(x[j] > b1); j++)
+        v[j] = sigma + sqrt((x[j] - px) * (x[j] - px) + py * py);
+    if (j < SL_NS) {
+        double e = sigma + sqrt((b1 - px) * (b1 - px) + py * py);
+        for (; j < SL_NS; j++)
+            v[j] = e + fabs(x[j] - b1);
+    }
+}
+
+/* the lower of two values, NaN ignored (the envelope's loop) */
+static inline double sl_lo(double a, double b)
+{
+    double lo = INFINITY;
+    if (a < lo)
+        lo = a;
+    if (b < lo)
+        lo = b;
+    return lo;
 }
 
 /* half-edge g (not passed) holds a window whose least value is
@@ -280,16 +313,16 @@ static void sl_keep(mfmm_slots *s, int32_t g, int fl, double L, double s0, doubl
         if (fabs(w[i].px - px) > tol || fabs(w[i].py - py) > tol ||
             fabs(w[i].sigma - sigma) > tol || g0 > w[i].g1 + tol || g1 < w[i].g0 - tol)
             continue;
-        w[i].g0 = fmin(g0, w[i].g0);
-        w[i].g1 = fmax(g1, w[i].g1);
+        w[i].g0 = sl_fmin(g0, w[i].g0);
+        w[i].g1 = sl_fmax(g1, w[i].g1);
         if (b0 >= w[i].b0 - tol && b1 <= w[i].b1 + tol)
             return; /* nothing new */
-        double u0 = fmin(b0, w[i].b0), u1 = fmax(b1, w[i].b1);
+        double u0 = sl_fmin(b0, w[i].b0), u1 = sl_fmax(b1, w[i].b1);
         w[i].b0 = u0;
         w[i].b1 = u1;
         s->info.merged++;
         sl_key(s, g, b0, b1, px, py, sigma);
-        if (s->passed[g]) {
+        if (s->e.label[g] == 2) {
             s->info.late++;
             sl_win c = {b0, b1, px, py, sigma, g0, g1};
             sl_cross(s, g, &c);
@@ -303,27 +336,46 @@ static void sl_keep(mfmm_slots *s, int32_t g, int fl, double L, double s0, doubl
         /* the envelope: of the K + 1 windows (the new one
          * included) drop the one whose loss raises the least least, the
          * sum over SL_NS points of the edge of the lowest value there */
-        double val[SL_NS][9];
-        for (int j = 0; j < SL_NS; j++) {
-            double x = L * j / (SL_NS - 1);
-            for (int i = 0; i < n; i++)
-                val[j][i] = sl_at(x, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma);
-            val[j][n] = sl_at(x, b0, b1, px, py, sigma);
-        }
+        double x[SL_NS], val[9][SL_NS];
+        for (int j = 0; j < SL_NS; j++)
+            x[j] = L * j / (SL_NS - 1);
+        for (int i = 0; i < n; i++)
+            sl_vals(x, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma, val[i]);
+        sl_vals(x, b0, b1, px, py, sigma, val[n]);
         double best = INFINITY;
         at = n;
-        for (int q = n; q >= 0; q--) {
-            double sum = 0.0;
+        if (n == 2) {
+            /* the three sums at once, each in the order of the loop below */
+            double sum2 = 0.0, sum1 = 0.0, sum0 = 0.0;
             for (int j = 0; j < SL_NS; j++) {
-                double lo = INFINITY;
-                for (int i = 0; i <= n; i++)
-                    if (i != q && val[j][i] < lo)
-                        lo = val[j][i];
-                sum += lo;
+                sum2 += sl_lo(val[0][j], val[1][j]);
+                sum1 += sl_lo(val[0][j], val[2][j]);
+                sum0 += sl_lo(val[1][j], val[2][j]);
             }
-            if (sum < best) {
-                best = sum;
-                at = q;
+            if (sum2 < best) {
+                best = sum2;
+                at = 2;
+            }
+            if (sum1 < best) {
+                best = sum1;
+                at = 1;
+            }
+            if (sum0 < best)
+                at = 0;
+        } else {
+            for (int q = n; q >= 0; q--) {
+                double sum = 0.0;
+                for (int j = 0; j < SL_NS; j++) {
+                    double lo = INFINITY;
+                    for (int i = 0; i <= n; i++)
+                        if (i != q && val[i][j] < lo)
+                            lo = val[i][j];
+                    sum += lo;
+                }
+                if (sum < best) {
+                    best = sum;
+                    at = q;
+                }
             }
         }
         s->info.evicted++;
@@ -333,7 +385,7 @@ static void sl_keep(mfmm_slots *s, int32_t g, int fl, double L, double s0, doubl
     w[at] = (sl_win){b0, b1, px, py, sigma, g0, g1};
     s->info.kept++;
     sl_key(s, g, b0, b1, px, py, sigma);
-    if (s->passed[g]) {
+    if (s->e.label[g] == 2) {
         /* kept after its half-edge was passed: crossed at once */
         s->info.late++;
         sl_win c = w[at];
@@ -357,8 +409,8 @@ static void sl_emit(mfmm_slots *s, int32_t h, double s0, double s1, double t0, d
         s0 = 0.0;
     if (s1 > L)
         s1 = L;
-    t0 = fmax(0.0, fmin(t0, s0));
-    t1 = fmin(L, fmax(t1, s1));
+    t0 = sl_fmax(0.0, sl_fmin(t0, s0));
+    t1 = sl_fmin(L, sl_fmax(t1, s1));
     if (!(s1 - s0 > EX_MIN_WIDTH * L)) {
         s->info.narrow++;
         return;
@@ -460,10 +512,26 @@ static void sl_cross(mfmm_slots *s, int32_t h, const sl_win *w)
 
 static void sl_pass(mfmm_slots *s, int32_t h)
 {
-    if (s->passed[h])
-        return;
-    s->passed[h] = 1;
     int n = s->n_slot[h];
+#ifdef __GNUC__
+    {
+        /* what the children will read: the slots of the half-edges across
+         * the face's other two edges, and the far corner's distance */
+        const ex_face *r = s->fr + h / 3;
+        int m = h % 3;
+        for (int c = 1; c <= 2; c++) {
+            int32_t g = r->across[(m + c) % 3];
+            if (g >= 0) {
+                const char *p = (const char *)(s->slot + (size_t)s->K * g);
+                __builtin_prefetch(p);
+                __builtin_prefetch(p + 64);
+                __builtin_prefetch(s->n_slot + g);
+                __builtin_prefetch(s->e.label + g);
+            }
+        }
+        __builtin_prefetch(s->d + r->v[m]);
+    }
+#endif
     /* (a window kept while another is crossed cannot land in the same slot:
      * the children go to the face's other edges) */
     for (int i = 0; i < n; i++) {
@@ -477,7 +545,6 @@ static void sl_reset(mfmm_slots *s)
     size_t nv = (size_t)s->nv, nh = 3 * (size_t)s->nf;
     memset(&s->info, 0, sizeof s->info);
     memset(s->n_slot, 0, nh);
-    memset(s->passed, 0, nh);
     memset(s->h.label, 0, nv);
     memset(s->e.label, 0, nh);
     s->e.heap_size = 0;
