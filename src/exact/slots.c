@@ -165,8 +165,8 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
 size_t mfmm_slots_bytes(const mfmm_mesh *mesh)
 {
     size_t nv = (size_t)mesh->nv, nh = 3 * (size_t)mesh->nf;
-    /* slots and per-half-edge flags and heap; distances, flags and heap per vertex */
-    return nh * (2 * sizeof(sl_win) + 2 + 1 + sizeof(double) + 2 * sizeof(int32_t)) +
+    /* slots, count, label and heap per half-edge; distances, flags and heap per vertex */
+    return nh * (2 * sizeof(sl_win) + 2 + sizeof(double) + 2 * sizeof(int32_t)) +
            nv * (sizeof(double) + 6 + sizeof(double) + 2 * sizeof(int32_t));
 }
 
