@@ -10,10 +10,12 @@
  * march. Propagation stops once every window and pseudo-source left is
  * farther than radius, so the cost grows with the patch, not the mesh
  * (docs/performance.md, "The cost of the exact start").
- * Sources as for mfmm_solve_exact (checked: MFMM_ERR_BAD_SOURCE and the
- * like); T = value + distance. The patch: every vertex with T <= radius,
- * and the ring of those beyond it by less than their least height in their
- * faces, whose T the propagation has also made final (start/patch.c).
+ * Sources as for mfmm_solve_exact, but in internal ids (mesh/order.h:
+ * vertices, and faces cut at T-junctions), checked as it checks its own
+ * (MFMM_ERR_BAD_SOURCE and the like); T = value + distance. The patch:
+ * every vertex with T <= radius, and the ring of those beyond it by less
+ * than their least height in their faces, whose T the propagation has also
+ * made final (start/patch.c).
  *   n_vertices: receives the number of vertices in the patch.
  *   vertices, distances: receive arrays of that length owned by ws, valid
  *   until its next call (vertex ids, and their exact T), in no particular

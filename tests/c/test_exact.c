@@ -981,6 +981,90 @@ static void test_patch(void **state)
     ex_free(&fx);
 }
 
+/* A sine heightfield and a zero-area face apart from it, the latter at
+ * input index `at` (the others in order, the source face `*src` moved past
+ * it), and the mesh built. */
+static mfmm_mesh *ex_sine_and_needle(mfmm_gen_mesh *g, int32_t at, int32_t *src)
+{
+    mfmm_gen_mesh s = mfmm_gen_sine(12);
+    assert_non_null(s.V);
+    *g = ex_alloc(s.nv + 3, s.nf + 1);
+    memcpy(g->V, s.V, 3 * (size_t)s.nv * sizeof(double));
+    double needle[9] = {5.0, 5.0, 0.0, 5.5, 5.0, 0.0, 6.0, 5.0, 0.0};
+    memcpy(g->V + 3 * s.nv, needle, sizeof needle);
+    int32_t was = *src;
+    for (int32_t f = 0, o = 0; o < g->nf; o++) {
+        int32_t *t = g->F + 3 * o;
+        if (o == at) {
+            t[0] = s.nv;
+            t[1] = s.nv + 1;
+            t[2] = s.nv + 2;
+            continue;
+        }
+        memcpy(t, s.F + 3 * f, 3 * sizeof *t);
+        if (f++ == was)
+            *src = o;
+    }
+    mfmm_gen_free(&s);
+    return tm_make(g);
+}
+
+/* The patch takes internal ids, faces too: its check must read the face the
+ * source names, not the input face of that number (a zero-area one here),
+ * or the march's exact start falls back to the plain start. */
+static void test_patch_internal_face_ids(void **state)
+{
+    (void)state;
+    int32_t src = 6 * 24 + 11, at;
+    mfmm_gen_mesh g;
+    mfmm_mesh *m0 = ex_sine_and_needle(&g, 2 * 144, &src);
+    at = m0->face_to_internal[src];
+    mfmm_mesh_destroy(m0);
+    mfmm_gen_free(&g);
+    src = 6 * 24 + 11;
+    mfmm_mesh *mesh = ex_sine_and_needle(&g, at, &src);
+    /* internal ids depend on the faces, not on their input order */
+    assert_int_equal(mesh->face_to_internal[src], at);
+    assert_true(mfmm_mesh_degenerate(mesh, mesh->face_to_internal[at]));
+    assert_false(mfmm_mesh_degenerate(mesh, at));
+    mfmm_exact_solver *ex = NULL;
+    assert_int_equal(mfmm_exact_solver_create(mesh, &ex), MFMM_OK);
+    double *e = malloc((size_t)g.nv * sizeof *e), *d = malloc((size_t)g.nv * sizeof *d);
+    assert_true(e && d);
+    mfmm_source fs = {0, src, {0.2, 0.3, 0.5}, 0.0};
+    assert_int_equal(mfmm_solve_exact(ex, &fs, 1, NULL, e, NULL, NULL), MFMM_OK);
+    mfmm_source ps = fs;
+    ps.face = at;
+    int32_t n = 0;
+    const int32_t *vs = NULL;
+    const double *ds = NULL;
+    assert_int_equal(mfmm_exact_patch(ex, &ps, 1, 0.3, 0, &n, &vs, &ds, NULL), MFMM_OK);
+    assert_true(n > 20);
+    for (int32_t i = 0; i < n; i++)
+        tm_assert_close(ds[i], e[mesh->to_external[vs[i]]], 1e-12);
+    /* the march from an exact start of 6 mean edges: exact within 4 of
+     * them, where the plain start's march is up to 5 % off */
+    mfmm_solver *solver = NULL;
+    assert_int_equal(mfmm_solver_create(mesh, &solver), MFMM_OK);
+    mfmm_solve_options so;
+    mfmm_solve_options_init(&so);
+    so.exact_start_radius = 6.0;
+    assert_int_equal(mfmm_solve(solver, &fs, 1, &so, d, NULL), MFMM_OK);
+    int32_t near = 0;
+    for (int32_t v = 0; v < g.nv; v++)
+        if (e[v] <= 4.0 * mesh->info.mean_edge_length) {
+            tm_assert_close(d[v], e[v], 1e-12);
+            near++;
+        }
+    assert_true(near > 100);
+    mfmm_solver_destroy(solver);
+    mfmm_exact_solver_destroy(ex);
+    free(e);
+    free(d);
+    mfmm_mesh_destroy(mesh);
+    mfmm_gen_free(&g);
+}
+
 /* ------------------------------------------------ igl.exact_geodesic data */
 
 #ifdef MFMM_TEST_ZLIB
@@ -1301,6 +1385,7 @@ int main(void)
         cmocka_unit_test(test_memory_limit),
         cmocka_unit_test(test_threads),
         cmocka_unit_test(test_patch),
+        cmocka_unit_test(test_patch_internal_face_ids),
         cmocka_unit_test(test_saddles_start_once),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_igl_reference_hand),

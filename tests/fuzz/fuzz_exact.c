@@ -43,6 +43,21 @@
  * gave 2.8015 one way and 2.7901 the other; a needle on a non-manifold edge
  * reached from a pass, 1 + sqrt 2 and sqrt 5).
  *
+ * Face sources (no max_distance): the exact distance from a point p in a
+ * face equals the one from a vertex at p on the surface cut there: the
+ * mesh's own faces (T-junctions closed: a point of an input face may lie on
+ * a cut between its pieces) with the face holding p and its copies split in
+ * three at p, or where p lies on an edge, every face on that edge split in
+ * two (not where one of them has zero area: cut, it would make p the middle
+ * of a needle, joined to the faces across the needle's long edge); solved
+ * from that vertex (and the second source at its value) to 1e-12 relative
+ * at every vertex, unless either solve fell back to walls.
+ * With the vertex symmetry above this makes a face source's distances
+ * symmetric too. Splitting the input face alone is not the same surface:
+ * a point on an edge, or on a cut that is an edge of other faces (a
+ * T-junction's piece on a non-manifold edge), then loses the faces across
+ * it.
+ *
  * Input layout (all optional past the end: zeros):
  *   byte 0: nv - 3 (3..66)      byte 1: nf - 1 (1..128)
  *   byte 2: flags: 1 face source, 2 max_distance, 4 memory_limit, 8 two sources
@@ -191,6 +206,69 @@ static int within(const double *d, const double *lo, const double *hi, int32_t n
     return 1;
 }
 
+/* The mesh's surface cut at face source s (header comment), in internal
+ * ids: vertices V2 (nv + 1, the point last: *P), faces F2 (room for 3 nf +
+ * 3, nf the faces built). Returns the number of faces; 0 where the point
+ * is in no face with an area, at a corner, within 1e-6 of an edge without
+ * being on it (a cut would leave a sliver of a face), or on an edge of a
+ * zero-area face. */
+static int32_t split_at(const mfmm_mesh *mesh, const mfmm_source *s, double *V2, int32_t *F2,
+                        int32_t *P)
+{
+    double beta[3];
+    int32_t g = mfmm_order_point_in(mesh, s->face, s->bary, beta), nf2 = 0, nv = mesh->nv;
+    if (g < 0 || mfmm_mesh_degenerate(mesh, g))
+        return 0;
+    /* a cut between pieces leaves rounding (4e-17) where the point is on it */
+    int zk = -1, nzero = 0;
+    for (int k = 0; k < 3; k++) {
+        if (beta[k] <= 1e-12) {
+            beta[k] = 0.0;
+            zk = k;
+            nzero++;
+        } else if (beta[k] < 1e-6) {
+            return 0;
+        }
+    }
+    if (nzero > 1)
+        return 0;
+    const int32_t *pv = mesh->face_records[g].v;
+    memcpy(V2, mesh->xyz, 3 * (size_t)nv * sizeof *V2);
+    double sum = beta[0] + beta[1] + beta[2];
+    for (int d = 0; d < 3; d++)
+        V2[3 * nv + d] = (beta[0] * V2[3 * pv[0] + d] + beta[1] * V2[3 * pv[1] + d] +
+                          beta[2] * V2[3 * pv[2] + d]) /
+                         sum;
+    *P = nv;
+    for (int32_t f = 0; f < mesh->nf; f++) {
+        const int32_t *t = mesh->face_records[f].v;
+        int in[3], n_in = 0;
+        for (int k = 0; k < 3; k++)
+            n_in += in[k] = (t[k] == pv[0] && zk != 0) || (t[k] == pv[1] && zk != 1) ||
+                            (t[k] == pv[2] && zk != 2);
+        if (zk < 0 && n_in == 3) { /* the face or a copy: three faces round p */
+            for (int k = 0; k < 3; k++) {
+                int32_t *o = F2 + 3 * nf2++;
+                o[0] = t[k];
+                o[1] = t[(k + 1) % 3];
+                o[2] = nv;
+            }
+        } else if (zk >= 0 && n_in == 2) { /* on the edge t[k] t[k+1]: two faces */
+            /* cut, a zero-area face there makes p a needle's middle vertex,
+             * which the solver joins to the faces across its long edge */
+            if (mfmm_mesh_degenerate(mesh, f))
+                return 0;
+            int k = !in[0] ? 1 : !in[1] ? 2 : 0;
+            int32_t a = t[k], b = t[(k + 1) % 3], c = t[(k + 2) % 3], *o = F2 + 3 * nf2;
+            o[0] = a, o[1] = nv, o[2] = c, o[3] = nv, o[4] = b, o[5] = c;
+            nf2 += 2;
+        } else {
+            memcpy(F2 + 3 * nf2++, t, 3 * sizeof *t);
+        }
+    }
+    return nf2;
+}
+
 /* The exact distance from vertex sources to v solved from v (the least of
  * value + distance back to each source); NaN when that solve fails or fell
  * back to walls at non-manifold edges, whose values are upper bounds only
@@ -318,6 +396,38 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (!isnan(rev) && !(fabs(rev - e[vs[j]]) <= BOUND_REL * e[vs[j]] + btol))
                 abort();
         }
+    }
+    /* a face source equals a vertex at its point (header comment), from the
+     * second source too, in internal ids on the cut surface */
+    if (src[0].face >= 0 && !(flags & 2) && !info.nonmanifold_walls) {
+        int32_t nvi = mesh->nv, nfi = mesh->nf, P = -1;
+        double *V2 = malloc(3 * ((size_t)nvi + 1) * sizeof *V2);
+        double *s2 = malloc(((size_t)nvi + 1) * sizeof *s2);
+        int32_t *F2 = malloc(3 * (3 * (size_t)nfi + 3) * sizeof *F2), nf2;
+        mfmm_mesh *m2 = NULL;
+        mfmm_exact_solver *ex2 = NULL;
+        if (V2 && s2 && F2 && (nf2 = split_at(mesh, &src[0], V2, F2, &P)) > 0 &&
+            mfmm_mesh_create(V2, nvi + 1, F2, nf2, NULL, &m2, NULL) == MFMM_OK &&
+            mfmm_exact_solver_create(m2, &ex2) == MFMM_OK) {
+            mfmm_source s2src[2] = {src[0], src[1]};
+            s2src[0].face = -1;
+            s2src[0].vertex = P;
+            if (n_src == 2)
+                s2src[1].vertex = mfmm_vertex_in(mesh, src[1].vertex);
+            mfmm_exact_info info2 = {.struct_size = sizeof info2};
+            if (mfmm_solve_exact(ex2, s2src, n_src, NULL, s2, &info2, NULL) == MFMM_OK &&
+                !info2.nonmanifold_walls)
+                for (int32_t v = 0; v < nvi; v++) {
+                    double a = e[mfmm_vertex_out(mesh, v)], b = s2[v];
+                    if (a != b && !(fabs(a - b) <= BOUND_REL * a + btol))
+                        abort();
+                }
+        }
+        mfmm_exact_solver_destroy(ex2);
+        mfmm_mesh_destroy(m2);
+        free(V2);
+        free(s2);
+        free(F2);
     }
     /* the patch of the exact start: the full solve's distances within radius */
     if (n_src == 1 && !(flags & 6)) {
