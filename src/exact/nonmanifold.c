@@ -39,6 +39,8 @@ int ex_dominate(const mfmm_exact_ws *ws, int32_t slot, double L, double *s0p,
          * one's interval, whose directions alone are carried already. */
         for (int32_t i = ws->nm_head[slot]; i >= 0; i = ws->rec[i].next) {
             const ex_rec *a = ws->rec + i;
+            if (a->depth > ws->pass_depth)
+                continue;
             double ds = (sigma - a->sigma) * il, pa = a->px * il, qa = a->py * il;
             if (fabs(ds) + fabs(pw - pa) + fabs(qw - qa) <=
                     EX_TIE * (1.0 + fabs(sigma * il) + fabs(pw) + fabs(qw)) &&
@@ -49,6 +51,10 @@ int ex_dominate(const mfmm_exact_ws *ws, int32_t slot, double L, double *s0p,
     }
     for (int32_t i = ws->nm_head[slot]; i >= 0; i = ws->rec[i].next) {
         const ex_rec *a = ws->rec + i;
+        /* a window whose pass was cut at EX_MAX_PASS carried nothing past
+         * the cut, so it leaves a shallower one free to go on */
+        if (a->depth > ws->pass_depth)
+            continue;
         double a0 = a->b0 * il, a1 = a->b1 * il;
         int left = a0 <= s0, right = a1 >= s1;
         if (!left && !right)
@@ -143,9 +149,10 @@ int ex_dominate(const mfmm_exact_ws *ws, int32_t slot, double L, double *s0p,
 }
 
 /* Keeps a fanned-out window at its slot for ex_dominate, while memory
- * allows (one not kept only trims nothing). */
+ * allows (one not kept only trims nothing); it trims only windows passing
+ * at depth or deeper (ex_rec). */
 void ex_keep(mfmm_exact_ws *ws, int32_t slot, double b0, double b1, double px, double py,
-                    double sigma)
+             double sigma, int32_t depth)
 {
     if (ws->rec_n == ws->rec_cap) {
         int32_t cap = ws->rec_cap;
@@ -169,6 +176,7 @@ void ex_keep(mfmm_exact_ws *ws, int32_t slot, double b0, double b1, double px, d
     r->px = px;
     r->py = py;
     r->sigma = sigma;
+    r->depth = depth;
     r->slot = slot;
     r->next = ws->nm_head[slot];
     ws->nm_head[slot] = ws->rec_n++;

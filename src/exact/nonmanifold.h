@@ -18,8 +18,9 @@ int ex_dominate(const mfmm_exact_ws *ws, int32_t slot, double L, double *s0p,
                        double *s1p, double px, double py, double sigma);
 
 /* Keeps a fanned-out window at its slot for ex_dominate, while memory
- * allows (one not kept only trims nothing). */
+ * allows (one not kept only trims nothing); it trims only windows passing
+ * at depth or deeper (ex_rec). */
 void ex_keep(mfmm_exact_ws *ws, int32_t slot, double b0, double b1, double px, double py,
-                    double sigma);
+             double sigma, int32_t depth);
 
 #endif

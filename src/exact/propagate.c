@@ -90,8 +90,10 @@ static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double i
 static void ex_pass(mfmm_exact_ws *ws, int32_t hd, int flip, double L, double s0, double s1,
                     double ix, double iy, double sigma)
 {
-    if (ws->pass_depth >= EX_MAX_PASS)
+    if (ws->pass_depth >= EX_MAX_PASS) {
+        ws->pass_cut = 1;
         return;
+    }
     if (flip) {
         double t0 = L - s1;
         s1 = L - s0;
@@ -255,15 +257,23 @@ static void ex_fan_out(mfmm_exact_ws *ws, int32_t h, int32_t va, int32_t vb, dou
              * each go on */
             if (in_pass || i < 0 || !ex_dominate(ws, i, L, &n0, &n1, npx, -iy, sigma))
                 continue;
-            ex_keep(ws, i, n0, n1, npx, -iy, sigma);
+            /* kept at this depth while its pass runs (windows come round
+             * deeper), then for all depths unless the pass was cut */
+            int cut = ws->pass_cut;
+            int32_t kept = ws->rec_n;
+            ws->pass_cut = 0;
+            ex_keep(ws, i, n0, n1, npx, -iy, sigma, ws->pass_depth);
             ex_pass(ws, g, fl, L, fl ? L - n1 : n0, fl ? L - n0 : n1, ix, iy, sigma);
+            if (kept < ws->rec_n && !ws->pass_cut)
+                ws->rec[kept].depth = 0;
+            ws->pass_cut |= cut;
             continue;
         }
         if (i < 0)
             return;
         if (!ex_dominate(ws, i, L, &n0, &n1, npx, -iy, sigma))
             continue;
-        ex_keep(ws, i, n0, n1, npx, -iy, sigma);
+        ex_keep(ws, i, n0, n1, npx, -iy, sigma, 0);
         ex_enqueue(ws, g, fl, va, vb, L, fl ? L - n1 : n0, fl ? L - n0 : n1, ix, iy, sigma,
                    !ws->pseudo[va], !ws->pseudo[vb]);
     }

@@ -87,7 +87,7 @@
  * and the vertices; corner and fan angles: about 160 bytes per face; per
  * vertex its flags, angle sum and least height, 17 bytes; 8 bytes per
  * half-edge of a non-manifold edge), the queue's entries (windows and vertex
- * events, 56 bytes each) and the windows kept at non-manifold edges (48
+ * events, 56 bytes each) and the windows kept at non-manifold edges (56
  * bytes each, ex_keep), grown by doubling within memory_limit. No
  * recursion. */
 #include <math.h>

@@ -97,6 +97,8 @@ typedef struct ex_entry {
 typedef struct ex_rec {
     double b0, b1, px, py, sigma;
     int32_t slot, next;
+    int32_t depth; /* trims only windows passing at this depth or deeper: its
+                      pass was cut at EX_MAX_PASS (0: it went on in full) */
 } ex_rec;
 
 /* The read-only tables of a mesh (exact.h): built once, shared by the
@@ -195,6 +197,7 @@ struct mfmm_exact_solver {
     void *interrupt_user;
     int pass_depth; /* zero-area faces a window is passing through (ex_pass) */
     int32_t pass_face[EX_MAX_PASS]; /* those faces' records, outermost first */
+    int pass_cut;   /* a pass was cut at EX_MAX_PASS (ex_fan_out) */
     /* with non-manifold edges crossed, windows past a budget (over_budget):
      * the run is redone with those edges as walls (walls; ex_run); past it
      * otherwise, the run stops (stalled) and edge paths finish it */

@@ -685,7 +685,7 @@ static void test_dominate_equal_sigma(void **state)
         double L = 0.5 + 2.0 * u[0], sigma = 3.0 * u[1];
         double pa = L * (2.0 * u[2] - 0.5), qa = -(0.1 + u[3]) * L;
         double pn = L * (2.0 * u[4] - 0.5), qn = -(0.1 + u[0] * u[3]) * L;
-        kept = (ex_rec){0.0, L, pa, qa, sigma, 0, -1};
+        kept = (ex_rec){0.0, L, pa, qa, sigma, 0, -1, 0};
         /* where |X - N| = |X - K| on the edge (y = 0) */
         double xb = (pa * pa + qa * qa - pn * pn - qn * qn) / (2.0 * (pa - pn));
         double s0 = 0.0, s1 = L;
@@ -791,6 +791,32 @@ static void test_pass_into_needle_on_nonmanifold_edge(void **state)
     static const int32_t F2[12] = {0, 1, 2, 0, 2, 3, 1, 4, 2, 5, 0, 2};
     ex_assert_symmetric(V2, 6, F2, 4, D);
     tm_assert_close(D[4 * 6 + 5], sqrt(5.0), 1e-15);
+}
+
+/* A strip of needles between two points each split into coincident
+ * vertices (4-9 at one, 10-13 at the other), reached from 16 through face
+ * 5 15 10 on its non-manifold edge 5-10: a window that came to needle 5 10 9
+ * round two others had its pass cut at EX_MAX_PASS, and kept there it
+ * dropped the window that came straight, so d(16, 14) was 40.955 for
+ * 25.062 the other way (a graph of 128 points an edge, joined straight
+ * within each face, gives 25.0626, a real path). A fuzzed mesh, reduced. */
+static void test_pass_cut_at_depth_limit(void **state)
+{
+    (void)state;
+    static const double V[57] = {
+        0, 0, -1, 5, 0, -1, -1, 5, 0, -1, 0, 1,
+        10.875, 10.875, 10.875, 10.875, 10.875, 10.875, 10.875, 10.875, 10.875,
+        10.875, 10.875, 10.875, 10.875, 10.875, 10.875, 10.875, 10.875, 10.875,
+        -6.25, -6.25, -6.25, -6.25, -6.25, -6.25, -6.25, -6.25, -6.25,
+        -6.25, -6.25, -6.25, -6.25, 0.125, 4.375, 0.625, 0.5, 2, 0.25, 2, 2,
+        0.875, 2, 3, 0.625, 1.625, 1.5};
+    static const int32_t F[45] = {3, 1, 15, 0, 17, 2, 0, 1, 2, 4, 5, 10, 4, 10, 9,
+                                  5, 6, 11, 5, 11, 10, 6, 7, 12, 6, 12, 11, 7, 8, 13,
+                                  7, 13, 12, 8, 14, 13, 5, 15, 10, 5, 10, 9, 16, 18, 17};
+    static double D[19 * 19];
+    ex_assert_symmetric(V, 19, F, 15, D);
+    tm_assert_close(D[16 * 19 + 14], 25.062132981489, 1e-9);
+    assert_true(D[16 * 19 + 14] <= 25.0626);
 }
 
 /* A zero-area face refuses a source; the rest is exact, and its vertex in
@@ -1381,6 +1407,7 @@ int main(void)
         cmocka_unit_test(test_dominate_equal_sigma),
         cmocka_unit_test(test_nonmanifold_symmetric),
         cmocka_unit_test(test_pass_into_needle_on_nonmanifold_edge),
+        cmocka_unit_test(test_pass_cut_at_depth_limit),
         cmocka_unit_test(test_degenerate_face),
         cmocka_unit_test(test_memory_limit),
         cmocka_unit_test(test_threads),
