@@ -44,9 +44,12 @@ double mfmm_distance_bound(const mfmm_mesh *mesh, const double *cost, mfmm_cost_
     return fmax_ * (mesh->info.mean_edge_length * mesh->info.n_edges);
 }
 
-mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int32_t i,
-                              mfmm_error *err)
+/* Source i in the caller's face ids (internal: the built faces, pieces of
+ * faces cut at T-junctions included; else the input faces). */
+static mfmm_status check_source(const mfmm_mesh *mesh, const mfmm_source *src, int32_t i,
+                                int internal, mfmm_error *err)
 {
+    int32_t nf = internal ? mesh->nf : mesh->nf_in;
     if (!isfinite(src->value))
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, i, "source %ld has a value that is not finite",
                          (long)i);
@@ -57,9 +60,9 @@ mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int
                              (long)src->vertex, (long)mesh->nv);
         return MFMM_OK;
     }
-    if (src->face >= mesh->nf_in)
+    if (src->face >= nf)
         return mfmm_fail(err, MFMM_ERR_BAD_SOURCE, i, "source %ld: face %ld is outside [0, %ld)",
-                         (long)i, (long)src->face, (long)mesh->nf_in);
+                         (long)i, (long)src->face, (long)nf);
     double sum = 0.0;
     for (int k = 0; k < 3; k++) {
         double w = src->bary[k];
@@ -72,11 +75,24 @@ mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int
     if (fabs(sum - 1.0) > 1e-9)
         return mfmm_fail(err, MFMM_ERR_BAD_BARYCENTRIC, i,
                          "source %ld: barycentric coordinates sum to %.17g, not 1", (long)i, sum);
-    if (mfmm_order_point_degenerate(mesh, src->face, src->bary))
+    if (internal ? mfmm_mesh_degenerate(mesh, src->face)
+                 : mfmm_order_point_degenerate(mesh, src->face, src->bary))
         return mfmm_fail(err, MFMM_ERR_DEGENERATE_SOURCE, i,
                          "source %ld lies on face %ld, which has zero area", (long)i,
                          (long)src->face);
     return MFMM_OK;
+}
+
+mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int32_t i,
+                              mfmm_error *err)
+{
+    return check_source(mesh, src, i, 0, err);
+}
+
+mfmm_status mfmm_check_source_internal(const mfmm_mesh *mesh, const mfmm_source *src, int32_t i,
+                                       mfmm_error *err)
+{
+    return check_source(mesh, src, i, 1, err);
 }
 
 void mfmm_uniform_cost(const mfmm_mesh *mesh, const double *cost, int cost_location,

@@ -15,9 +15,13 @@ mfmm_status mfmm_check_cost(const mfmm_mesh *mesh, const double *cost,
  * (1 without one; cost checked). */
 double mfmm_distance_bound(const mfmm_mesh *mesh, const double *cost, mfmm_cost_location where);
 
-/* Checks source i: ids in range, face not degenerate, barycentric valid. */
+/* Checks source i: ids in range, face not degenerate, barycentric valid.
+ * _internal: the same for ids in the mesh's internal order (mesh/order.h),
+ * whose faces include the pieces of faces cut at T-junctions. */
 mfmm_status mfmm_check_source(const mfmm_mesh *mesh, const mfmm_source *src, int32_t i,
                               mfmm_error *err);
+mfmm_status mfmm_check_source_internal(const mfmm_mesh *mesh, const mfmm_source *src, int32_t i,
+                                       mfmm_error *err);
 
 /* For the march's virtual stencils under a cost (march.h): uniform[v] = the
  * cost every face around v has (per face), or that v and every neighbour

@@ -8,36 +8,19 @@
 #include "base/error.h"
 #include "exact/run.h"
 #include "exact/state.h"
+#include "mesh/check.h"
 #include "patch.h"
 
-/* Sources in internal ids, checked as mfmm_check_source checks input ids:
- * that check would read the area of the input face of the same number, and
+/* Sources in internal ids (mfmm_check_source_internal): the input ids'
+ * check would read the area of the input face of the same number, and
  * refuse the pieces of faces cut at T-junctions. */
 static mfmm_status patch_check_sources(const mfmm_exact_ws *ws, const mfmm_source *sources,
                                        int32_t n_sources)
 {
-    const mfmm_mesh *mesh = ws->mesh;
     for (int32_t i = 0; i < n_sources; i++) {
-        const mfmm_source *s = sources + i;
-        if (!isfinite(s->value))
-            return MFMM_ERR_BAD_ARGUMENT;
-        if (s->face < 0) {
-            if (s->face != -1 || s->vertex < 0 || s->vertex >= mesh->nv)
-                return MFMM_ERR_BAD_SOURCE;
-            continue;
-        }
-        if (s->face >= mesh->nf)
-            return MFMM_ERR_BAD_SOURCE;
-        double sum = 0.0;
-        for (int k = 0; k < 3; k++) {
-            if (!isfinite(s->bary[k]) || s->bary[k] < -1e-12)
-                return MFMM_ERR_BAD_BARYCENTRIC;
-            sum += s->bary[k];
-        }
-        if (fabs(sum - 1.0) > 1e-9)
-            return MFMM_ERR_BAD_BARYCENTRIC;
-        if (mfmm_mesh_degenerate(mesh, s->face))
-            return MFMM_ERR_DEGENERATE_SOURCE;
+        mfmm_status st = mfmm_check_source_internal(ws->mesh, sources + i, i, NULL);
+        if (st != MFMM_OK)
+            return st;
     }
     return MFMM_OK;
 }
