@@ -15,6 +15,11 @@ typedef struct mfmm_slots mfmm_slots;
 /* A workspace on the mesh's exact tables (mfmm_exact_tables_of). */
 mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out);
 void mfmm_slots_destroy(mfmm_slots *s);
+/* flat (nv,): 1 where a vertex's offers are redundant once a window's ray
+ * reaches it (its neighbourhood unfolds flat, or a wall's vertex of pi or
+ * less); the tables built everywhere (mfmm_exact_tables_ensure). */
+void mfmm_slots_flat(const mfmm_exact_tables *t, uint8_t *flat);
+
 /* About the bytes a workspace holds on `mesh` (K = 2), its tables apart. */
 size_t mfmm_slots_bytes(const mfmm_mesh *mesh);
 
