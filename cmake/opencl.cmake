@@ -1,19 +1,37 @@
 # The OpenCL backend. Included by the top-level CMakeLists.txt; also run as a
-# script (cmake -P) at build time to embed kernels/fmm_rows.cl with its
-# #include "march/march.h" line replaced by src/march/march.h (and that
-# file's #include "local_update.h" by src/march/local_update.h), so the
-# embedded program is self-contained.
+# script (cmake -P) at build time to embed the program: kernels/fmm_rows.cl
+# (the march) and kernels/windows_rows.cl (the window method), with every
+# #include "..." line replaced by that header from src/ (src/march/ or
+# src/exact/ for a header named without its folder), so the embedded
+# program is self-contained. Headers included twice keep their guards.
 
 if(CMAKE_SCRIPT_MODE_FILE)
-  # -DKERNEL=... -DSRC_DIR=<src/> -DOUT=...
-  file(READ "${SRC_DIR}/march/local_update.h" lu)
-  file(READ "${SRC_DIR}/march/march.h" march)
-  file(READ "${KERNEL}" text)
-  string(REPLACE "#include \"local_update.h\"" "${lu}" march "${march}")
-  string(REPLACE "#include \"march/march.h\"" "${march}" text "${text}")
-  if(text MATCHES "#include \"")
-    message(FATAL_ERROR "${KERNEL}: an #include was left unexpanded")
-  endif()
+  # -DKERNEL_DIR=<kernels/> -DSRC_DIR=<src/> -DOUT=...
+  set(KERNELS "${KERNEL_DIR}/fmm_rows.cl" "${KERNEL_DIR}/windows_rows.cl")
+  set(text "")
+  foreach(k IN LISTS KERNELS)
+    file(READ "${k}" part)
+    string(APPEND text "${part}\n")
+  endforeach()
+  set(guard 0)
+  while(text MATCHES "#include \"([^\"]+)\"")
+    set(inc "${CMAKE_MATCH_1}")
+    set(found "")
+    foreach(dir "${SRC_DIR}" "${SRC_DIR}/march" "${SRC_DIR}/exact")
+      if(NOT found AND EXISTS "${dir}/${inc}")
+        set(found "${dir}/${inc}")
+      endif()
+    endforeach()
+    if(NOT found)
+      message(FATAL_ERROR "${KERNELS}: #include \"${inc}\" not found under ${SRC_DIR}")
+    endif()
+    file(READ "${found}" body)
+    string(REPLACE "#include \"${inc}\"" "${body}" text "${text}")
+    math(EXPR guard "${guard} + 1")
+    if(guard GREATER 50)
+      message(FATAL_ERROR "${KERNELS}: #include lines nested too deep")
+    endif()
+  endwhile()
   file(WRITE "${OUT}.txt" "${text}")
   file(READ "${OUT}.txt" hex HEX)
   string(LENGTH "${hex}" nhex)
@@ -21,7 +39,7 @@ if(CMAKE_SCRIPT_MODE_FILE)
   string(REGEX REPLACE "([0-9a-f][0-9a-f])" "0x\\1," hex "${hex}")
   string(REGEX REPLACE "(0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,0x..,)" "\\1\n" hex "${hex}")
   file(WRITE "${OUT}.tmp"
-    "/* Generated from kernels/fmm_rows.cl by cmake/opencl.cmake. Do not edit. */\n"
+    "/* Generated from kernels/fmm_rows.cl and kernels/windows_rows.cl by cmake/opencl.cmake. Do not edit. */\n"
     "#include <stddef.h>\n"
     "const char mfmm_kernel_fmm_rows[] = {\n${hex}0x00};\n"
     "const size_t mfmm_kernel_fmm_rows_len = ${nbytes};\n")
@@ -59,14 +77,18 @@ message(STATUS "meshfmm: OpenCL backend on (headers in ${MESHFMM_OPENCL_INCLUDE_
 
 set(MESHFMM_KERNEL_C ${CMAKE_CURRENT_BINARY_DIR}/generated/fmm_rows_cl.c)
 add_custom_command(OUTPUT ${MESHFMM_KERNEL_C}
-  COMMAND ${CMAKE_COMMAND} -DKERNEL=${CMAKE_CURRENT_SOURCE_DIR}/kernels/fmm_rows.cl
+  COMMAND ${CMAKE_COMMAND}
+          -DKERNEL_DIR=${CMAKE_CURRENT_SOURCE_DIR}/kernels
           -DSRC_DIR=${CMAKE_CURRENT_SOURCE_DIR}/src -DOUT=${MESHFMM_KERNEL_C}
           -P ${CMAKE_CURRENT_SOURCE_DIR}/cmake/opencl.cmake
   DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/kernels/fmm_rows.cl
+          ${CMAKE_CURRENT_SOURCE_DIR}/kernels/windows_rows.cl
           ${CMAKE_CURRENT_SOURCE_DIR}/src/march/local_update.h
           ${CMAKE_CURRENT_SOURCE_DIR}/src/march/march.h
+          ${CMAKE_CURRENT_SOURCE_DIR}/src/exact/face_frame.h
+          ${CMAKE_CURRENT_SOURCE_DIR}/src/exact/slots_core.h
           ${CMAKE_CURRENT_SOURCE_DIR}/cmake/opencl.cmake
-  COMMENT "Embedding kernels/fmm_rows.cl"
+  COMMENT "Embedding kernels/fmm_rows.cl and kernels/windows_rows.cl"
   VERBATIM)
 target_sources(meshfmm_objects PRIVATE ${MESHFMM_KERNEL_C})
 target_compile_definitions(meshfmm_objects PRIVATE MESHFMM_HAVE_OPENCL CL_TARGET_OPENCL_VERSION=120)

@@ -658,7 +658,7 @@ typedef struct mfmm_matrix_options {
                                         opencl is NULL; NULL: defaults */
     mfmm_method method;              /* as in mfmm_solve_options (default
                                         MFMM_METHOD_FMM); MFMM_METHOD_WINDOWS runs on
-                                        the serial and threads backends only */
+                                        every backend (auto: threads) */
 } mfmm_matrix_options;
 
 /* Fills `options` with the defaults (auto backend, float32, no cost, no limit,
@@ -698,7 +698,7 @@ typedef struct mfmm_matrix_info {
  * MFMM_ERR_BAD_SOURCE (err->index: the row); MFMM_ERR_BAD_COST;
  * MFMM_ERR_BAD_ARGUMENT (no output, sparse with dense or on OPENCL, a
  * target out of range, dtype, backend, max_distance, exact_start_radius,
- * method as for mfmm_solve or MFMM_METHOD_WINDOWS on OPENCL, n_threads < 0,
+ * method as for mfmm_solve, n_threads < 0,
  * float32 range, struct_size);
  * MFMM_ERR_CANCELLED; MFMM_ERR_NO_OPENCL, MFMM_ERR_OPENCL_BUILD,
  * MFMM_ERR_OPENCL_RUNTIME (backend OPENCL); MFMM_ERR_OUT_OF_MEMORY.

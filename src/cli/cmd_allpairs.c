@@ -444,9 +444,6 @@ int cmd_allpairs(int argc, char **argv)
         return cli_usage_error("allpairs", "--cost-per-face needs --cost");
     if (cli_check_method("allpairs", o.method, method_given, 0, cost_path != NULL) != CLI_OK)
         return CLI_USAGE;
-    if (o.method == MFMM_METHOD_WINDOWS && backend == MFMM_BACKEND_OPENCL)
-        return cli_usage_error("allpairs", "--method windows runs on the serial and threads "
-                               "backends, not opencl (--backend auto runs threads)");
     if (threads_given && (backend == MFMM_BACKEND_SERIAL || backend == MFMM_BACKEND_OPENCL))
         return cli_usage_error("allpairs", "--threads is for the threads backend (and auto's "
                                "fallback to it); --backend %s does not use it",

@@ -42,6 +42,13 @@ void mfmm_slots_flat(const mfmm_exact_tables *t, uint8_t *flat)
     }
 }
 
+void mfmm_slots_flat_of(const mfmm_mesh *mesh, uint8_t *flat)
+{
+    const mfmm_exact_tables *t = NULL;
+    if (mfmm_exact_tables_of(mesh, &t) == MFMM_OK)
+        mfmm_slots_flat(t, flat);
+}
+
 mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
 {
     const mfmm_exact_tables *t = NULL;
@@ -102,6 +109,29 @@ size_t mfmm_slots_bytes(const mfmm_mesh *mesh)
      * flags and heap per vertex */
     return nh * (2 * sizeof(sl_win) + 3 + sizeof(double) + 2 * sizeof(int32_t)) +
            nv * (sizeof(double) + 5 + sizeof(double) + 2 * sizeof(int32_t));
+}
+
+size_t mfmm_slots_block_bytes(const mfmm_mesh *mesh)
+{
+    return sl_block_bytes(mesh->nv, mesh->nf, 2);
+}
+
+mfmm_status mfmm_slots_tables_of(const mfmm_mesh *mesh, mfmm_slots_tables *out)
+{
+    const mfmm_exact_tables *t = NULL;
+    mfmm_status st = mfmm_exact_tables_of(mesh, &t);
+    if (st != MFMM_OK)
+        return st;
+    mfmm_exact_tables_ensure(t, NULL, 0, INFINITY);
+    out->fr = t->fr;
+    out->fr_size = sizeof(ex_face);
+    out->vf_offset = t->vf_offset;
+    out->vf_corner = t->vf_corner;
+    out->face_in = t->face_in;
+    out->nm_he = t->nm_he;
+    out->nm_next = t->nm_next;
+    out->n_nm = t->n_nm;
+    return MFMM_OK;
 }
 
 void mfmm_slots_destroy(mfmm_slots *s)

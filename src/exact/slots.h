@@ -19,6 +19,24 @@ void mfmm_slots_destroy(mfmm_slots *s);
  * reaches it (its neighbourhood unfolds flat, or a wall's vertex of pi or
  * less); the tables built everywhere (mfmm_exact_tables_ensure). */
 void mfmm_slots_flat(const mfmm_exact_tables *t, uint8_t *flat);
+/* The same on the mesh's tables, once mfmm_slots_tables_of has succeeded. */
+void mfmm_slots_flat_of(const mfmm_mesh *mesh, uint8_t *flat);
+
+/* The arrays the window method's OpenCL kernel reads (kernels/windows_rows.cl):
+ * the mesh's exact tables, built everywhere. fr: nf face records of
+ * fr_size bytes each (face_frame.h's ex_face); vf_offset (nv + 1),
+ * vf_corner (3 nf), face_in (nf); nm_he and nm_next (n_nm). */
+typedef struct mfmm_slots_tables {
+    const void *fr;
+    size_t fr_size;
+    const int32_t *vf_offset, *vf_corner, *face_in, *nm_he, *nm_next;
+    int32_t n_nm;
+} mfmm_slots_tables;
+mfmm_status mfmm_slots_tables_of(const mfmm_mesh *mesh, mfmm_slots_tables *out);
+
+/* The bytes of one solve's arrays in one block, as the kernel lays them
+ * out (K = 2). */
+size_t mfmm_slots_block_bytes(const mfmm_mesh *mesh);
 
 /* About the bytes a workspace holds on `mesh` (K = 2), its tables apart. */
 size_t mfmm_slots_bytes(const mfmm_mesh *mesh);

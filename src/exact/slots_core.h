@@ -560,4 +560,66 @@ MFMM_INLINE double sl_value(const sl_state *s, mfmm_i32 v, double level)
     return s->h.label[v] == 2 && s->d[v] <= level ? s->d[v] : MFMM_INF;
 }
 
+/* ---- one block per solve (the OpenCL kernel's per-item workspace) ---- */
+
+/* n bytes rounded up to a multiple of 8, so that every array is aligned */
+#define SL_ALIGN8(n) (((n) + 7) / 8 * 8)
+
+/* The bytes of one solve's arrays (sl_attach) on nv vertices and nf faces,
+ * K windows per half-edge. */
+MFMM_INLINE size_t sl_block_bytes(mfmm_i32 nv, mfmm_i32 nf, int K)
+{
+    size_t v = (size_t)nv, h = 3 * (size_t)nf;
+    return (size_t)K * h * sizeof(sl_win) + 8 * h + 16 * v + 2 * SL_ALIGN8(4 * h) +
+           2 * SL_ALIGN8(4 * v) + 3 * SL_ALIGN8(h) + 4 * SL_ALIGN8(v);
+}
+
+/* Points s's per-solve arrays (s->nv, s->nf and s->K set) into the block at
+ * base (sl_block_bytes of them, 8-aligned). */
+MFMM_INLINE void sl_attach(sl_state *s, MFMM_GLOBAL char *base)
+{
+    size_t v = (size_t)s->nv, h = 3 * (size_t)s->nf;
+    s->slot = (MFMM_GLOBAL sl_win *)base;
+    base += (size_t)s->K * h * sizeof(sl_win);
+    s->e.heap_key = (MFMM_GLOBAL double *)base;
+    base += 8 * h;
+    s->h.heap_key = (MFMM_GLOBAL double *)base;
+    s->d = (MFMM_GLOBAL double *)(base + 8 * v);
+    base += 16 * v;
+    s->e.heap_vertex = (MFMM_GLOBAL mfmm_i32 *)base;
+    base += SL_ALIGN8(4 * h);
+    s->e.heap_pos = (MFMM_GLOBAL mfmm_i32 *)base;
+    base += SL_ALIGN8(4 * h);
+    s->h.heap_vertex = (MFMM_GLOBAL mfmm_i32 *)base;
+    base += SL_ALIGN8(4 * v);
+    s->h.heap_pos = (MFMM_GLOBAL mfmm_i32 *)base;
+    base += SL_ALIGN8(4 * v);
+    s->n_slot = (MFMM_GLOBAL mfmm_u8 *)base;
+    base += SL_ALIGN8(h);
+    s->fresh = (MFMM_GLOBAL mfmm_u8 *)base;
+    base += SL_ALIGN8(h);
+    s->e.label = (MFMM_GLOBAL mfmm_u8 *)base;
+    base += SL_ALIGN8(h);
+    s->ray = (MFMM_GLOBAL mfmm_u8 *)base;
+    base += SL_ALIGN8(v);
+    s->is_src = (MFMM_GLOBAL mfmm_u8 *)base;
+    base += SL_ALIGN8(v);
+    s->is_tgt = (MFMM_GLOBAL mfmm_u8 *)base;
+    base += SL_ALIGN8(v);
+    s->h.label = (MFMM_GLOBAL mfmm_u8 *)base;
+}
+
+/* A solve from the vertex source `source` (value 0), stopped at `level`
+ * (+inf: none) or once the n_targets targets settle: what mfmm_slots_run
+ * does for one vertex source, so that the kernel's rows are its rows. */
+MFMM_INLINE void sl_solve_vertex(sl_state *s, mfmm_i32 source, double level,
+                                 MFMM_GLOBAL const mfmm_i32 *targets, mfmm_i32 n_targets)
+{
+    sl_reset(s);
+    mfmm_i32 n_tgt = sl_targets(s, targets, n_targets);
+    sl_update(s, source, 0.0, 0);
+    s->is_src[source] = 1;
+    sl_loop(s, level, n_tgt);
+}
+
 #endif

@@ -85,10 +85,6 @@ static mfmm_status matrix_run(const mfmm_mesh *mesh, const int32_t *sources, int
         return MFMM_ERR_BAD_ARGUMENT;
     if (mfmm_check_method((int)o->method, o->cost != NULL, err) != MFMM_OK)
         return MFMM_ERR_BAD_ARGUMENT;
-    if (o->method == MFMM_METHOD_WINDOWS && o->backend == MFMM_BACKEND_OPENCL)
-        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
-                         "MFMM_METHOD_WINDOWS runs on the serial and threads backends, not "
-                         "OpenCL; use threads (or auto)");
     if (o->n_threads < 0)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1, "n_threads is %d, must be >= 0",
                          (int)o->n_threads);
@@ -221,7 +217,8 @@ static mfmm_status matrix_run(const mfmm_mesh *mesh, const int32_t *sources, int
             info->backend_used = MFMM_BACKEND_THREADS;
             snprintf(info->backend_reason, sizeof info->backend_reason, "%s",
                      job.sparse ? "the OpenCL backend computes dense rows only, not sparse rows"
-                                : "the OpenCL backend has no window method");
+                                : "auto runs the window method on threads (backend opencl "
+                                  "runs it on an OpenCL device)");
             st = mfmm_rows_threads(&job, 0, err);
             break;
         }

@@ -5,8 +5,10 @@
  * single-source value (windows of one source can lose their slots to
  * another's); paths traced on its values; stops
  * (max_distance, targets) write a full solve's values bit for bit; matrix
- * rows on the serial and threads backends equal mfmm_solve's bit for bit;
- * a cost, an unknown method and OpenCL are refused with a message. */
+ * rows on the serial, threads and OpenCL backends equal mfmm_solve's bit
+ * for bit (OpenCL: dense float64 and float32 rows, targets, max_distance,
+ * on a sphere and on a three-page book whose spine is non-manifold); a cost
+ * and an unknown method are refused with a message. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -334,6 +336,111 @@ static void test_matrix_rows(void **state)
     mfmm_gen_free(&g);
 }
 
+/* A book of `pages` square pages of n x n quads around the spine x = y = 0,
+ * z in [0, 1]: every spine edge lies on `pages` faces (non-manifold for 3+). */
+static mfmm_gen_mesh book(int n, int pages)
+{
+    mfmm_gen_mesh g;
+    memset(&g, 0, sizeof g);
+    g.nv = (n + 1) + pages * n * (n + 1);
+    g.nf = pages * 2 * n * n;
+    g.V = malloc((size_t)g.nv * 3 * sizeof *g.V);
+    g.F = malloc((size_t)g.nf * 3 * sizeof *g.F);
+    assert_non_null(g.V);
+    assert_non_null(g.F);
+    for (int j = 0; j <= n; j++) { /* the spine */
+        g.V[3 * j] = 0.0;
+        g.V[3 * j + 1] = 0.0;
+        g.V[3 * j + 2] = (double)j / n;
+    }
+    int32_t f = 0;
+    for (int p = 0; p < pages; p++) {
+        double a = 2.0 * 3.14159265358979323846 * (p + 0.3 * p * p) / (pages + 1.0);
+        int32_t base = (n + 1) + p * n * (n + 1);
+        for (int i = 1; i <= n; i++)
+            for (int j = 0; j <= n; j++) {
+                double *x = g.V + 3 * (size_t)(base + (i - 1) * (n + 1) + j);
+                x[0] = cos(a) * i / n;
+                x[1] = sin(a) * i / n;
+                x[2] = (double)j / n;
+            }
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++) {
+                /* column i (the spine at i = 0) to column i + 1 */
+                int32_t a0 = i == 0 ? j : base + (i - 1) * (n + 1) + j, a1 = a0 + 1;
+                int32_t b0 = base + i * (n + 1) + j, b1 = b0 + 1;
+                int32_t q[6] = {a0, b0, b1, a0, b1, a1};
+                memcpy(g.F + 3 * (size_t)f, q, sizeof q);
+                f += 2;
+            }
+    }
+    return g;
+}
+
+/* Matrix rows on the OpenCL backend equal the serial backend's bit for bit:
+ * dense float64 and float32, target columns, max_distance. */
+static void test_opencl_rows(void **state)
+{
+    (void)state;
+    mfmm_gen_mesh meshes[2] = {mfmm_gen_icosphere(3), book(12, 3)};
+    for (int k = 0; k < 2; k++) {
+        mfmm_gen_mesh *g = meshes + k;
+        mfmm_mesh *mesh = tm_make(g);
+        enum { NS = 6 };
+        int32_t src[NS] = {0, 5, g->nv / 3, g->nv / 2, g->nv - 7, g->nv - 1};
+        int32_t tgt[4] = {1, g->nv / 4, g->nv / 2, g->nv - 2};
+        size_t n = (size_t)NS * (size_t)g->nv;
+        double *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
+        assert_non_null(a);
+        assert_non_null(b);
+        for (int variant = 0; variant < 4; variant++) {
+            mfmm_matrix_options o;
+            mfmm_matrix_options_init(&o);
+            o.method = MFMM_METHOD_WINDOWS;
+            o.dtype = variant == 1 ? MFMM_FLOAT32 : MFMM_FLOAT64;
+            if (variant == 2) {
+                o.targets = tgt;
+                o.n_targets = 4;
+            }
+            if (variant == 3)
+                o.max_distance = 0.6;
+            size_t bytes = (variant == 2 ? (size_t)NS * 4 : n) *
+                           (variant == 1 ? sizeof(float) : sizeof(double));
+            mfmm_error err;
+            o.backend = MFMM_BACKEND_SERIAL;
+            o.out = a;
+            assert_int_equal(mfmm_distance_matrix(mesh, src, NS, &o, NULL, &err), MFMM_OK);
+            o.backend = MFMM_BACKEND_OPENCL;
+            o.out = b;
+            mfmm_status st = mfmm_distance_matrix(mesh, src, NS, &o, NULL, &err);
+            if (st == MFMM_ERR_NO_OPENCL) {
+                free(a);
+                free(b);
+                mfmm_mesh_destroy(mesh);
+                mfmm_gen_free(&meshes[0]);
+                mfmm_gen_free(&meshes[1]);
+                skip();
+            }
+            assert_int_equal(st, MFMM_OK);
+            assert_memory_equal(a, b, bytes);
+        }
+        if (k == 1) { /* the book's rows reach every page */
+            mfmm_matrix_options o;
+            mfmm_matrix_options_init(&o);
+            o.method = MFMM_METHOD_WINDOWS;
+            o.dtype = MFMM_FLOAT64;
+            o.out = a;
+            assert_int_equal(mfmm_distance_matrix(mesh, src, NS, &o, NULL, NULL), MFMM_OK);
+            for (size_t i = 0; i < n; i++)
+                assert_true(isfinite(a[i]));
+        }
+        free(a);
+        free(b);
+        mfmm_mesh_destroy(mesh);
+        mfmm_gen_free(g);
+    }
+}
+
 static void test_refused(void **state)
 {
     (void)state;
@@ -357,15 +464,6 @@ static void test_refused(void **state)
     o.method = (mfmm_method)7;
     assert_int_equal(mfmm_solve(s, &src, 1, &o, d, &err), MFMM_ERR_BAD_ARGUMENT);
     assert_non_null(strstr(err.message, "method"));
-    mfmm_matrix_options mo;
-    mfmm_matrix_options_init(&mo);
-    mo.method = MFMM_METHOD_WINDOWS;
-    mo.backend = MFMM_BACKEND_OPENCL;
-    mo.dtype = MFMM_FLOAT64;
-    mo.out = d;
-    assert_int_equal(mfmm_distance_matrix(mesh, (const int32_t[]){0}, 1, &mo, NULL, &err),
-                     MFMM_ERR_BAD_ARGUMENT);
-    assert_non_null(strstr(err.message, "OpenCL"));
     free(d);
     free(cost);
     mfmm_solver_destroy(s);
@@ -379,7 +477,7 @@ int main(void)
         cmocka_unit_test(test_flat_euclidean), cmocka_unit_test(test_lower_bound),
         cmocka_unit_test(test_missing_triangle), cmocka_unit_test(test_stops),
         cmocka_unit_test(test_paths),
-        cmocka_unit_test(test_matrix_rows),
+        cmocka_unit_test(test_matrix_rows), cmocka_unit_test(test_opencl_rows),
         cmocka_unit_test(test_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

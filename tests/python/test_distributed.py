@@ -511,9 +511,6 @@ def test_method_is_passed_through_and_part_of_the_job(hand, client, tmp_path):
     with pytest.raises(ValueError, match="takes no cost"):
         md.distance_matrix(hand, bad, sources=src, client=client, progress=False,
                            method="windows", cost=np.ones(hand.n_vertices))
-    with pytest.raises(ValueError, match="not opencl"):
-        md.distance_matrix(hand, bad, sources=src, client=client, progress=False,
-                           method="windows", backend="opencl")
     with pytest.raises(ValueError, match="not a method of"):
         md.distance_matrix(hand, bad, sources=src, client=client, progress=False,
                            method="exact")

@@ -166,7 +166,8 @@ def test_matrix_rows_equal_windows_solves(spot, backend):
     assert np.array_equal(D, want)
     assert info.backend == ("serial" if backend == "serial" else "threads")
     if backend == "auto":  # auto says why it ran threads
-        assert info.reason == "the OpenCL backend has no window method"
+        assert info.reason == ("auto runs the window method on threads (backend opencl runs it "
+                               "on an OpenCL device)")
     # float32: the float64 rows rounded
     assert np.array_equal(spot.distance_matrix(SOURCES, backend=backend, method="windows"),
                           want.astype(np.float32))
@@ -241,11 +242,23 @@ def test_matrix_refusals(spot):
         spot.distance_matrix([0, 1], method="windows", cost=cost)
     with pytest.raises(ValueError, match="takes no cost"):
         next(spot.iter_distance_rows([0, 1], method="windows", cost=cost))
-    # the library refuses OpenCL before it looks for a device (a ValueError,
-    # as make_error gives for MFMM_ERR_BAD_ARGUMENT)
-    with pytest.raises(ValueError, match="serial and threads backends") as e:
-        spot.distance_matrix([0, 1], backend="opencl", method="windows")
-    assert e.value.status == "MFMM_ERR_BAD_ARGUMENT"
+
+
+@pytest.mark.parametrize("dtype", ["float64", "float32"])
+def test_opencl_rows_equal_serial_rows(spot, dtype):
+    """The OpenCL kernel runs the C core's own propagation (slots_core.h):
+    dense rows, target columns and max_distance rows, bit for bit."""
+    tg = [3, 100, spot.n_vertices - 1]
+    kws = [dict(), dict(targets=tg), dict(max_distance=0.3)]
+    for kw in kws:
+        want = spot.distance_matrix(SOURCES, backend="serial", dtype=dtype, method="windows",
+                                    **kw)
+        try:
+            got = spot.distance_matrix(SOURCES, backend="opencl", dtype=dtype,
+                                       method="windows", **kw)
+        except meshfmm.OpenCLError:
+            pytest.skip("no OpenCL device")
+        assert np.array_equal(got, want), kw
 
 
 def test_farthest_point_sampling_equals_a_loop_of_windows_solves(spot):

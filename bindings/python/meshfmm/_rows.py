@@ -100,9 +100,7 @@ def options(mesh: "Mesh", req: Request, out: np.ndarray, *, sparse: bool, cost: 
         opts.n_targets = req.tgt.shape[0]
     auto = _lib.BACKENDS["auto"]
     if req.backend == auto and (sparse or opts.method == _lib.MFMM_METHOD_WINDOWS):
-        pass  # the library runs threads (OpenCL does dense rows of the march only)
-    elif opts.method == _lib.MFMM_METHOD_WINDOWS:
-        pass  # backend "opencl": the library refuses the windows method before any device
+        pass  # the library runs threads (sparse rows; auto runs windows on threads)
     elif req.backend in (auto, _lib.BACKENDS["opencl"]):
         opts.opencl = shared_opencl_context()
     return opts, [c, req.src, req.tgt, out]

@@ -414,9 +414,6 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
                          f"not {compression!r}")
     if backend not in ("auto", "threads", "serial", "opencl"):
         raise ValueError(f"backend must be auto, threads, serial or opencl, not {backend!r}")
-    if method == "windows" and backend == "opencl":
-        raise ValueError("method='windows' runs on the serial and threads backends, not "
-                         "opencl (backend='auto' runs threads)")
     if not _args.is_int(retries) or retries < 0:
         raise ValueError(f"retries must be an integer >= 0, not {retries!r}")
     if block_rows is not None and (not _args.is_int(block_rows) or block_rows < 1):

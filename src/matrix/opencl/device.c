@@ -191,14 +191,16 @@ void mfmm_cl_release(ocl *cl)
 }
 
 /* A call's own queue and kernel on an open context. */
-mfmm_status mfmm_cl_open_call(ocl *cl, int f64, mfmm_error *err)
+mfmm_status mfmm_cl_open_call(ocl *cl, int f64, int windows, mfmm_error *err)
 {
     cl_int e;
     cl->queue = cl->api->clCreateCommandQueue(cl->context, cl->device, 0, &e);
     if (e != CL_SUCCESS)
         return mfmm_fail(err, MFMM_ERR_OPENCL_RUNTIME, -1, "clCreateCommandQueue on '%s': %s",
                          cl->name, mfmm_cl_error_name(e));
-    cl->kernel = cl->api->clCreateKernel(cl->program, f64 ? "fmm_rows_f64" : "fmm_rows_f32", &e);
+    const char *name = windows ? (f64 ? "windows_rows_f64" : "windows_rows_f32")
+                               : (f64 ? "fmm_rows_f64" : "fmm_rows_f32");
+    cl->kernel = cl->api->clCreateKernel(cl->program, name, &e);
     if (e != CL_SUCCESS)
         return mfmm_fail(err, MFMM_ERR_OPENCL_BUILD, -1, "clCreateKernel: %s", mfmm_cl_error_name(e));
     return MFMM_OK;

@@ -35,8 +35,10 @@ mfmm_status mfmm_cl_select_device(ocl *cl, const char *want, mfmm_error *err);
  * failure). */
 void mfmm_cl_device_string(const ocl *cl, cl_device_info what, char *buf, size_t n);
 
-/* A call's own queue and kernel (float64 or float32) on an open context. */
-mfmm_status mfmm_cl_open_call(ocl *cl, int f64, mfmm_error *err);
+/* A call's own queue and kernel on an open context: the march's rows
+ * (fmm_rows_*) or, with windows set, the window method's (windows_rows_*),
+ * float64 or float32. */
+mfmm_status mfmm_cl_open_call(ocl *cl, int f64, int windows, mfmm_error *err);
 
 /* Releases what one call made (its queue and kernel). */
 void mfmm_cl_release_call(ocl *cl);

@@ -1,7 +1,9 @@
 /* A matrix job's rows on an OpenCL device: the mesh uploaded once, then
  * batches of rows, one work-item per source, each batch's seeds computed
  * on the host as the serial solver computes them (start/seed.h), its rows
- * read back and delivered while the next batch runs (rows.h). */
+ * read back and delivered while the next batch runs (rows.h). The window
+ * method's rows upload the mesh's exact tables instead, and each item's
+ * arrays lie in one slice of a workspace buffer (kernels/windows_rows.cl). */
 #ifdef MESHFMM_HAVE_OPENCL
 
 #include <stdlib.h>
@@ -9,22 +11,34 @@
 
 #include "base/error.h"
 #include "exact/exact.h"
+#include "exact/slots.h"
 #include "matrix/rows.h"
 #include "mesh/check.h"
 #include "mesh/spokes.h"
 #include "rows.h"
 #include "start/seed.h"
 
-enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_ORDER, MB_VIRTS, MB_STRIPOFF, MB_VFIRST, MB_SPOKEOFF, MB_SPOKES, MB_LABEL, MB_KEY, MB_VERT,
-       MB_POS, MB_T, MB_OUT, MB_COUNT };
+/* the mesh's arrays (read-only), then a batch's workspaces (from MB_LABEL);
+ * MB_FR to MB_FLAT and MB_WS: the window method's */
+enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_ORDER, MB_VIRTS, MB_STRIPOFF, MB_VFIRST, MB_SPOKEOFF, MB_SPOKES,
+       MB_FR, MB_VFOFF, MB_VFCORNER, MB_FACEIN, MB_NMHE, MB_NMNEXT, MB_FLAT, MB_LABEL, MB_KEY, MB_VERT,
+       MB_POS, MB_T, MB_WS, MB_OUT, MB_COUNT };
+
+static int windows_job(const mfmm_rows_job *job)
+{
+    return job->opt->method == MFMM_METHOD_WINDOWS;
+}
 
 /* Bytes per work-item on the device (workspace and output row), and on the
  * host (two blocks when rows are not read straight into the caller's buffer). */
 static size_t item_bytes(const mfmm_rows_job *job, int direct)
 {
     size_t nv = (size_t)job->mesh->nv, w = (size_t)job->width;
-    /* label, heap key, vertex and position, T apart from the output row */
-    size_t b = nv * (1 + 8 + 4 + 4 + 8) + w * job->elem_size;
+    /* label, heap key, vertex and position, T apart from the output row;
+     * the window method's block of arrays (slots_core.h) */
+    size_t b = windows_job(job) ? mfmm_slots_block_bytes(job->mesh)
+                                : nv * (1 + 8 + 4 + 4 + 8);
+    b += w * job->elem_size;
     if (!direct)
         b += 2 * w * job->elem_size;
     return b;
@@ -45,7 +59,9 @@ static int32_t batch_rows(const ocl *cl, const mfmm_rows_job *job, int direct, i
     if (budget > cl->global_mem / 2)
         budget = (size_t)(cl->global_mem / 2);
     size_t b = budget / item_bytes(job, direct);
-    size_t by_alloc = (size_t)(cl->max_alloc / (nv * 8)); /* the largest buffer: 8 nv per item */
+    /* the largest buffer: 8 nv per item, or the window method's blocks */
+    size_t by_alloc = (size_t)(cl->max_alloc / (windows_job(job) ? mfmm_slots_block_bytes(job->mesh)
+                                                                  : nv * 8));
     if (b > by_alloc)
         b = by_alloc;
     if (b > 4096)
@@ -155,7 +171,7 @@ typedef struct run {
     ocl cl;
     const mfmm_cl_api *api;
     int32_t start, rows, batch;
-    int f64, direct, exact;
+    int f64, direct, exact, windows;
     size_t nv, row_bytes;
     cl_mem mem[MB_COUNT];
     char *host;          /* two batches of rows, when not read into opt->out */
@@ -167,7 +183,99 @@ typedef struct run {
     cl_uint seed_arg;    /* the kernel's first seed argument */
     mfmm_exact_ws *ews;
     seed_buf sb;
+    uint8_t *flat;       /* the window method's flat flags (mfmm_slots_flat) */
+    cl_ulong ws_stride;  /* the window method's bytes per item */
 } run;
+
+/* The window method's arrays: the mesh's exact tables, built everywhere,
+ * its flat flags, the job's sources, targets and vertex order. */
+static mfmm_status run_upload_windows(run *r, mfmm_error *err)
+{
+    const mfmm_rows_job *job = r->job;
+    const mfmm_mesh *mesh = job->mesh;
+    const mfmm_cl_api *api = r->api;
+    cl_mem *mem = r->mem;
+    size_t nv = r->nv, nf = (size_t)mesh->nf;
+    mfmm_slots_tables t;
+    if (mfmm_slots_tables_of(mesh, &t) != MFMM_OK)
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the exact tables");
+    r->flat = malloc(nv + 1);
+    if (!r->flat)
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for %d flags", (int)nv);
+    mfmm_slots_flat_of(mesh, r->flat);
+    cl_int e = CL_SUCCESS;
+    cl_mem_flags ro = CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR;
+    cl_context c = r->cl.context;
+    /* an empty array (no non-manifold edge) stands in as one int */
+    const void *nm_he = t.n_nm ? (const void *)t.nm_he : (const void *)&r->no_target;
+    const void *nm_next = t.n_nm ? (const void *)t.nm_next : (const void *)&r->no_target;
+    size_t n_nm = t.n_nm ? (size_t)t.n_nm : 1;
+    mem[MB_FR] = api->clCreateBuffer(c, ro, nf * t.fr_size, (void *)t.fr, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_VFOFF] = api->clCreateBuffer(c, ro, (nv + 1) * sizeof(int32_t),
+                                            (void *)t.vf_offset, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_VFCORNER] = api->clCreateBuffer(c, ro, 3 * nf * sizeof(int32_t),
+                                               (void *)t.vf_corner, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_FACEIN] = api->clCreateBuffer(c, ro, nf * sizeof(int32_t), (void *)t.face_in, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_NMHE] = api->clCreateBuffer(c, ro, n_nm * sizeof(int32_t), (void *)nm_he, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_NMNEXT] = api->clCreateBuffer(c, ro, n_nm * sizeof(int32_t), (void *)nm_next, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_FLAT] = api->clCreateBuffer(c, ro, nv, r->flat, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_SOURCES] = api->clCreateBuffer(c, ro, (size_t)job->n_sources * sizeof(int32_t),
+                                              (void *)job->sources, &e);
+    if (e == CL_SUCCESS)
+        mem[MB_TARGETS] = api->clCreateBuffer(c, ro,
+                                              (job->targets ? (size_t)job->width : 1) * sizeof(int32_t),
+                                              job->targets ? (void *)job->targets : (void *)&r->no_target,
+                                              &e);
+    if (e == CL_SUCCESS)
+        mem[MB_ORDER] = api->clCreateBuffer(c, ro, nv * sizeof(int32_t), mesh->to_internal, &e);
+    if (e != CL_SUCCESS)
+        return runtime_fail(err, "uploading the exact tables", e);
+    return MFMM_OK;
+}
+
+/* The window method's kernel arguments that stay the same for every batch
+ * (kernels/windows_rows.cl; first and count, 11 and 12, per batch). */
+static mfmm_status run_set_args_windows(run *r, mfmm_error *err)
+{
+    const mfmm_rows_job *job = r->job;
+    const mfmm_cl_api *api = r->api;
+    cl_kernel k = r->cl.kernel;
+    cl_mem *mem = r->mem;
+    mfmm_slots_tables t;
+    if (mfmm_slots_tables_of(job->mesh, &t) != MFMM_OK)
+        return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the exact tables");
+    cl_int nvi = (cl_int)r->nv, nfi = (cl_int)job->mesh->nf, n_nm = t.n_nm;
+    cl_double maxd = job->opt->max_distance;
+    cl_ulong stride = r->ws_stride;
+    cl_int e = api->clSetKernelArg(k, 0, sizeof nvi, &nvi);
+    e |= api->clSetKernelArg(k, 1, sizeof nfi, &nfi);
+    e |= api->clSetKernelArg(k, 2, sizeof(cl_mem), &mem[MB_FR]);
+    e |= api->clSetKernelArg(k, 3, sizeof(cl_mem), &mem[MB_VFOFF]);
+    e |= api->clSetKernelArg(k, 4, sizeof(cl_mem), &mem[MB_VFCORNER]);
+    e |= api->clSetKernelArg(k, 5, sizeof(cl_mem), &mem[MB_FACEIN]);
+    e |= api->clSetKernelArg(k, 6, sizeof(cl_mem), &mem[MB_NMHE]);
+    e |= api->clSetKernelArg(k, 7, sizeof(cl_mem), &mem[MB_NMNEXT]);
+    e |= api->clSetKernelArg(k, 8, sizeof n_nm, &n_nm);
+    e |= api->clSetKernelArg(k, 9, sizeof(cl_mem), &mem[MB_FLAT]);
+    e |= api->clSetKernelArg(k, 10, sizeof(cl_mem), &mem[MB_SOURCES]);
+    e |= api->clSetKernelArg(k, 13, sizeof maxd, &maxd);
+    e |= api->clSetKernelArg(k, 14, sizeof(cl_mem), &mem[MB_TARGETS]);
+    e |= api->clSetKernelArg(k, 15, sizeof r->n_targets, &r->n_targets);
+    e |= api->clSetKernelArg(k, 16, sizeof(cl_mem), &mem[MB_ORDER]);
+    e |= api->clSetKernelArg(k, 17, sizeof(cl_mem), &mem[MB_WS]);
+    e |= api->clSetKernelArg(k, 18, sizeof stride, &stride);
+    e |= api->clSetKernelArg(k, 19, sizeof(cl_mem), &mem[MB_OUT]);
+    if (e != CL_SUCCESS)
+        return runtime_fail(err, "clSetKernelArg", e);
+    return MFMM_OK;
+}
 
 /* Uploads the mesh (read-only, used in place where the driver allows), the
  * job's sources, cost, targets and the cost around each vertex. */
@@ -274,14 +382,18 @@ static mfmm_status run_workspaces(run *r, mfmm_error *err)
                              (int)r->batch, (unsigned)r->cl.compute_units, job->budget,
                              item_bytes(job, r->direct));
         size_t b = (size_t)r->batch;
-        mem[MB_LABEL] = api->clCreateBuffer(r->cl.context, CL_MEM_READ_WRITE, b * nv, NULL, &e);
-        if (e == CL_SUCCESS)
+        if (r->windows)
+            mem[MB_WS] = api->clCreateBuffer(r->cl.context, CL_MEM_READ_WRITE,
+                                             b * (size_t)r->ws_stride, NULL, &e);
+        else
+            mem[MB_LABEL] = api->clCreateBuffer(r->cl.context, CL_MEM_READ_WRITE, b * nv, NULL, &e);
+        if (e == CL_SUCCESS && !r->windows)
             mem[MB_KEY] = api->clCreateBuffer(r->cl.context, CL_MEM_READ_WRITE, b * nv * 8, NULL, &e);
-        if (e == CL_SUCCESS)
+        if (e == CL_SUCCESS && !r->windows)
             mem[MB_VERT] = api->clCreateBuffer(r->cl.context, CL_MEM_READ_WRITE, b * nv * 4, NULL, &e);
-        if (e == CL_SUCCESS)
+        if (e == CL_SUCCESS && !r->windows)
             mem[MB_POS] = api->clCreateBuffer(r->cl.context, CL_MEM_READ_WRITE, b * nv * 4, NULL, &e);
-        if (e == CL_SUCCESS)
+        if (e == CL_SUCCESS && !r->windows)
             mem[MB_T] = api->clCreateBuffer(r->cl.context, CL_MEM_READ_WRITE, b * nv * 8, NULL, &e);
         if (e == CL_SUCCESS)
             mem[MB_OUT] = api->clCreateBuffer(r->cl.context, CL_MEM_READ_WRITE, b * r->row_bytes, NULL, &e);
@@ -388,8 +500,9 @@ static mfmm_status run_enqueue(run *r, int32_t k, mfmm_error *err)
     cl_int first = r->start + k * r->batch;
     cl_int count = job->n_sources - first < r->batch ? job->n_sources - first : r->batch;
     int kernel_queued = 0;
-    e = api->clSetKernelArg(kernel, 9, sizeof first, &first);
-    e |= api->clSetKernelArg(kernel, 10, sizeof count, &count);
+    cl_uint arg_first = r->windows ? 11 : 9;
+    e = api->clSetKernelArg(kernel, arg_first, sizeof first, &first);
+    e |= api->clSetKernelArg(kernel, arg_first + 1, sizeof count, &count);
     if (e != CL_SUCCESS)
         return runtime_fail(err, "clSetKernelArg", e);
     if (r->exact) {
@@ -478,6 +591,7 @@ static void run_release(run *r)
             api->clReleaseMemObject(r->mem[i]);
     free(r->host);
     free(r->uniform);
+    free(r->flat);
     r->job->info->start_fallbacks += r->sb.fallbacks;
     free(r->sb.idx);
     free(r->sb.val);
@@ -501,22 +615,24 @@ mfmm_status mfmm_cl_run_rows(const ocl *shared, const mfmm_rows_job *job, int32_
     r.rows = rows;
     r.f64 = job->elem_size == sizeof(double);
     r.direct = job->opt->out != NULL;
-    r.exact = mfmm_exact_start_on(job->opt->exact_start_radius);
+    r.windows = windows_job(job);
+    r.exact = !r.windows && mfmm_exact_start_on(job->opt->exact_start_radius);
+    r.ws_stride = r.windows ? (cl_ulong)mfmm_slots_block_bytes(job->mesh) : 0;
     r.nv = (size_t)job->mesh->nv;
     r.row_bytes = (size_t)job->width * job->elem_size;
     r.one = 1.0;
     r.no_target = 0;
     r.n_targets = job->targets ? (cl_int)job->width : 0;
-    mfmm_status st = mfmm_cl_open_call(&r.cl, r.f64, err);
+    mfmm_status st = mfmm_cl_open_call(&r.cl, r.f64, r.windows, err);
     if (st != MFMM_OK) {
         mfmm_cl_release_call(&r.cl);
         return st;
     }
-    st = run_upload(&r, err);
+    st = r.windows ? run_upload_windows(&r, err) : run_upload(&r, err);
     if (st == MFMM_OK)
         st = run_workspaces(&r, err);
     if (st == MFMM_OK)
-        st = run_set_args(&r, err);
+        st = r.windows ? run_set_args_windows(&r, err) : run_set_args(&r, err);
     /* Batch k runs while the host delivers batch k-1: in an in-order queue,
      * kernel k+1 is enqueued after the read of batch k. */
     int32_t n_batches = st == MFMM_OK ? (rows + r.batch - 1) / r.batch : 0;

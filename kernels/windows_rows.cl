@@ -1,0 +1,96 @@
+/*
+ * The window method's rows (MFMM_METHOD_WINDOWS), many sources at once: one
+ * work-item runs one source's solve (src/exact/slots_core.h, the C core's
+ * own propagation) and writes that source's row. Each item's arrays lie in
+ * its own slice of one workspace buffer (sl_attach). With targets
+ * (n_targets > 0) a row stops once its targets settle, as the serial solve
+ * does, and writes only their columns.
+ *
+ * Built without -cl-mad-enable / -cl-fast-relaxed-math; local_update.h sets
+ * FP_CONTRACT OFF, so rows equal the C core's bit for bit in float64.
+ * The host embeds this file with the #include lines replaced by the headers.
+ */
+#include "exact/slots_core.h"
+
+/* The solve from sources[first + i] in item i's slice of ws. */
+inline void mfmm_windows_row(sl_state *s, int nv, int nf, __global const ex_face *fr,
+                             __global const int *vf_offset, __global const int *vf_corner,
+                             __global const int *face_in, __global const int *nm_he,
+                             __global const int *nm_next, int n_nm,
+                             __global const uchar *flat, int source, double max_distance,
+                             __global const int *targets, int n_targets,
+                             __global char *ws)
+{
+    s->nv = nv;
+    s->nf = nf;
+    s->fr = fr;
+    s->vf_offset = vf_offset;
+    s->vf_corner = vf_corner;
+    s->face_in = face_in;
+    s->nm_he = nm_he;
+    s->nm_next = nm_next;
+    s->n_nm = n_nm;
+    s->flat = flat;
+    s->K = 2;
+    sl_attach(s, ws);
+    sl_solve_vertex(s, source, max_distance, targets, n_targets);
+}
+
+/* float64 rows: the caller's vertex order (order: internal id of each input
+ * vertex), or the target columns. */
+__kernel void windows_rows_f64(int nv, int nf, __global const ex_face *fr,
+                               __global const int *vf_offset, __global const int *vf_corner,
+                               __global const int *face_in, __global const int *nm_he,
+                               __global const int *nm_next, int n_nm,
+                               __global const uchar *flat, __global const int *sources,
+                               int first, int count, double max_distance,
+                               __global const int *targets, int n_targets,
+                               __global const int *order, __global char *ws, ulong ws_stride,
+                               __global double *out)
+{
+    int i = (int)get_global_id(0);
+    if (i >= count)
+        return;
+    sl_state s;
+    mfmm_windows_row(&s, nv, nf, fr, vf_offset, vf_corner, face_in, nm_he, nm_next, n_nm, flat,
+                     sources[first + i], max_distance, targets, n_targets,
+                     ws + (ulong)i * ws_stride);
+    if (n_targets > 0) {
+        __global double *row = out + (ulong)i * (ulong)n_targets;
+        for (int j = 0; j < n_targets; j++)
+            row[j] = sl_value(&s, targets[j], max_distance);
+        return;
+    }
+    __global double *row = out + (ulong)i * (ulong)nv;
+    for (int v = 0; v < nv; v++)
+        row[v] = sl_value(&s, order[v], max_distance);
+}
+
+/* float32 rows: as float64, converted (round to nearest). */
+__kernel void windows_rows_f32(int nv, int nf, __global const ex_face *fr,
+                               __global const int *vf_offset, __global const int *vf_corner,
+                               __global const int *face_in, __global const int *nm_he,
+                               __global const int *nm_next, int n_nm,
+                               __global const uchar *flat, __global const int *sources,
+                               int first, int count, double max_distance,
+                               __global const int *targets, int n_targets,
+                               __global const int *order, __global char *ws, ulong ws_stride,
+                               __global float *out)
+{
+    int i = (int)get_global_id(0);
+    if (i >= count)
+        return;
+    sl_state s;
+    mfmm_windows_row(&s, nv, nf, fr, vf_offset, vf_corner, face_in, nm_he, nm_next, n_nm, flat,
+                     sources[first + i], max_distance, targets, n_targets,
+                     ws + (ulong)i * ws_stride);
+    if (n_targets > 0) {
+        __global float *row = out + (ulong)i * (ulong)n_targets;
+        for (int j = 0; j < n_targets; j++)
+            row[j] = (float)sl_value(&s, targets[j], max_distance);
+        return;
+    }
+    __global float *row = out + (ulong)i * (ulong)nv;
+    for (int v = 0; v < nv; v++)
+        row[v] = (float)sl_value(&s, order[v], max_distance);
+}
