@@ -1093,10 +1093,9 @@ class Mesh:
             As in :meth:`distance`. Every backend starts each row alike;
             OpenCL rows equal the serial rows bit for bit.
         method : {"fmm", "windows"}
-            As in :meth:`distance`: "fmm" (default) on every backend;
-            "windows" (no cost) on "serial" and "threads" ("auto" runs
-            threads and says why in :class:`MatrixInfo`; "opencl" refuses
-            it with a ValueError). Rows equal ``distance(source,
+            As in :meth:`distance`, on every backend; "windows" takes no
+            cost, and "auto" runs it on threads (saying why in
+            :class:`MatrixInfo`). Rows equal ``distance(source,
             method=method)`` bit for bit in float64, with targets,
             max_distance and sparse rows alike. "exact" is not a matrix
             method (a ValueError): solve each row with
