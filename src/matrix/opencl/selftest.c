@@ -13,7 +13,8 @@
 /* ---- the self-test of a program before it goes to or comes from the cache ----
  * All rows of a small mesh with obtuse corners (a sheared 7 x 6 grid, its
  * vertices jittered so that no two triangles are alike), in float64 and
- * float32, against mfmm_solve, bit for bit. A cached binary that fails to
+ * float32, for the march and the window method, against mfmm_solve, bit for
+ * bit. A cached binary that fails to
  * make a kernel, to run or to give exactly these rows is not used. (A 5 x 4
  * grid without jitter let a binary built with -cl-fast-relaxed-math
  * -cl-mad-enable pass once the update was written in closed form: its rows
@@ -48,17 +49,26 @@ mfmm_status mfmm_cl_self_test(ocl *cl, mfmm_error *err)
     mfmm_status st = mfmm_mesh_create(xyz, NV, faces, NF, NULL, &mesh, err);
     if (st == MFMM_OK)
         st = mfmm_solver_create(mesh, &solver);
-    for (int32_t s = 0; st == MFMM_OK && s < NV; s++) {
-        mfmm_source src;
-        memset(&src, 0, sizeof src);
-        src.vertex = s;
-        sources[s] = mesh->to_internal[s]; /* a job's sources are internal ids */
-        src.face = -1;
-        st = mfmm_solve(solver, &src, 1, NULL, ref + (size_t)s * NV, err);
-    }
-    for (int f64 = 1; st == MFMM_OK && f64 >= 0; f64--) {
+    for (int k = 0; st == MFMM_OK && k < 4; k++) {
+        /* k: the march then the window method, each in float64 then float32 */
+        int f64 = !(k & 1);
+        mfmm_method method = k < 2 ? MFMM_METHOD_FMM : MFMM_METHOD_WINDOWS;
+        mfmm_solve_options so;
+        mfmm_solve_options_init(&so);
+        so.method = method;
+        for (int32_t s = 0; st == MFMM_OK && f64 && s < NV; s++) {
+            mfmm_source src;
+            memset(&src, 0, sizeof src);
+            src.vertex = s;
+            sources[s] = mesh->to_internal[s]; /* a job's sources are internal ids */
+            src.face = -1;
+            st = mfmm_solve(solver, &src, 1, &so, ref + (size_t)s * NV, err);
+        }
+        if (st != MFMM_OK)
+            break;
         mfmm_matrix_options o;
         mfmm_matrix_options_init(&o);
+        o.method = method;
         mfmm_matrix_info info;
         memset(&info, 0, sizeof info);
         o.out = &got;
@@ -80,8 +90,8 @@ mfmm_status mfmm_cl_self_test(ocl *cl, mfmm_error *err)
             double want = f64 ? ref[i] : (double)(float)ref[i];
             if (memcmp(&r, &want, sizeof r) != 0)
                 st = mfmm_fail(err, MFMM_ERR_OPENCL_RUNTIME, i,
-                               "OpenCL self-test: row %d vertex %d is %.17g, not %.17g",
-                               i / NV, i % NV, r, want);
+                               "OpenCL self-test (%s): row %d vertex %d is %.17g, not %.17g",
+                               k < 2 ? "march" : "windows", i / NV, i % NV, r, want);
         }
     }
     mfmm_solver_destroy(solver);
