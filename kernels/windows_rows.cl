@@ -36,61 +36,31 @@ inline void mfmm_windows_row(sl_state *s, int nv, int nf, __global const ex_face
     sl_solve_vertex(s, source, max_distance, targets, n_targets);
 }
 
-/* float64 rows: the caller's vertex order (order: internal id of each input
- * vertex), or the target columns. */
-__kernel void windows_rows_f64(int nv, int nf, __global const ex_face *fr,
-                               __global const int *vf_offset, __global const int *vf_corner,
-                               __global const int *face_in, __global const int *nm_he,
-                               __global const int *nm_next, int n_nm,
-                               __global const uchar *flat, __global const int *sources,
-                               int first, int count, double max_distance,
-                               __global const int *targets, int n_targets,
-                               __global const int *order, __global char *ws, ulong ws_stride,
-                               __global double *out)
-{
-    int i = (int)get_global_id(0);
-    if (i >= count)
-        return;
-    sl_state s;
-    mfmm_windows_row(&s, nv, nf, fr, vf_offset, vf_corner, face_in, nm_he, nm_next, n_nm, flat,
-                     sources[first + i], max_distance, targets, n_targets,
-                     ws + (ulong)i * ws_stride);
-    if (n_targets > 0) {
-        __global double *row = out + (ulong)i * (ulong)n_targets;
-        for (int j = 0; j < n_targets; j++)
-            row[j] = sl_value(&s, targets[j], max_distance);
-        return;
+/* windows_rows_f64 and windows_rows_f32: a row per item in the caller's
+ * vertex order (order: internal id of each input vertex), or the target
+ * columns, as OUT_T (float32: rounded to nearest). */
+#define MFMM_WINDOWS_ROWS(NAME, OUT_T)                                                         \
+    __kernel void NAME(int nv, int nf, __global const ex_face *fr,                             \
+                       __global const int *vf_offset, __global const int *vf_corner,           \
+                       __global const int *face_in, __global const int *nm_he,                 \
+                       __global const int *nm_next, int n_nm, __global const uchar *flat,      \
+                       __global const int *sources, int first, int count,                      \
+                       double max_distance, __global const int *targets, int n_targets,        \
+                       __global const int *order, __global char *ws, ulong ws_stride,          \
+                       __global OUT_T *out)                                                    \
+    {                                                                                          \
+        int i = (int)get_global_id(0);                                                         \
+        if (i >= count)                                                                        \
+            return;                                                                            \
+        sl_state s;                                                                            \
+        mfmm_windows_row(&s, nv, nf, fr, vf_offset, vf_corner, face_in, nm_he, nm_next, n_nm,  \
+                         flat, sources[first + i], max_distance, targets, n_targets,           \
+                         ws + (ulong)i * ws_stride);                                           \
+        int width = n_targets > 0 ? n_targets : nv;                                            \
+        __global OUT_T *row = out + (ulong)i * (ulong)width;                                   \
+        for (int j = 0; j < width; j++)                                                        \
+            row[j] = (OUT_T)sl_value(&s, n_targets > 0 ? targets[j] : order[j], max_distance); \
     }
-    __global double *row = out + (ulong)i * (ulong)nv;
-    for (int v = 0; v < nv; v++)
-        row[v] = sl_value(&s, order[v], max_distance);
-}
 
-/* float32 rows: as float64, converted (round to nearest). */
-__kernel void windows_rows_f32(int nv, int nf, __global const ex_face *fr,
-                               __global const int *vf_offset, __global const int *vf_corner,
-                               __global const int *face_in, __global const int *nm_he,
-                               __global const int *nm_next, int n_nm,
-                               __global const uchar *flat, __global const int *sources,
-                               int first, int count, double max_distance,
-                               __global const int *targets, int n_targets,
-                               __global const int *order, __global char *ws, ulong ws_stride,
-                               __global float *out)
-{
-    int i = (int)get_global_id(0);
-    if (i >= count)
-        return;
-    sl_state s;
-    mfmm_windows_row(&s, nv, nf, fr, vf_offset, vf_corner, face_in, nm_he, nm_next, n_nm, flat,
-                     sources[first + i], max_distance, targets, n_targets,
-                     ws + (ulong)i * ws_stride);
-    if (n_targets > 0) {
-        __global float *row = out + (ulong)i * (ulong)n_targets;
-        for (int j = 0; j < n_targets; j++)
-            row[j] = (float)sl_value(&s, targets[j], max_distance);
-        return;
-    }
-    __global float *row = out + (ulong)i * (ulong)nv;
-    for (int v = 0; v < nv; v++)
-        row[v] = (float)sl_value(&s, order[v], max_distance);
-}
+MFMM_WINDOWS_ROWS(windows_rows_f64, double)
+MFMM_WINDOWS_ROWS(windows_rows_f32, float)
