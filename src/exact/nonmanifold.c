@@ -1,11 +1,91 @@
 /* Windows at non-manifold edges: a window fanned out into the other faces
  * on such an edge (propagate.c, ex_fan_out) is kept, per face entered, and
- * trims the windows that enter that face there later (nonmanifold.h). */
+ * trims the windows that enter that face there later (nonmanifold.h); so
+ * is a window queued where a pass was cut (ex_pass_later), per zero-area
+ * half-edge. */
 #include <math.h>
 #include <stdlib.h>
 
 #include "nonmanifold.h"
 #include "queue.h"
+
+/* The head of slot's list in rec: a non-manifold half-edge's (slot >= 0)
+ * or a cut pass's (-2 - j, ex_pass_slot). */
+static int32_t *ex_head(const mfmm_exact_ws *ws, int32_t slot)
+{
+    return slot >= 0 ? ws->nm_head + slot : ws->pass_slot + 2 * (-2 - slot) + 1;
+}
+
+/* A half-edge's bucket in pass_hash (mask: its size - 1). */
+static uint32_t ex_pass_bucket(int32_t h, int32_t mask)
+{
+    return ((uint32_t)h * 2654435761u) & (uint32_t)mask;
+}
+
+/* Doubles the cut passes' slots, within memory_limit: 0 when they cannot
+ * grow. */
+static int ex_pass_grow(mfmm_exact_ws *ws)
+{
+    int32_t cap = ws->pass_cap;
+    if (cap >= INT32_MAX / 4)
+        return 0;
+    int32_t ncap = cap ? 2 * cap : 16;
+    size_t more = (size_t)(ncap - cap) * 4 * sizeof(int32_t);
+    if (ws->memory_limit && ex_bytes(ws, ws->heap_cap) + more > ws->memory_limit)
+        return 0;
+    int32_t *slot = realloc(ws->pass_slot, 2 * (size_t)ncap * sizeof *slot);
+    if (!slot)
+        return 0;
+    ws->pass_slot = slot;
+    int32_t *hash = malloc(2 * (size_t)ncap * sizeof *hash);
+    if (!hash)
+        return 0;
+    free(ws->pass_hash);
+    ws->pass_hash = hash;
+    ws->pass_cap = ncap;
+    int32_t mask = 2 * ncap - 1;
+    for (int32_t i = 0; i <= mask; i++)
+        hash[i] = -1;
+    for (int32_t j = 0; j < ws->pass_n; j++) {
+        uint32_t b = ex_pass_bucket(slot[2 * j], mask);
+        while (hash[b] >= 0)
+            b = (b + 1) & (uint32_t)mask;
+        hash[b] = j;
+    }
+    if (ex_bytes(ws, ws->heap_cap) > ws->peak_bytes)
+        ws->peak_bytes = ex_bytes(ws, ws->heap_cap);
+    return 1;
+}
+
+int32_t ex_pass_slot(mfmm_exact_ws *ws, int32_t h)
+{
+    int32_t mask = 2 * ws->pass_cap - 1;
+    if (ws->pass_cap > 0)
+        for (uint32_t b = ex_pass_bucket(h, mask); ws->pass_hash[b] >= 0;
+             b = (b + 1) & (uint32_t)mask)
+            if (ws->pass_slot[2 * ws->pass_hash[b]] == h)
+                return -2 - ws->pass_hash[b];
+    if (ws->pass_n == ws->pass_cap && !ex_pass_grow(ws))
+        return -1;
+    mask = 2 * ws->pass_cap - 1;
+    uint32_t b = ex_pass_bucket(h, mask);
+    while (ws->pass_hash[b] >= 0)
+        b = (b + 1) & (uint32_t)mask;
+    int32_t j = ws->pass_n++;
+    ws->pass_slot[2 * j] = h;
+    ws->pass_slot[2 * j + 1] = -1;
+    ws->pass_hash[b] = j;
+    return -2 - j;
+}
+
+void ex_pass_reset(mfmm_exact_ws *ws)
+{
+    if (ws->pass_n == 0)
+        return;
+    for (int32_t i = 0; i < 2 * ws->pass_cap; i++)
+        ws->pass_hash[i] = -1;
+    ws->pass_n = 0;
+}
 
 /* D(x) - D'(x) of two windows on one edge, in units of the edge */
 static double ex_diff(double x, double px, double py, double dsig, double pa, double qa)
@@ -37,10 +117,8 @@ int ex_dominate(const mfmm_exact_ws *ws, int32_t slot, double L, double *s0p,
          * are this window's alone. It goes only when it is a kept one come
          * round again (alike to rounding, as below) over no more than that
          * one's interval, whose directions alone are carried already. */
-        for (int32_t i = ws->nm_head[slot]; i >= 0; i = ws->rec[i].next) {
+        for (int32_t i = *ex_head(ws, slot); i >= 0; i = ws->rec[i].next) {
             const ex_rec *a = ws->rec + i;
-            if (a->depth > ws->pass_depth)
-                continue;
             double ds = (sigma - a->sigma) * il, pa = a->px * il, qa = a->py * il;
             if (fabs(ds) + fabs(pw - pa) + fabs(qw - qa) <=
                     EX_TIE * (1.0 + fabs(sigma * il) + fabs(pw) + fabs(qw)) &&
@@ -49,12 +127,8 @@ int ex_dominate(const mfmm_exact_ws *ws, int32_t slot, double L, double *s0p,
         }
         return 1;
     }
-    for (int32_t i = ws->nm_head[slot]; i >= 0; i = ws->rec[i].next) {
+    for (int32_t i = *ex_head(ws, slot); i >= 0; i = ws->rec[i].next) {
         const ex_rec *a = ws->rec + i;
-        /* a window whose pass was cut at EX_MAX_PASS carried nothing past
-         * the cut, so it leaves a shallower one free to go on */
-        if (a->depth > ws->pass_depth)
-            continue;
         double a0 = a->b0 * il, a1 = a->b1 * il;
         int left = a0 <= s0, right = a1 >= s1;
         if (!left && !right)
@@ -148,11 +222,10 @@ int ex_dominate(const mfmm_exact_ws *ws, int32_t slot, double L, double *s0p,
     return 1;
 }
 
-/* Keeps a fanned-out window at its slot for ex_dominate, while memory
- * allows (one not kept only trims nothing); it trims only windows passing
- * at depth or deeper (ex_rec). */
+/* Keeps a fanned-out window (or one queued from a cut pass) at its slot
+ * for ex_dominate, while memory allows (one not kept only trims nothing). */
 void ex_keep(mfmm_exact_ws *ws, int32_t slot, double b0, double b1, double px, double py,
-             double sigma, int32_t depth)
+             double sigma)
 {
     if (ws->rec_n == ws->rec_cap) {
         int32_t cap = ws->rec_cap;
@@ -176,9 +249,10 @@ void ex_keep(mfmm_exact_ws *ws, int32_t slot, double b0, double b1, double px, d
     r->px = px;
     r->py = py;
     r->sigma = sigma;
-    r->depth = depth;
+    /* (unused: every pass goes on in full, a cut one from the queue) */
+    r->depth = 0;
     r->slot = slot;
-    r->next = ws->nm_head[slot];
-    ws->nm_head[slot] = ws->rec_n++;
+    r->next = *ex_head(ws, slot);
+    *ex_head(ws, slot) = ws->rec_n++;
 }
 

@@ -17,10 +17,19 @@
 int ex_dominate(const mfmm_exact_ws *ws, int32_t slot, double L, double *s0p,
                        double *s1p, double px, double py, double sigma);
 
-/* Keeps a fanned-out window at its slot for ex_dominate, while memory
- * allows (one not kept only trims nothing); it trims only windows passing
- * at depth or deeper (ex_rec). */
+/* The slot (-2 or below; a non-manifold half-edge's is its index in nm_he)
+ * of the windows queued at zero-area half-edge h where a pass was cut
+ * (ex_pass_later), made on first use in a run; -1 when memory allows no
+ * more. */
+int32_t ex_pass_slot(mfmm_exact_ws *ws, int32_t h);
+
+/* Frees every slot of cut passes for a new run (their lists in rec go
+ * with it). */
+void ex_pass_reset(mfmm_exact_ws *ws);
+
+/* Keeps a fanned-out window (or one queued from a cut pass) at its slot
+ * for ex_dominate, while memory allows (one not kept only trims nothing). */
 void ex_keep(mfmm_exact_ws *ws, int32_t slot, double b0, double b1, double px, double py,
-             double sigma, int32_t depth);
+             double sigma);
 
 #endif

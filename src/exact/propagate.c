@@ -78,6 +78,42 @@ static double ex_gap(double x, double s0, double s1)
 static void ex_emit(mfmm_exact_ws *ws, int32_t h, double s0, double s1, double ix, double iy,
                     double sigma, int known);
 
+/* A window about to enter zero-area face hd / 3 at pass depth EX_MAX_PASS
+ * (ex_pass's arguments) is queued there and passed on from depth 0 when
+ * popped (ex_propagate), so that the recursion stays bounded while a longer
+ * strip of such faces still carries it; it is trimmed against the windows
+ * queued at hd before, so that one come round a loop of them ends. */
+static void ex_pass_later(mfmm_exact_ws *ws, int32_t hd, int flip, double L, double s0,
+                          double s1, double ix, double iy, double sigma)
+{
+    double dx = ex_gap(ix, s0, s1);
+    double key = sigma + (dx > 0.0 ? sqrt(dx * dx + iy * iy) : iy);
+    if (key > ws->max_d)
+        return;
+    /* in hd's frame */
+    double b0 = flip ? L - s1 : s0, b1 = flip ? L - s0 : s1, px = flip ? L - ix : ix;
+    /* (without a slot, memory being short, it goes on untrimmed) */
+    int32_t slot = ex_pass_slot(ws, hd);
+    if (slot != -1) {
+        if (!ex_dominate(ws, slot, L, &b0, &b1, px, -iy, sigma))
+            return;
+        ex_keep(ws, slot, b0, b1, px, -iy, sigma);
+    }
+    int32_t wi = ex_new(ws);
+    if (wi < 0)
+        return;
+    ex_entry *w = ws->heap + wi;
+    w->b0 = b0;
+    w->b1 = b1;
+    w->px = px;
+    w->py = -iy;
+    w->sigma = sigma;
+    w->he = hd;
+    w->key = key;
+    ex_queue(ws, wi);
+    ws->n_windows++;
+}
+
 /* A window entering a zero-area face D through D's half-edge hd (flip: hd
  * runs the other way from the window's frame, an edge of length L). D's
  * corners lie on one line, so the points of the edge crossed are points of
@@ -91,7 +127,7 @@ static void ex_pass(mfmm_exact_ws *ws, int32_t hd, int flip, double L, double s0
                     double ix, double iy, double sigma)
 {
     if (ws->pass_depth >= EX_MAX_PASS) {
-        ws->pass_cut = 1;
+        ex_pass_later(ws, hd, flip, L, s0, s1, ix, iy, sigma);
         return;
     }
     if (flip) {
@@ -257,23 +293,15 @@ static void ex_fan_out(mfmm_exact_ws *ws, int32_t h, int32_t va, int32_t vb, dou
              * each go on */
             if (in_pass || i < 0 || !ex_dominate(ws, i, L, &n0, &n1, npx, -iy, sigma))
                 continue;
-            /* kept at this depth while its pass runs (windows come round
-             * deeper), then for all depths unless the pass was cut */
-            int cut = ws->pass_cut;
-            int32_t kept = ws->rec_n;
-            ws->pass_cut = 0;
-            ex_keep(ws, i, n0, n1, npx, -iy, sigma, ws->pass_depth);
+            ex_keep(ws, i, n0, n1, npx, -iy, sigma);
             ex_pass(ws, g, fl, L, fl ? L - n1 : n0, fl ? L - n0 : n1, ix, iy, sigma);
-            if (kept < ws->rec_n && !ws->pass_cut)
-                ws->rec[kept].depth = 0;
-            ws->pass_cut |= cut;
             continue;
         }
         if (i < 0)
             return;
         if (!ex_dominate(ws, i, L, &n0, &n1, npx, -iy, sigma))
             continue;
-        ex_keep(ws, i, n0, n1, npx, -iy, sigma, 0);
+        ex_keep(ws, i, n0, n1, npx, -iy, sigma);
         ex_enqueue(ws, g, fl, va, vb, L, fl ? L - n1 : n0, fl ? L - n0 : n1, ix, iy, sigma,
                    !ws->pseudo[va], !ws->pseudo[vb]);
     }
@@ -295,6 +323,11 @@ void ex_propagate(mfmm_exact_ws *ws, const ex_entry *w)
     int32_t vc = r->v[m];
     double L = r->len[m], cx = r->cx[m], cy = r->cy[m];
     double b0 = w->b0, b1 = w->b1, px = w->px, py = w->py, sigma = w->sigma;
+    if (r->skip == 1) {
+        /* a pass cut at EX_MAX_PASS, going on (ex_pass_later) */
+        ex_pass(ws, h, 0, L, b0, b1, px, -py, sigma);
+        return;
+    }
     /* (the window is not checked again here, against the face it crosses
      * with the distances known by now: that drops almost nothing for its
      * cost, docs/performance.md#design-measurements) */

@@ -7,7 +7,7 @@
 size_t ex_bytes(const mfmm_exact_ws *ws, int32_t heap_cap)
 {
     return ws->fixed_bytes + (size_t)heap_cap * sizeof(ex_entry) +
-           (size_t)ws->rec_cap * sizeof(ex_rec);
+           (size_t)ws->rec_cap * sizeof(ex_rec) + (size_t)ws->pass_cap * 4 * sizeof(int32_t);
 }
 
 /* Grows the entries by doubling, within memory_limit. */

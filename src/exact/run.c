@@ -8,6 +8,7 @@
 #include "base/error.h"
 #include "mesh/check.h"
 #include "mesh/order.h"
+#include "nonmanifold.h"
 #include "propagate.h"
 #include "queue.h"
 #include "run.h"
@@ -23,8 +24,10 @@ static void ex_reset(mfmm_exact_ws *ws)
     }
     ws->n_touched = 0;
     for (int32_t i = 0; i < ws->rec_n; i++)
-        ws->nm_head[ws->rec[i].slot] = -1;
+        if (ws->rec[i].slot >= 0)
+            ws->nm_head[ws->rec[i].slot] = -1;
     ws->rec_n = 0;
+    ex_pass_reset(ws);
     /* a run that emptied its queue left every bucket empty: only a failed
      * one (out of memory) needs them cleared (48 KB, a patch uses ~30) */
     if (ws->heap_n != 0)
@@ -173,6 +176,10 @@ static mfmm_status ex_run_once(mfmm_exact_ws *ws, const mfmm_source *sources,
         free(ws->rec);
         ws->rec = NULL;
         ws->rec_cap = 0;
+        free(ws->pass_slot);
+        free(ws->pass_hash);
+        ws->pass_slot = ws->pass_hash = NULL;
+        ws->pass_cap = 0;
         ws->peak_bytes = ex_bytes(ws, 0);
     }
     for (int32_t i = 0; i < n_sources; i++) {

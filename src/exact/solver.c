@@ -70,7 +70,8 @@
  * windows that entered that face there before (ex_dominate), and the edge's
  * ends are pseudo-sources; copies of a face are no part of the surface
  * (skip 2); a zero-area face (skip 1, its corners on one line) is passed
- * through along that line (ex_pass), its edges relax their ends, and a
+ * through along that line (ex_pass; past EX_MAX_PASS in a row, from the
+ * queue), its edges relax their ends, and a
  * vertex on its longest edge starts windows across that edge. An edge
  * almost a point next to the faces at its ends (a vertex split in two 1e-15
  * apart) is a wall whose ends start windows all around: no frame can be
@@ -130,6 +131,8 @@ void mfmm_exact_ws_destroy(mfmm_exact_ws *ws)
     free(ws->bhead);
     free(ws->nm_head);
     free(ws->rec);
+    free(ws->pass_slot);
+    free(ws->pass_hash);
     free(ws);
 }
 

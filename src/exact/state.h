@@ -166,7 +166,6 @@ struct mfmm_exact_solver {
     void *interrupt_user;
     int pass_depth; /* zero-area faces a window is passing through (ex_pass) */
     int32_t pass_face[EX_MAX_PASS]; /* those faces' records, outermost first */
-    int pass_cut;   /* a pass was cut at EX_MAX_PASS (ex_fan_out) */
     /* with non-manifold edges crossed, windows past a budget (over_budget):
      * the run is redone with those edges as walls (walls; ex_run); past it
      * otherwise, the run stops (stalled) and edge paths finish it */
@@ -178,6 +177,12 @@ struct mfmm_exact_solver {
     int32_t *nm_head;
     ex_rec *rec;
     int32_t rec_n, rec_cap;
+    /* the windows queued where a pass was cut at EX_MAX_PASS (ex_pass_later),
+     * by slot -2 - j: pass_slot (2 pass_cap,) holds slot j's zero-area
+     * half-edge and the head of its list in rec, pass_hash (2 pass_cap,)
+     * the j of a half-edge by hash (-1: none); pass_n slots in use */
+    int32_t *pass_slot, *pass_hash;
+    int32_t pass_n, pass_cap;
 };
 
 static inline double vdist(const double *p, const double *q)

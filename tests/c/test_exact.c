@@ -819,6 +819,28 @@ static void test_pass_cut_at_depth_limit(void **state)
     assert_true(D[16 * 19 + 14] <= 25.0626);
 }
 
+/* Two faces joined only through a strip of 10 needles along the x axis
+ * (each one's long edge the next one's short edge, so none closes a
+ * T-junction): 0 = (0, 0, 1) above the line, 1 = (0, 1, 0) beside it, the
+ * path through the origin 2 long, and 13 = (-0.5, 0, 0), the last needle's
+ * middle vertex, at its Euclidean distance sqrt 1.25 from 0. With passes
+ * cut at EX_MAX_PASS (8 in a row) d(0, 1) was 2.8284 and d(1, 0) 4.0322,
+ * paths through vertices of the strip. */
+static void test_pass_through_long_needle_strip(void **state)
+{
+    (void)state;
+    static const double V[42] = {0, 0, 1, 0, 1, 0, -1, 0, 0, 1, 0, 0, -2, 0, 0, 2, 0, 0,
+                                 -3, 0, 0, 3, 0, 0, -4, 0, 0, 4, 0, 0, -5, 0, 0, 5, 0, 0,
+                                 -6, 0, 0, -0.5, 0, 0};
+    static const int32_t F[36] = {2, 3, 0, 2, 3, 4, 4, 3, 5, 4, 5, 6, 6, 5, 7, 6, 7, 8,
+                                  8, 7, 9, 8, 9, 10, 10, 9, 11, 10, 11, 12, 12, 11, 13,
+                                  13, 11, 1};
+    static double D[14 * 14];
+    ex_assert_symmetric(V, 14, F, 12, D);
+    tm_assert_close(D[1], 2.0, 1e-15);
+    tm_assert_close(D[13], sqrt(1.25), 1e-15);
+}
+
 /* A zero-area face refuses a source; the rest is exact, and its vertex in
  * the middle of the edge it shares, reached through it (ex_pass), is at its
  * Euclidean distance too (it was +inf, behind a wall). */
@@ -1408,6 +1430,7 @@ int main(void)
         cmocka_unit_test(test_nonmanifold_symmetric),
         cmocka_unit_test(test_pass_into_needle_on_nonmanifold_edge),
         cmocka_unit_test(test_pass_cut_at_depth_limit),
+        cmocka_unit_test(test_pass_through_long_needle_strip),
         cmocka_unit_test(test_degenerate_face),
         cmocka_unit_test(test_memory_limit),
         cmocka_unit_test(test_threads),

@@ -48,10 +48,10 @@
  * mesh's own faces (T-junctions closed: a point of an input face may lie on
  * a cut between its pieces) with the face holding p and its copies split in
  * three at p, or where p lies on an edge, every face on that edge split in
- * two (not where one of them has zero area: cut, it would make p the middle
- * of a needle, joined to the faces across the needle's long edge); solved
- * from that vertex (and the second source at its value) to 1e-12 relative
- * at every vertex, unless either solve fell back to walls.
+ * two (a zero-area one too: its two pieces join the same points of the
+ * line its corners lie on as it did); solved from that vertex (and the
+ * second source at its value) to 1e-12 relative at every vertex, unless
+ * either solve fell back to walls.
  * With the vertex symmetry above this makes a face source's distances
  * symmetric too. Splitting the input face alone is not the same surface:
  * a point on an edge, or on a cut that is an edge of other faces (a
@@ -209,9 +209,8 @@ static int within(const double *d, const double *lo, const double *hi, int32_t n
 /* The mesh's surface cut at face source s (header comment), in internal
  * ids: vertices V2 (nv + 1, the point last: *P), faces F2 (room for 3 nf +
  * 3, nf the faces built). Returns the number of faces; 0 where the point
- * is in no face with an area, at a corner, within 1e-6 of an edge without
- * being on it (a cut would leave a sliver of a face), or on an edge of a
- * zero-area face. */
+ * is in no face with an area, at a corner, or within 1e-6 of an edge
+ * without being on it, where a cut would leave a sliver of a face. */
 static int32_t split_at(const mfmm_mesh *mesh, const mfmm_source *s, double *V2, int32_t *F2,
                         int32_t *P)
 {
@@ -254,10 +253,6 @@ static int32_t split_at(const mfmm_mesh *mesh, const mfmm_source *s, double *V2,
                 o[2] = nv;
             }
         } else if (zk >= 0 && n_in == 2) { /* on the edge t[k] t[k+1]: two faces */
-            /* cut, a zero-area face there makes p a needle's middle vertex,
-             * which the solver joins to the faces across its long edge */
-            if (mfmm_mesh_degenerate(mesh, f))
-                return 0;
             int k = !in[0] ? 1 : !in[1] ? 2 : 0;
             int32_t a = t[k], b = t[(k + 1) % 3], c = t[(k + 2) % 3], *o = F2 + 3 * nf2;
             o[0] = a, o[1] = nv, o[2] = c, o[3] = nv, o[4] = b, o[5] = c;

@@ -422,3 +422,25 @@ def test_degenerate_fans_finish_without_walls():
     assert info.nonmanifold_walls == 0
     source = sources[0].vertex
     assert d[source] == 0.0 and not np.any(np.isnan(d)) and np.all(d >= 0)
+
+
+def test_face_source_on_a_needle_edge_crosses_the_tangle():
+    """tests/fuzz/regressions/exact/face-source-on-a-needle-edge: the x axis
+    is a tangle of 20 needles; p, a point on edge 8-2 of face 15, lies on
+    edge 4-12 of face 8 too, through a strip of 9 needles (each sharing an
+    edge with the next, all holding p), so the straight segment from p to
+    vertex 27 of face 8 lies on the surface and d(27) is the Euclidean
+    distance 5.0251 (5.7795 when a pass stopped after 8 needles); from
+    vertex 3 of that line, likewise 5.0140 (6.1128). No value lies below
+    the Euclidean distance."""
+    V, F, data, at = fuzz_exact_mesh("face-source-on-a-needle-edge")
+    bary = (0.0, 1.0 / 3.0, 2.0 / 3.0)
+    p = bary[1] * V[F[15, 1]] + bary[2] * V[F[15, 2]]
+    for source, x in ((_lib.mfmm_source(0, 15, bary, 0.0), p),
+                      (_lib.mfmm_source(3, -1, (0.0, 0.0, 0.0), 0.0), V[3])):
+        st, d, info, err = _solve_exact(V, F, source)
+        assert st == 0, err.message
+        assert info.nonmanifold_walls == 0
+        euclid = np.linalg.norm(V - x, axis=1)
+        np.testing.assert_allclose(d[27], euclid[27], rtol=1e-12, atol=0)
+        assert np.all(d >= euclid * (1 - 1e-12))
