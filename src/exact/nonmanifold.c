@@ -249,8 +249,6 @@ void ex_keep(mfmm_exact_ws *ws, int32_t slot, double b0, double b1, double px, d
     r->px = px;
     r->py = py;
     r->sigma = sigma;
-    /* (unused: every pass goes on in full, a cut one from the queue) */
-    r->depth = 0;
     r->slot = slot;
     r->next = *ex_head(ws, slot);
     *ex_head(ws, slot) = ws->rec_n++;

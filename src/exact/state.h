@@ -34,7 +34,8 @@
 /* an edge shorter than this times the longest edge of a face at its ends
  * is a wall (ex_wall_short_edges) */
 #define EX_SHORT_EDGE 1e-6
-/* zero-area faces one window may pass through in a row (ex_pass) */
+/* zero-area faces one window passes through in a row by recursion (ex_pass);
+ * past them it is queued and goes on from the queue (ex_pass_later) */
 #define EX_MAX_PASS 8
 /* a vertex whose angle sum exceeds 2 pi by this much is a saddle */
 #define EX_SADDLE_TOL 1e-12
@@ -66,8 +67,6 @@ typedef struct ex_entry {
 typedef struct ex_rec {
     double b0, b1, px, py, sigma;
     int32_t slot, next;
-    int32_t depth; /* trims only windows passing at this depth or deeper: its
-                      pass was cut at EX_MAX_PASS (0: it went on in full) */
 } ex_rec;
 
 /* The read-only tables of a mesh (exact.h): built once, shared by the

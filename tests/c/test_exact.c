@@ -685,7 +685,7 @@ static void test_dominate_equal_sigma(void **state)
         double L = 0.5 + 2.0 * u[0], sigma = 3.0 * u[1];
         double pa = L * (2.0 * u[2] - 0.5), qa = -(0.1 + u[3]) * L;
         double pn = L * (2.0 * u[4] - 0.5), qn = -(0.1 + u[0] * u[3]) * L;
-        kept = (ex_rec){0.0, L, pa, qa, sigma, 0, -1, 0};
+        kept = (ex_rec){0.0, L, pa, qa, sigma, 0, -1};
         /* where |X - N| = |X - K| on the edge (y = 0) */
         double xb = (pa * pa + qa * qa - pn * pn - qn * qn) / (2.0 * (pa - pn));
         double s0 = 0.0, s1 = L;
