@@ -271,8 +271,12 @@ typedef enum mfmm_method {
      * a straight segment from a source or a vertex where geodesics bend,
      * unfolded through the faces it crosses: several times more accurate
      * than the march, never below the geodesic distance beyond rounding,
-     * exact on flat regions, several times the march's time. Geodesic
-     * distance only (no cost); unfolding and exact_start_radius do not
+     * exact on flat regions, several times the march's time. With a cost,
+     * windows run within faces of one cost (value sigma + F |segment|) and
+     * stop where it changes; a settled vertex updates a face whose corners'
+     * costs differ by the march's triangle update (section 4.1) under the
+     * march's cost convention. Those updates, as the march's, may lie below
+     * the weighted distance. unfolding and exact_start_radius do not
      * apply. */
     MFMM_METHOD_WINDOWS = 1
 } mfmm_method;
@@ -281,7 +285,7 @@ typedef struct mfmm_solve_options {
     size_t struct_size;              /* set by mfmm_solve_options_init */
     const double *cost;              /* NULL (default): F = 1. Finite and > 0, and its
                                         largest entry times the edges' total length below
-                                        DBL_MAX / 16 */
+                                        DBL_MAX / 16. Both methods take one */
     mfmm_cost_location cost_location;/* ignored when cost is NULL */
     double max_distance;             /* stop past it; vertices beyond are +inf. Default
                                         +inf; >= 0 */
@@ -321,7 +325,7 @@ MFMM_API void mfmm_solve_options_init(mfmm_solve_options *options);
  * source); MFMM_ERR_BAD_COST (err->index: the entry); MFMM_ERR_BAD_ARGUMENT
  * (max_distance NaN or < 0; n_targets < 0, or > 0 with targets NULL; a
  * target out of range, err->index: its position; exact_start_radius;
- * method unknown, or MFMM_METHOD_WINDOWS with a cost; struct_size);
+ * method unknown; struct_size);
  * MFMM_ERR_OUT_OF_MEMORY.
  * Thread safety: one call at a time per solver. */
 MFMM_API mfmm_status mfmm_solve(mfmm_solver *solver, const mfmm_source *sources,

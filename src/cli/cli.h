@@ -247,8 +247,8 @@ int cli_start_option(const char *sub, int which, int *given);
     "  --method M              fmm (default): Fast Marching; windows: window\n"              \
     "                          propagation keeping two windows per half-edge, never\n"      \
     "                          below the geodesic distance, several times as accurate\n"   \
-    "                          and several times the time; no --cost (the start\n"         \
-    "                          options do not apply to it)\n"
+    "                          and several times the time (the start options do\n"        \
+    "                          not apply to it)\n"
 /* --method's value: "fmm" or "windows" into *method. CLI_OK, or CLI_USAGE
  * with the error printed. */
 int cli_parse_method(const char *sub, const char *arg, mfmm_method *method);

@@ -15,6 +15,8 @@ struct mfmm_slots {
     const mfmm_mesh *mesh;
     sl_state c;
     uint8_t *flat; /* (nv) sl_state's, owned here */
+    double *fcost; /* (nf) the records' costs of the last run with a cost, relative */
+    double *vcost; /* (nv) the vertices' costs of the last run per vertex, relative */
 };
 
 void mfmm_slots_flat(const mfmm_exact_tables *t, uint8_t *flat)
@@ -76,6 +78,8 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     c->K = 2;
     s->flat = malloc(nv + 1);
     c->flat = s->flat;
+    s->fcost = malloc(((size_t)t->nf + 1) * sizeof *s->fcost);
+    s->vcost = malloc((nv + 1) * sizeof *s->vcost);
     c->slot = malloc((2 * nh + 1) * sizeof *c->slot);
     c->n_slot = malloc(nh + 1);
     c->fresh = malloc(nh + 1);
@@ -91,9 +95,10 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     c->e.heap_key = malloc((nh + 1) * sizeof(double));
     c->e.heap_vertex = malloc((nh + 1) * sizeof(int32_t));
     c->e.heap_pos = malloc((nh + 1) * sizeof(int32_t));
-    if (!s->flat || !c->slot || !c->n_slot || !c->fresh || !c->d || !c->ray || !c->is_src ||
-        !c->is_tgt || !c->h.label || !c->h.heap_key || !c->h.heap_vertex || !c->h.heap_pos ||
-        !c->e.label || !c->e.heap_key || !c->e.heap_vertex || !c->e.heap_pos) {
+    if (!s->flat || !s->fcost || !s->vcost || !c->slot || !c->n_slot || !c->fresh || !c->d ||
+        !c->ray || !c->is_src || !c->is_tgt || !c->h.label || !c->h.heap_key ||
+        !c->h.heap_vertex || !c->h.heap_pos || !c->e.label || !c->e.heap_key ||
+        !c->e.heap_vertex || !c->e.heap_pos) {
         mfmm_slots_destroy(s);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
@@ -106,9 +111,10 @@ size_t mfmm_slots_bytes(const mfmm_mesh *mesh)
 {
     size_t nv = (size_t)mesh->nv, nh = 3 * (size_t)mesh->nf;
     /* slots, count, fresh bits, label and heap per half-edge; distances,
-     * flags and heap per vertex */
+     * flags, heap and cost per vertex; a cost per face */
     return nh * (2 * sizeof(sl_win) + 3 + sizeof(double) + 2 * sizeof(int32_t)) +
-           nv * (sizeof(double) + 5 + sizeof(double) + 2 * sizeof(int32_t));
+           nv * (sizeof(double) + 5 + sizeof(double) + 2 * sizeof(int32_t) + sizeof(double)) +
+           (nh / 3) * sizeof(double);
 }
 
 size_t mfmm_slots_block_bytes(const mfmm_mesh *mesh)
@@ -140,6 +146,8 @@ void mfmm_slots_destroy(mfmm_slots *s)
         return;
     sl_state *c = &s->c;
     free(s->flat);
+    free(s->fcost);
+    free(s->vcost);
     free(c->slot);
     free(c->n_slot);
     free(c->fresh);
@@ -194,6 +202,14 @@ static void sl_run(mfmm_slots *s, double *out)
         out[v] = s->c.d[v];
 }
 
+/* No cost: every face 1.0 (the window method's own entry points). */
+static void sl_no_cost(mfmm_slots *s)
+{
+    s->c.fcost = NULL;
+    s->c.h.cost = NULL;
+    s->c.h.cost_location = 0;
+}
+
 void mfmm_slots_solve(mfmm_slots *s, int32_t source, double *out)
 {
     mfmm_slots_solve_multi(s, 1, &source, NULL, out);
@@ -202,6 +218,7 @@ void mfmm_slots_solve(mfmm_slots *s, int32_t source, double *out)
 void mfmm_slots_solve_multi(mfmm_slots *s, int32_t n, const int32_t *src, const double *value,
                             double *out)
 {
+    sl_no_cost(s);
     sl_reset(&s->c);
     for (int32_t i = 0; i < n; i++) {
         sl_update(&s->c, src[i], value ? value[i] : 0.0, 0);
@@ -213,6 +230,7 @@ void mfmm_slots_solve_multi(mfmm_slots *s, int32_t n, const int32_t *src, const 
 void mfmm_slots_solve_face(mfmm_slots *s, int32_t f, const int32_t fv[3], const double w[3],
                            double *out)
 {
+    sl_no_cost(s);
     sl_reset(&s->c);
     const ex_face *r = s->c.fr + f;
     double b[3] = {0.0, 0.0, 0.0};
@@ -237,12 +255,39 @@ void mfmm_slots_solve_face(mfmm_slots *s, int32_t f, const int32_t fv[3], const 
     sl_run(s, out);
 }
 
+/* The cost of a straight segment from a point in face record r_id to its
+ * corner v: the face's, or in a face of mixed cost (per vertex) the mean of
+ * the cost at the point (fp, interpolated) and at v, as the march's
+ * straight start (start/straight.c). */
+static double sl_start_cost(const mfmm_slots *s, int32_t r_id, double fp, int32_t v)
+{
+    double c = sl_cost(&s->c, r_id);
+    return c > 0.0 ? c : 0.5 * (fp + s->c.h.cost[v]);
+}
+
 /* A point in face record r at weights b (r's corners, summing to 1, none
  * 1): each edge gets a window of the whole edge from the point, which also
- * sets the edge's ends to their straight distances. */
+ * sets the edge's ends to their straight distances. In a face of mixed cost
+ * the corners get the march's straight start instead (no window lies
+ * there). */
 static void sl_start_face(mfmm_slots *s, int32_t r_id, const double b[3], double value)
 {
     const ex_face *r = s->c.fr + r_id;
+    if (!(sl_cost(&s->c, r_id) > 0.0)) {
+        double fp = 0.0;
+        for (int k = 0; k < 3; k++)
+            fp += b[k] * s->c.h.cost[r->v[k]];
+        for (int k = 0; k < 3; k++) {
+            /* |point corner k| in half-edge 3r+k's frame: corner k at
+             * (cx, cy), the point at (ix, iy) */
+            double L = r->len[k];
+            double ix = b[k] * r->cx[k] + b[ex_prev[k]] * L, iy = b[k] * r->cy[k];
+            double dx = r->cx[k] - ix, dy = r->cy[k] - iy;
+            sl_update(&s->c, r->v[k], value + sl_start_cost(s, r_id, fp, r->v[k]) *
+                                                  sqrt(dx * dx + dy * dy), 0);
+        }
+        return;
+    }
     for (int k = 0; k < 3; k++) {
         /* the point in half-edge 3f+k's frame (corner k+1 at 0, k+2 at L,
          * corner k at (cx, cy)) */
@@ -252,17 +297,68 @@ static void sl_start_face(mfmm_slots *s, int32_t r_id, const double b[3], double
     }
 }
 
+static double sl_face_cost(const mfmm_exact_tables *t, const double *cost, int cost_location,
+                           double *fout, double *vout)
+{
+    /* the scale: the least cost, so that a constant cost runs at 1.0, the
+     * bits of no cost, and its values are the scale times those */
+    int32_t n = cost_location == 2 ? t->nf : t->nv;
+    double scale = cost[0];
+    for (int32_t i = 1; i < n; i++)
+        scale = cost[i] < scale ? cost[i] : scale;
+    if (cost_location == 1)
+        for (int32_t v = 0; v < t->nv; v++)
+            vout[v] = cost[v] / scale;
+    for (int32_t f = 0; f < t->nf; f++) {
+        const ex_face *r = t->fr + t->face_in[f];
+        double x = cost_location == 2 ? cost[f] : cost[r->v[0]];
+        if (cost_location == 1 && (cost[r->v[1]] != x || cost[r->v[2]] != x))
+            fout[t->face_in[f]] = -1.0;
+        else
+            fout[t->face_in[f]] = x / scale;
+    }
+    return scale;
+}
+
+double mfmm_slots_face_cost(const mfmm_mesh *mesh, const double *cost, int cost_location,
+                            double *fout, double *vout)
+{
+    const mfmm_exact_tables *t = NULL;
+    if (mfmm_exact_tables_of(mesh, &t) != MFMM_OK)
+        return 1.0;
+    return sl_face_cost(t, cost, cost_location, fout, vout);
+}
+
+/* Sets the records' costs (sl_state.fcost) of a cost in internal ids;
+ * returns the scale they are relative to (1.0 with no cost). */
+static double sl_set_cost(mfmm_slots *s, const double *cost, int cost_location)
+{
+    sl_no_cost(s);
+    if (!cost || (cost_location != 1 && cost_location != 2))
+        return 1.0;
+    double scale = sl_face_cost(s->t, cost, cost_location, s->fcost, s->vcost);
+    s->c.fcost = s->fcost;
+    if (cost_location == 1) {
+        s->c.h.cost = s->vcost;
+        s->c.h.cost_location = 1;
+    }
+    return scale;
+}
+
 int32_t mfmm_slots_run(mfmm_slots *s, const mfmm_source *sources, int32_t n_sources,
                        double max_distance, const int32_t *targets, int32_t n_targets,
-                       double *T, int32_t *settled)
+                       const double *cost, int cost_location, double *T, int32_t *settled)
 {
     const mfmm_mesh *mesh = s->mesh;
+    /* the run is in units of the scale (the least cost): values, sources'
+     * values and the level divided by it, the values written times it */
+    double scale = sl_set_cost(s, cost, cost_location), level = max_distance / scale;
     sl_reset(&s->c);
     int32_t n_tgt = sl_targets(&s->c, targets, n_targets);
     for (int32_t i = 0; i < n_sources; i++) {
         const mfmm_source *src = sources + i;
         if (src->face < 0) {
-            sl_update(&s->c, src->vertex, src->value, 0);
+            sl_update(&s->c, src->vertex, src->value / scale, 0);
             s->c.is_src[src->vertex] = 1;
             continue;
         }
@@ -283,6 +379,11 @@ int32_t mfmm_slots_run(mfmm_slots *s, const mfmm_source *sources, int32_t n_sour
             if (b[k] >= 1.0 - 1e-12)
                 corner = k;
         }
+        int32_t rec = s->c.face_in[face];
+        double fp = 0.0; /* the cost at the point (per vertex) */
+        if (s->c.h.cost)
+            for (int k = 0; k < 3; k++)
+                fp += b[k] * s->c.h.cost[r->v[k]];
         if (corner >= 0) {
             /* at a corner: a vertex source, offset by the (tiny) distance */
             double p[3], w[3];
@@ -293,11 +394,14 @@ int32_t mfmm_slots_run(mfmm_slots *s, const mfmm_source *sources, int32_t n_sour
             }
             mfmm_bary_to_xyz(mesh, face, w, p);
             int32_t v = r->v[corner];
-            sl_update(&s->c, v, src->value + vdist(p, mesh->xyz + 3 * (size_t)v), 0);
+            sl_update(&s->c, v,
+                      src->value / scale +
+                          sl_start_cost(s, rec, fp, v) * vdist(p, mesh->xyz + 3 * (size_t)v),
+                      0);
             s->c.is_src[v] = 1;
             continue;
         }
-        sl_start_face(s, s->c.face_in[face], b, src->value);
+        sl_start_face(s, s->c.face_in[face], b, src->value / scale);
         if (mesh->piece_next) {
             /* a face cut at T-junctions: the segments from the point to
              * every piece's corners lie in the face as given (the edges
@@ -308,15 +412,18 @@ int32_t mfmm_slots_run(mfmm_slots *s, const mfmm_source *sources, int32_t n_sour
                  q = mesh->piece_next[q])
                 for (int k = 0; k < 3; k++) {
                     int32_t c = mesh->face_records[q].v[k];
-                    sl_update(&s->c, c, src->value + vdist(p, mesh->xyz + 3 * (size_t)c), 0);
+                    sl_update(&s->c, c,
+                              src->value / scale + sl_start_cost(s, rec, fp, c) *
+                                               vdist(p, mesh->xyz + 3 * (size_t)c),
+                              0);
                 }
         }
     }
-    sl_loop(&s->c, max_distance, n_tgt);
+    sl_loop(&s->c, level, n_tgt);
     int32_t n = 0;
     for (int32_t v = 0; v < s->c.nv; v++) {
-        if (s->c.h.label[v] == 2 && s->c.d[v] <= max_distance) {
-            T[v] = s->c.d[v];
+        if (s->c.h.label[v] == 2 && s->c.d[v] <= level) {
+            T[v] = scale * s->c.d[v];
             if (settled)
                 settled[n] = v;
             n++;

@@ -61,6 +61,14 @@ void mfmm_slots_solve_multi(mfmm_slots *s, int32_t n, const int32_t *src, const 
 void mfmm_slots_solve_face(mfmm_slots *s, int32_t f, const int32_t fv[3], const double w[3],
                            double *out);
 
+/* The costs a run with a cost in internal ids, per vertex (cost_location
+ * 1) or per face (2), reads, relative to the least cost, which is returned
+ * (the run's values are in its units): fout (nf) each exact-table record's
+ * (sl_state.fcost): the face's, or per vertex the corners' common cost, -1
+ * where they differ; per vertex, vout (nv) the vertices'. */
+double mfmm_slots_face_cost(const mfmm_mesh *mesh, const double *cost, int cost_location,
+                            double *fout, double *vout);
+
 /* The solve behind MFMM_METHOD_WINDOWS: sources as for mfmm_solve, in
  * internal ids (vertex sources, points in faces, each with its value),
  * stopped once the front passes max_distance (+inf: none) or, with
@@ -70,10 +78,12 @@ void mfmm_slots_solve_face(mfmm_slots *s, int32_t f, const int32_t fv[3], const 
  * max_distance), the same bits as a solve without the stops (values after
  * a vertex settles only lower it by rounding, 1e-13 relative, and the run
  * goes on past the stop by SL_STOP relative). settled: (nv,) out, may be
- * NULL: the vertices written. Returns how many. */
+ * NULL: the vertices written. cost: NULL, or per vertex (cost_location 1)
+ * or per face (2) in internal ids (sl_state.fcost, slots_core.h). Returns
+ * how many. */
 int32_t mfmm_slots_run(mfmm_slots *s, const mfmm_source *sources, int32_t n_sources,
                        double max_distance, const int32_t *targets, int32_t n_targets,
-                       double *T, int32_t *settled);
+                       const double *cost, int cost_location, double *T, int32_t *settled);
 
 /* Counters of the last solve. */
 typedef struct mfmm_slots_info {

@@ -47,6 +47,17 @@
  *   the faces the window crossed (possibly ending with a segment from the
  *   interval's end across one face), sigma itself a value, or d(u) + |uv|:
  *   the length of a path on the surface, never below the geodesic distance.
+ * - A cost (per face, or per vertex: a face whose corners' costs are
+ *   equal has that cost, else it is of mixed cost): a window lies in faces
+ *   of one cost c, its values sigma + c |segment| and its trims ex_trim's
+ *   inequality divided by c; it stops at an edge into a face of another
+ *   cost (as at a wall; the edge's ends are relaxed). A settled vertex
+ *   offers windows into faces of one cost, and into a face of mixed cost
+ *   does the march's update instead (sl_fmm_corner; Kimmel & Sethian 1998,
+ *   section 4.1): refraction where the cost changes is the march's. Values
+ *   from those updates are no path lengths and may lie below the weighted
+ *   distance, as the march's. Without a cost c is 1.0 (x * 1.0 and x / 1.0
+ *   are exact): the same bits as with no cost code at all.
  * - Walls and zero-area faces stop windows (the edge relaxation goes on);
  *   at a non-manifold edge a window goes on into every other face on it
  *   (as the exact solver's ex_fan_out); copies of a face are skipped. */
@@ -103,7 +114,16 @@ typedef struct sl_state {
                                     not a window's end) */
     MFMM_GLOBAL mfmm_u8 *is_src; /* (nv) the vertex sources of the solve */
     MFMM_GLOBAL mfmm_u8 *is_tgt; /* (nv) targets not yet settled */
-    mfmm_march_state h; /* vertices (T unused); label 0 far, 1 close, 2 settled */
+    /* (nf) each record's cost: the face's, or per vertex the corners' common
+     * cost, or -1 where they differ; NULL with no cost (every face 1.0).
+     * Costs relative to the least (the run's unit, mfmm_slots_run), so that
+     * a constant cost runs at 1.0 */
+    MFMM_GLOBAL const double *fcost;
+    /* vertices (T unused); label 0 far, 1 close, 2 settled. With a cost per
+     * vertex h.cost holds it (internal ids, relative as fcost) and
+     * h.cost_location is 1, for the march's cost convention
+     * (mfmm_march_cost) in faces of mixed cost */
+    mfmm_march_state h;
     mfmm_march_state e; /* half-edges keyed by their windows' least distance */
     int K;              /* windows per half-edge */
     double tgt_level;   /* the largest value of the targets settled (sl_loop) */
@@ -143,24 +163,87 @@ MFMM_INLINE void sl_update(sl_state *s, mfmm_i32 v, double dist, int ray)
     s->h.label[v] = 1;
 }
 
+/* the cost of face record f: 1.0 with no cost (x * 1.0 and x / 1.0 are
+ * exact, so the no-cost path keeps its bits), -1 where it is not uniform */
+MFMM_INLINE double sl_cost(const sl_state *s, mfmm_i32 f)
+{
+    return s->fcost ? s->fcost[f] : 1.0;
+}
+
+/* Vertex v settled at dv updates corner jc of face record r (a face of mixed
+ * cost, per vertex) as the march does when a vertex settles (march.h,
+ * mfmm_march_corner without virtual edges): the edge from v at the march's
+ * edge cost and, when the face's third vertex has settled, Kimmel &
+ * Sethian's triangle update through the face's inside (1998, section 4.1)
+ * with the march's cost across the face (mfmm_march_cost); the edge from
+ * the third vertex was offered when it settled, at its edge cost. */
+MFMM_INLINE void sl_fmm_corner(sl_state *s, MFMM_GLOBAL const ex_face *r, int jc, mfmm_i32 v,
+                               double dv)
+{
+    mfmm_i32 c = r->v[jc];
+    if (s->h.label[c] == 2)
+        return; /* settled: the march updates only vertices not yet settled */
+    int ja = ex_next[jc], jb = ex_prev[jc];
+    mfmm_i32 ia = r->v[ja], ib = r->v[jb];
+    double f_a, f_b, f_t;
+    (void)mfmm_march_cost(&s->h, 0, c, ia, ib, &f_a, &f_b, &f_t);
+    /* a = |BC| (len[ja]), b = |AC| (len[jb]); cos at C from the side lengths,
+     * with + - * / only, so that C and OpenCL C round alike */
+    double a = r->len[ja], b = r->len[jb], l = r->len[jc];
+    double t = v == ia ? dv + b * f_b : dv + a * f_a;
+    mfmm_i32 y = v == ia ? ib : ia;
+    if (s->h.label[y] == 2) {
+        double cs = (a * a + b * b - l * l) / (2.0 * a * b);
+        double ta = v == ia ? dv : s->d[ia], tb = v == ia ? s->d[ib] : dv;
+        t = mfmm_min(t, mfmm_triangle_interior(ta, tb, a, b, cs, f_t));
+    }
+    sl_update(s, c, t, 0);
+}
+
+/* the cost of the edge of face record f from u to w: the face's, or in a
+ * face of mixed cost (per vertex) the mean of the ends' costs, as the
+ * march's edge update (mfmm_march_cost) */
+MFMM_INLINE double sl_edge_cost(const sl_state *s, mfmm_i32 f, mfmm_i32 u, mfmm_i32 w)
+{
+    double c = sl_cost(s, f);
+    return c > 0.0 ? c : 0.5 * (s->h.cost[u] + s->h.cost[w]);
+}
+
+/* Whether the faces around v all have one cost (always without a cost): a
+ * flat vertex's offers are redundant only then, since windows stop where
+ * the cost changes. */
+MFMM_INLINE int sl_one_cost(const sl_state *s, mfmm_i32 v)
+{
+    if (!s->fcost)
+        return 1;
+    mfmm_i32 i0 = s->vf_offset[v], i1 = s->vf_offset[v + 1];
+    if (i0 == i1)
+        return 1;
+    double c = sl_cost(s, ex_corner(s->vf_corner, s->face_in, i0) / 3);
+    for (mfmm_i32 i = i0 + 1; i < i1; i++)
+        if (sl_cost(s, ex_corner(s->vf_corner, s->face_in, i) / 3) != c)
+            return 0;
+    return c > 0.0;
+}
+
 /* the distances a window gives at the SL_NS points x (ascending) of its
  * edge: over the nearer end of its interval, then along the edge, outside
  * it (each end's segment computed once for all the points beyond it) */
 MFMM_INLINE void sl_vals(const double *x, double b0, double b1, double px, double py,
-                           double sigma, double *v)
+                           double sigma, double cost, double *v)
 {
     int j = 0;
     if (x[0] < b0) {
-        double e = sigma + sqrt((b0 - px) * (b0 - px) + py * py);
+        double e = sigma + cost * sqrt((b0 - px) * (b0 - px) + py * py);
         for (; j < SL_NS && x[j] < b0; j++)
-            v[j] = e + fabs(x[j] - b0);
+            v[j] = e + cost * fabs(x[j] - b0);
     }
     for (; j < SL_NS && !(x[j] > b1); j++)
-        v[j] = sigma + sqrt((x[j] - px) * (x[j] - px) + py * py);
+        v[j] = sigma + cost * sqrt((x[j] - px) * (x[j] - px) + py * py);
     if (j < SL_NS) {
-        double e = sigma + sqrt((b1 - px) * (b1 - px) + py * py);
+        double e = sigma + cost * sqrt((b1 - px) * (b1 - px) + py * py);
         for (; j < SL_NS; j++)
-            v[j] = e + fabs(x[j] - b1);
+            v[j] = e + cost * fabs(x[j] - b1);
     }
 }
 
@@ -176,14 +259,15 @@ MFMM_INLINE double sl_lo(double a, double b)
 }
 
 /* half-edge g holds a window (a new one, or one kept since g was passed)
- * whose least value is sigma + the distance from (px, py) to [b0, b1]: g
+ * whose least value is sigma + cost times the distance from (px, py) to
+ * [b0, b1] (cost: the face g enters, where the window lies): g
  * is passed (again) by then. Labels: 0 not queued, 1 queued, 2 passed,
  * 3 passed and queued again for the windows kept since (fresh). */
 MFMM_INLINE void sl_key(sl_state *s, mfmm_i32 g, double b0, double b1, double px, double py,
-                        double sigma)
+                        double sigma, double cost)
 {
     double c = px < b0 ? b0 : px > b1 ? b1 : px;
-    double m = sigma + sqrt((c - px) * (c - px) + py * py);
+    double m = sigma + cost * sqrt((c - px) * (c - px) + py * py);
     mfmm_u8 lab = s->e.label[g];
     int queued = lab == 1 || lab == 3;
     if (queued && !(m < s->e.heap_key[s->e.heap_pos[g]]))
@@ -194,9 +278,10 @@ MFMM_INLINE void sl_key(sl_state *s, mfmm_i32 g, double b0, double b1, double px
 
 /* Window [s0, s1] from pseudo-source (ix, iy) (the frame of the half-edge
  * it leaves through, iy >= 0 on the face's side) into the slots of half-edge
- * g across the edge, whose frame runs the other way when fl is set. */
+ * g across the edge, whose frame runs the other way when fl is set; cost:
+ * the faces it lies in (g's face's, as the face it leaves). */
 MFMM_INLINE void sl_keep(sl_state *s, mfmm_i32 g, int fl, double L, double s0, double s1, double t0,
-                    double t1, double ix, double iy, double sigma)
+                    double t1, double ix, double iy, double sigma, double cost)
 {
     double b0 = fl ? L - s1 : s0, b1 = fl ? L - s0 : s1, px = fl ? L - ix : ix, py = -iy;
     double g0 = fl ? L - t1 : t0, g1 = fl ? L - t0 : t1;
@@ -207,7 +292,7 @@ MFMM_INLINE void sl_keep(sl_state *s, mfmm_i32 g, int fl, double L, double s0, d
      * vertex by its two sides, one window together (the rays between them,
      * cut by trims, are paths too). Pieces whose traced rays do not meet
      * stay apart: they may have come round a hole, whose rays are no paths. */
-    double tol = SL_SAME * (L + fabs(px) - py + sigma);
+    double tol = SL_SAME * (L + fabs(px) - py + sigma / cost);
     for (int i = 0; i < n; i++) {
         if (fabs(w[i].px - px) > tol || fabs(w[i].py - py) > tol ||
             fabs(w[i].sigma - sigma) > tol || g0 > w[i].g1 + tol || g1 < w[i].g0 - tol)
@@ -220,7 +305,7 @@ MFMM_INLINE void sl_keep(sl_state *s, mfmm_i32 g, int fl, double L, double s0, d
         w[i].b0 = u0;
         w[i].b1 = u1;
         s->info.merged++;
-        sl_key(s, g, b0, b1, px, py, sigma);
+        sl_key(s, g, b0, b1, px, py, sigma, cost);
         if (s->e.label[g] == 3) {
             /* g was passed: the joined window crosses again (what it
              * crossed before gives the same values) */
@@ -240,8 +325,8 @@ MFMM_INLINE void sl_keep(sl_state *s, mfmm_i32 g, int fl, double L, double s0, d
         for (int j = 0; j < SL_NS; j++)
             x[j] = L * j / (SL_NS - 1);
         for (int i = 0; i < n; i++)
-            sl_vals(x, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma, val[i]);
-        sl_vals(x, b0, b1, px, py, sigma, val[n]);
+            sl_vals(x, w[i].b0, w[i].b1, w[i].px, w[i].py, w[i].sigma, cost, val[i]);
+        sl_vals(x, b0, b1, px, py, sigma, cost, val[n]);
         double best = MFMM_INF;
         at = n;
         if (n == 2) {
@@ -285,7 +370,7 @@ MFMM_INLINE void sl_keep(sl_state *s, mfmm_i32 g, int fl, double L, double s0, d
     sl_win nw = {b0, b1, px, py, sigma, g0, g1};
     w[at] = nw;
     s->info.kept++;
-    sl_key(s, g, b0, b1, px, py, sigma);
+    sl_key(s, g, b0, b1, px, py, sigma, cost);
     if (s->e.label[g] == 3) {
         /* kept after g was passed: g is queued again, to cross it (no
          * recursion, which OpenCL C has not) */
@@ -298,14 +383,18 @@ MFMM_INLINE void sl_keep(sl_state *s, mfmm_i32 g, int fl, double L, double s0, d
  * of the edge, traced across [t0, t1] (sl_win), from (ix, iy) in h's frame
  * (iy >= 0, on the face's side); offer: 0 a window's child, 1 a vertex's
  * offer, 2 a vertex source's. Lowers the edge's ends it reaches, then goes
- * into the slots of the half-edge(s) across. */
+ * into the slots of the half-edge(s) across. With a cost the face h / 3 has
+ * one cost c (the caller checks): values are sigma + c |segment|, trims
+ * compare sigma / c with the ends' distances / c, and a window stops at an
+ * edge into a face of another cost (refraction is the march's: its ends are
+ * relaxed, and their vertices update the faces beyond). */
 MFMM_INLINE void sl_emit(sl_state *s, mfmm_i32 h, double s0, double s1, double t0, double t1,
                     double ix, double iy, double sigma, int offer)
 {
     MFMM_GLOBAL const ex_face *r = s->fr + h / 3;
     int k = h % 3;
     mfmm_i32 va = r->v[ex_next[k]], vb = r->v[ex_prev[k]];
-    double L = r->len[k];
+    double L = r->len[k], cost = sl_cost(s, h / 3);
     if (s0 < 0.0)
         s0 = 0.0;
     if (s1 > L)
@@ -319,27 +408,36 @@ MFMM_INLINE void sl_emit(sl_state *s, mfmm_i32 h, double s0, double s1, double t
     double iy2 = iy * iy;
     if (offer) {
         /* a vertex's offer: its ends at the face's edge lengths */
-        sl_update(s, va, sigma + r->len[ex_prev[k]], offer == 2);
-        sl_update(s, vb, sigma + r->len[ex_next[k]], offer == 2);
+        sl_update(s, va, sigma + cost * r->len[ex_prev[k]], offer == 2);
+        sl_update(s, vb, sigma + cost * r->len[ex_next[k]], offer == 2);
     } else {
         if (s0 <= EX_POS_TOL * L)
-            sl_update(s, va, sigma + sqrt(ix * ix + iy2), 1);
+            sl_update(s, va, sigma + cost * sqrt(ix * ix + iy2), 1);
         if (s1 >= L - EX_POS_TOL * L)
-            sl_update(s, vb, sigma + sqrt((ix - L) * (ix - L) + iy2), 1);
+            sl_update(s, vb, sigma + cost * sqrt((ix - L) * (ix - L) + iy2), 1);
     }
     mfmm_i32 g = r->across[k];
     if (g < 0 && r->flip[k] != 2)
         return; /* a wall, or a zero-area face (its edges relax; windows stop) */
+    if (g >= 0 && sl_cost(s, g / 3) != cost)
+        return; /* another cost across: the march's refraction, not a window */
     s->info.emitted++;
-    double da = s->d[va], db = s->d[vb];
+    double da = s->d[va], db = s->d[vb], sigma_l = sigma;
     da += EX_TIE * da;
     db += EX_TIE * db;
-    if (!ex_trim(ix, -iy, sigma, L, da, db, &s0, &s1)) {
+    if (cost != 1.0) {
+        /* the trim's inequality divided by the cost: in lengths of this
+         * face (skipped at 1.0, where it is exact: three divisions less) */
+        sigma_l = sigma / cost;
+        da /= cost;
+        db /= cost;
+    }
+    if (!ex_trim(ix, -iy, sigma_l, L, da, db, &s0, &s1)) {
         s->info.trimmed++;
         return;
     }
     if (g >= 0) {
-        sl_keep(s, g, r->flip[k], L, s0, s1, t0, t1, ix, iy, sigma);
+        sl_keep(s, g, r->flip[k], L, s0, s1, t0, t1, ix, iy, sigma, cost);
         return;
     }
     /* a non-manifold edge: on into every other face on it, each unfolded
@@ -355,8 +453,9 @@ MFMM_INLINE void sl_emit(sl_state *s, mfmm_i32 h, double s0, double s1, double t
             return;
         i = ex_nm_find(s->nm_he, s->n_nm, q);
         MFMM_GLOBAL const ex_face *rq = s->fr + q / 3;
-        if (!rq->skip)
-            sl_keep(s, q, rq->v[ex_next[q % 3]] != va, L, s0, s1, t0, t1, ix, iy, sigma);
+        if (!rq->skip && sl_cost(s, q / 3) == cost)
+            sl_keep(s, q, rq->v[ex_next[q % 3]] != va, L, s0, s1, t0, t1, ix, iy, sigma,
+                    cost);
     }
 }
 
@@ -369,13 +468,13 @@ MFMM_INLINE void sl_cross(sl_state *s, mfmm_i32 h, const sl_win *w)
     mfmm_i32 vc = r->v[m];
     double L = r->len[m], cx = r->cx[m], cy = r->cy[m];
     double b0 = w->b0, b1 = w->b1, px = w->px, py = w->py, sigma = w->sigma;
-    double g0 = w->g0, g1 = w->g1;
+    double g0 = w->g0, g1 = w->g1, cost = sl_cost(s, f);
     s->info.crossed++;
     double tc = px + (cx - px) * (-py) / (cy - py);
     double tol = EX_POS_TOL * L;
     if (tc >= b0 - tol && tc <= b1 + tol) {
         double ex = cx - px, ey = cy - py;
-        sl_update(s, vc, sigma + sqrt(ex * ex + ey * ey), 1);
+        sl_update(s, vc, sigma + cost * sqrt(ex * ex + ey * ey), 1);
     } else {
         /* C beside the window: the ray to the interval's nearer end, then
          * straight across the face (a path, wherever C is): a vertex at
@@ -383,7 +482,7 @@ MFMM_INLINE void sl_cross(sl_state *s, mfmm_i32 h, const sl_win *w)
          * edge's length off */
         double e = tc < b0 ? b0 : b1;
         double ie = sqrt((e - px) * (e - px) + py * py), ec = sqrt((cx - e) * (cx - e) + cy * cy);
-        sl_update(s, vc, sigma + ie + ec, 0);
+        sl_update(s, vc, sigma + cost * ie + cost * ec, 0);
     }
     int m1 = ex_next[m], m2 = ex_prev[m];
     if (b0 < tc) {
@@ -505,6 +604,8 @@ MFMM_INLINE void sl_loop(sl_state *s, double level, mfmm_i32 n_tgt)
 #endif
         s->info.settled++;
         double dv = s->d[v];
+        /* flat: the windows beside v carry its paths on (one cost around) */
+        int quiet = s->ray[v] && s->flat[v] && sl_one_cost(s, v);
         if (s->is_tgt[v]) {
             s->is_tgt[v] = 0;
             if (dv > s->tgt_level)
@@ -517,19 +618,28 @@ MFMM_INLINE void sl_loop(sl_state *s, double level, mfmm_i32 n_tgt)
             mfmm_i32 c = ex_corner(s->vf_corner, s->face_in, i);
             MFMM_GLOBAL const ex_face *r = fr + c / 3;
             int k = c % 3;
+            mfmm_i32 vn = r->v[ex_next[k]], vp = r->v[ex_prev[k]];
             if (r->skip) {
                 if (r->skip == 1) { /* zero-area: the edges only */
-                    sl_update(s, r->v[ex_next[k]], dv + r->len[ex_prev[k]], 0);
-                    sl_update(s, r->v[ex_prev[k]], dv + r->len[ex_next[k]], 0);
+                    sl_update(s, vn, dv + sl_edge_cost(s, c / 3, v, vn) * r->len[ex_prev[k]], 0);
+                    sl_update(s, vp, dv + sl_edge_cost(s, c / 3, v, vp) * r->len[ex_next[k]], 0);
                 }
                 continue;
             }
-            if (s->ray[v] && s->flat[v]) {
+            double cf = sl_cost(s, c / 3);
+            if (!(cf > 0.0)) {
+                /* a face of mixed cost (per vertex): no window can lie in
+                 * it; the march's update of its other corners instead */
+                sl_fmm_corner(s, r, ex_next[k], v, dv);
+                sl_fmm_corner(s, r, ex_prev[k], v, dv);
+                continue;
+            }
+            if (quiet) {
                 /* not needed: a vertex reached by a window's ray whose
                  * neighbourhood unfolds flat has the windows beside it
                  * carry its paths on; the edges only */
-                sl_update(s, r->v[ex_next[k]], dv + r->len[ex_prev[k]], 0);
-                sl_update(s, r->v[ex_prev[k]], dv + r->len[ex_next[k]], 0);
+                sl_update(s, vn, dv + cf * r->len[ex_prev[k]], 0);
+                sl_update(s, vp, dv + cf * r->len[ex_next[k]], 0);
                 if (!s->is_src[v])
                     continue;
             }

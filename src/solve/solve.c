@@ -111,10 +111,7 @@ mfmm_status mfmm_check_method(int method, int has_cost, mfmm_error *err)
         return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
                          "method is %d; it must be MFMM_METHOD_FMM (0) or MFMM_METHOD_WINDOWS (1)",
                          method);
-    if (method == MFMM_METHOD_WINDOWS && has_cost)
-        return mfmm_fail(err, MFMM_ERR_BAD_ARGUMENT, -1,
-                         "MFMM_METHOD_WINDOWS computes geodesic distance without a cost; use "
-                         "MFMM_METHOD_FMM for a cost");
+    (void)has_cost; /* both methods take a cost */
     return MFMM_OK;
 }
 
@@ -247,7 +244,8 @@ static int32_t solver_march(mfmm_solver *solver, const mfmm_source *sources, int
         if (!solver->windows && mfmm_slots_create(mesh, &solver->windows) != MFMM_OK)
             return -1;
         solver->n_pending = mfmm_slots_run(solver->windows, sources, n_sources, opt.max_distance,
-                                           opt.targets, opt.n_targets, T, solver->touched);
+                                           opt.targets, opt.n_targets, opt.cost,
+                                           (int)opt.cost_location, T, solver->touched);
         return solver->n_pending;
     }
     mfmm_march_state s;

@@ -289,8 +289,14 @@ expect 0 "landmarks --method windows" "$BIN" landmarks "$T/g.obj" -k 3 --method 
 expect 0 "allpairs --method windows" "$BIN" allpairs "$T/g.obj" --method windows --quiet -o "$T/aw.npy"
 expect 2 "distance --exact with --method" "$BIN" distance "$T/g.obj" --source "$C" --exact --method windows -o "$T/x.txt" &&
     { grep -q -- "--exact and --method are two methods" "$T/err" && ok "--exact --method message" || fail "message: $(cat "$T/err")"; }
-expect 2 "distance --method windows with --cost" "$BIN" distance "$T/g.obj" --source "$C" --method windows --cost "$T/cost.txt" -o "$T/x.txt" &&
-    { grep -q -- "it takes no --cost" "$T/err" && ok "--method windows --cost message" || fail "message: $(cat "$T/err")"; }
+# a constant cost 2: twice the Euclidean distances
+if expect 0 "distance --method windows with --cost" "$BIN" distance "$T/g.obj" --source "$C" --method windows --cost "$T/cost.txt" -o "$T/wc.txt"; then
+    paste -d ' ' "$T/v.txt" "$T/wc.txt" | awk '
+        function abs(a) { return a < 0 ? -a : a }
+        { n++; e = abs($5 - 2 * sqrt($2 * $2 + $3 * $3)); if (e > m) m = e }
+        END { printf "%d %.3g\n", n, m; exit !(n == '"$NV"' && m <= 2e-12) }' >"$T/chk" &&
+        ok "windows with cost 2 on the grid is twice Euclidean: $(cat "$T/chk")" || fail "windows with cost 2: $(cat "$T/chk")"
+fi
 expect 2 "voronoi --method exact" "$BIN" voronoi "$T/g.obj" --source "$C" --method exact -o "$T/x.txt"
 [ ! -e "$T/x.txt" ] && [ ! -e "$T/x.npy" ] && ok "refused --method runs write nothing" || fail "a refused run wrote"
 # the window method on OpenCL: the rows of the CPU backends, byte for byte

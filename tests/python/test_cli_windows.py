@@ -1,8 +1,8 @@
 """--method windows on the command lines: the C commands that solve
 (distance, allpairs, landmarks, voronoi, path) write the Python API's
 windows values bit for bit; the Python commands (isolines, render) take
-it too; the usage errors (--exact with --method, a cost, OpenCL) exit 2
-and write nothing."""
+it too, with a cost too; the usage errors (--exact with --method, an
+unknown or repeated method) exit 2 and write nothing."""
 
 from __future__ import annotations
 
@@ -116,14 +116,6 @@ def test_usage_errors(cli, tmp_path):
             err = refused(cli, sub, PATH, "--source", 0, "--exact", "--method", method,
                           "-o", out)
             assert "--exact and --method are two methods" in err
-        err = refused(cli, sub, PATH, "--source", 0, "--method", "windows", "--cost", cost,
-                      "-o", out)
-        assert "--method windows computes geodesic distance: it takes no --cost" in err
-    err = refused(cli, "path", PATH, "--source", 0, "--target", 9, "--method", "windows",
-                  "--cost", cost, "-o", tmp_path / "p.csv")
-    assert "takes no --cost" in err
-    err = refused(cli, "allpairs", PATH, "--method", "windows", "--cost", cost, "-o", out)
-    assert "takes no --cost" in err
     for sub in ("distance", "landmarks", "allpairs"):
         args = ["-k", 3] if sub == "landmarks" else ["--source", 0] if sub == "distance" else []
         err = refused(cli, sub, PATH, *args, "--method", "exact", "-o", out)
@@ -131,6 +123,29 @@ def test_usage_errors(cli, tmp_path):
         err = refused(cli, sub, PATH, *args, "--method", "fmm", "--method", "windows", "-o", out)
         assert "--method given twice" in err
     assert list(tmp_path.iterdir()) == [cost]
+
+
+@pytest.mark.parametrize("where", ["vertex", "face"])
+def test_cost(cli, tmp_path, where):
+    """--method windows --cost: the Python API's values bit for bit
+    (distance, allpairs)."""
+    m = mesh(NAME)
+    n = m.n_vertices if where == "vertex" else m.n_faces
+    c = 1.0 + (np.arange(n) % 5 == 0)
+    cost = tmp_path / "c.npy"
+    np.save(cost, c)
+    flag = ["--cost-per-face"] if where == "face" else []
+    out = tmp_path / "d.npy"
+    run(cli, "distance", PATH, "--source", 77, "--method", "windows", "--cost", cost, *flag,
+        "-o", out)
+    want = m.distance(77, c, cost_location=where, method="windows")
+    assert np.load(out).tobytes() == want.tobytes()
+    src = np.array([0, 77], dtype=np.int32)
+    np.save(tmp_path / "s.npy", src)
+    run(cli, "allpairs", PATH, "--sources", tmp_path / "s.npy", "--dtype", "float64",
+        "--backend", "serial", "--method", "windows", "--cost", cost, *flag, "--quiet",
+        "-o", tmp_path / "D.npy")
+    assert np.load(tmp_path / "D.npy")[1].tobytes() == want.tobytes()
 
 
 def test_python_isolines_and_render_take_the_method(tmp_path):
@@ -149,7 +164,14 @@ def test_python_isolines_and_render_take_the_method(tmp_path):
            "-o", tmp_path / "b.csv")
     assert b.returncode == 0, b.stderr
     assert (tmp_path / "a.csv").read_bytes() == (tmp_path / "b.csv").read_bytes()
+    np.save(tmp_path / "c.npy", np.full(m.n_vertices, 2.0))
     c = py("isolines", PATH, "--source", 77, "--method", "windows", "--cost",
-           tmp_path / "f.npy", "--values", "0.2", "-o", tmp_path / "c.csv")
-    assert c.returncode == 2 and "takes no cost" in c.stderr
+           tmp_path / "c.npy", "--values", "0.4", "-o", tmp_path / "c.csv")
+    assert c.returncode == 0, c.stderr
+    d = py("isolines", PATH, "--source", 77, "--method", "windows", "--values", "0.2",
+           "-o", tmp_path / "d.csv")
+    assert d.returncode == 0, d.stderr
+    # cost 2: the 0.4 isoline is the 0.2 one without a cost, but for its value
+    lines = [(tmp_path / n).read_text().count("\n") for n in ("c.csv", "d.csv")]
+    assert lines[0] == lines[1]
     assert "windows" in py("render", "--help").stdout

@@ -508,9 +508,6 @@ def test_method_is_passed_through_and_part_of_the_job(hand, client, tmp_path):
     assert zs.same_job(old, job) == [] and zs.job_key(old) == zs.job_key(job)
     # refused before the store is touched
     bad = str(tmp_path / "bad.zarr")
-    with pytest.raises(ValueError, match="takes no cost"):
-        md.distance_matrix(hand, bad, sources=src, client=client, progress=False,
-                           method="windows", cost=np.ones(hand.n_vertices))
     with pytest.raises(ValueError, match="not a method of"):
         md.distance_matrix(hand, bad, sources=src, client=client, progress=False,
                            method="exact")
@@ -536,8 +533,13 @@ def test_command_line_method(hand, client, tmp_path, capsys):
     assert "differs in: method" in err and len(err.strip().splitlines()) == 1
     cost = tmp_path / "cost.txt"
     cost.write_text("1\n" * hand.n_vertices)
-    assert cli_allpairs_zarr(args + ["--method", "windows", "--cost", str(cost)]) == 2
-    assert "takes no cost" in capsys.readouterr().err
+    store2 = str(tmp_path / "wc.zarr")
+    args2 = [a if a != store else store2 for a in args]
+    assert cli_allpairs_zarr(args2 + ["--method", "windows", "--cost", str(cost)]) == 0
+    assert np.array_equal(zarr.open_array(store2, mode="r")[:],
+                          hand.distance_matrix([0, 5, 9], backend="serial", dtype="float64",
+                                               method="windows",
+                                               cost=np.ones(hand.n_vertices)))
 
 
 def test_mesh_options_reach_the_workers_and_the_job(hand, client, tmp_path):

@@ -12,7 +12,9 @@ iter_distance_rows, farthest_point_sampling, voronoi_labels and path.
 - exact on surfaces that unfold into the plane (cylinders, folded pages);
 - matrix rows, landmarks and labels equal those of windows solves, float64
   bit for bit;
-- the refusals: "exact" in the matrix calls, a cost, the OpenCL backend.
+- the refusals: "exact" in the matrix calls.
+- a cost: a constant one scales the values; matrix rows (serial, threads,
+  OpenCL) equal the solves' bit for bit; farthest points and paths take it.
 """
 
 from __future__ import annotations
@@ -258,19 +260,58 @@ def test_matrix_refusals(spot):
         spot.distance_matrix([0, 1], method="exact")
     with pytest.raises(ValueError, match="method must be one of"):
         spot.distance_matrix([0, 1], method="mmp")
-    cost = np.ones(spot.n_vertices)
-    with pytest.raises(ValueError, match="takes no cost"):
-        spot.distance_matrix([0, 1], method="windows", cost=cost)
-    with pytest.raises(ValueError, match="takes no cost"):
-        next(spot.iter_distance_rows([0, 1], method="windows", cost=cost))
+
+
+@pytest.mark.parametrize("where", ["vertex", "face"])
+def test_cost_scales_and_rows_equal_solves(spot, where):
+    """A constant cost c: c times the values without one (1e-12 relative).
+    A varying cost: matrix rows on every backend equal the solves."""
+    n = spot.n_vertices if where == "vertex" else spot.n_faces
+    for s in (0, 905):
+        d1 = spot.distance(s, method="windows")
+        dc = spot.distance(s, np.full(n, 2.5), cost_location=where, method="windows")
+        np.testing.assert_allclose(dc, 2.5 * d1, rtol=1e-12, atol=0)
+    cost = 1.0 + 0.5 * (np.arange(n) % 3 == 0)
+    want = np.stack([spot.distance(int(s), cost, cost_location=where, method="windows")
+                     for s in SOURCES])
+    for backend in ("serial", "threads"):
+        got = spot.distance_matrix(SOURCES, backend=backend, dtype="float64", method="windows",
+                                   cost=cost, cost_location=where)
+        assert np.array_equal(got, want), backend
+    got = np.concatenate([b for _, b in spot.iter_distance_rows(
+        SOURCES, block_rows=2, dtype="float64", backend="threads", method="windows",
+        cost=cost, cost_location=where)])
+    assert np.array_equal(got, want)
+
+
+def test_face_cost_values_are_paths(spot):
+    """Per face no face has mixed cost, so every value is a weighted path
+    length: never below the least cost times the exact geodesic distance
+    (1e-9 relative), and where no path shorter than the value leaves the
+    cost-1 region the windows values without a cost."""
+    F, V = spot.faces, spot.vertices
+    cost = 1.0 + (V[F, 1].min(axis=1) > 0.0)  # cost 2: faces wholly above y = 0
+    s = 7  # at y = -0.055
+    d = spot.distance(s, cost, cost_location="face", method="windows")
+    ex = spot.distance(s, method="exact")
+    assert np.all(d >= ex * (1.0 - 1e-9))
+    near = spot.distance(s, method="windows")
+    inside = near < -V[s, 1]  # shorter than the way up to y = 0
+    assert inside.sum() >= 5
+    np.testing.assert_allclose(d[inside], near[inside], rtol=1e-12, atol=0)
 
 
 @pytest.mark.parametrize("dtype", ["float64", "float32"])
 def test_opencl_rows_equal_serial_rows(spot, dtype):
     """The OpenCL kernel runs the C core's own propagation (slots_core.h):
-    dense rows, target columns and max_distance rows, bit for bit."""
+    dense rows, target columns and max_distance rows, with and without a
+    cost, bit for bit."""
     tg = [3, 100, spot.n_vertices - 1]
-    kws = [dict(), dict(targets=tg), dict(max_distance=0.3)]
+    vcost = 1.0 + 0.5 * (np.arange(spot.n_vertices) % 3 == 0)
+    fcost = 1.0 + 2.0 * (spot.vertices[spot.faces[:, 0], 2] > 0.0)
+    kws = [dict(), dict(targets=tg), dict(max_distance=0.3),
+           dict(cost=vcost, cost_location="vertex"), dict(cost=fcost, cost_location="face"),
+           dict(cost=1.5 * vcost, cost_location="vertex", targets=tg, max_distance=0.6)]
     for kw in kws:
         want = spot.distance_matrix(SOURCES, backend="serial", dtype=dtype, method="windows",
                                     **kw)
@@ -300,8 +341,10 @@ def test_farthest_point_sampling_equals_a_loop_of_windows_solves(spot):
     assert pts.tolist() != spot.farthest_point_sampling(k, start=5).tolist()
     with pytest.raises(ValueError, match="not a method of farthest_point_sampling"):
         spot.farthest_point_sampling(3, method="exact")
-    with pytest.raises(ValueError, match="takes no cost"):
-        spot.farthest_point_sampling(3, method="windows", cost=np.ones(spot.n_vertices))
+    c = 1.0 + (np.arange(spot.n_vertices) % 4 == 0)
+    pts = spot.farthest_point_sampling(3, start=5, method="windows", cost=c)
+    far = int(np.argmax(spot.distance(5, c, method="windows")))
+    assert pts.tolist()[:2] == [5, far]
 
 
 def test_voronoi_labels_and_path_take_the_method(spot):
@@ -312,8 +355,10 @@ def test_voronoi_labels_and_path_take_the_method(spot):
     p = spot.path(0, 2929, method="windows")
     back = spot.geodesic_path(spot.distance(0, method="windows"), 2929, sources=[0])
     assert np.array_equal(p.points, back.points[::-1])
-    with pytest.raises(ValueError, match="takes no cost"):
-        spot.path(0, 2929, method="windows", cost=np.ones(spot.n_vertices))
+    c = 1.0 + (np.arange(spot.n_vertices) % 4 == 0)
+    p = spot.path(0, 2929, method="windows", cost=c)
+    back = spot.geodesic_path(spot.distance(0, c, method="windows"), 2929, sources=[0], cost=c)
+    assert np.array_equal(p.points, back.points[::-1])
 
 
 # ----------------------------------------------------------- random meshes

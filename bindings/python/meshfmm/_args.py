@@ -324,17 +324,14 @@ def method(name: Any, exact: bool = True) -> int:
 
 def solve_method(name: Any, cost: Any, what: str) -> int:
     """The C mfmm_method of a call that solves by mfmm_solve or its rows
-    (`what` names it in messages): "fmm" or "windows"; "exact" (its own
-    solver, mfmm_solve_exact) and "windows" with a cost are refused."""
+    (`what` names it in messages): "fmm" or "windows", each with or without
+    a cost; "exact" (its own solver, mfmm_solve_exact) is refused."""
     if name == "exact":
         raise ValueError(f"method='exact' is not a method of {what}: it takes 'fmm' or "
                          "'windows' (exact distances: Mesh.distance(method='exact'), one "
                          "solve per source)")
-    m = method(name, exact=False)
-    if m == _lib.MFMM_METHOD_WINDOWS and cost is not None:
-        raise ValueError("method='windows' computes geodesic distance: it takes no cost "
-                         "(use method='fmm')")
-    return m
+    del cost  # both methods take a cost
+    return method(name, exact=False)
 
 
 def backend(name: Any) -> int:

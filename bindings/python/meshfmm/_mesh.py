@@ -498,8 +498,9 @@ class Mesh:
             half-edge (``MFMM_METHOD_WINDOWS``; the documentation's page
             "The windows method"): more accurate than "fmm", never below
             the geodesic distance, exact where the surface unfolds flat, at
-            several times its time; no cost (unfolding and exact_start do
-            not apply). "exact": exact polyhedral geodesic
+            several times its time; with a cost, windows within faces of
+            one cost and the march's update where the cost changes
+            (unfolding and exact_start do not apply). "exact": exact polyhedral geodesic
             distances by window propagation (``mfmm_solve_exact``), without
             cost, targets, unfolding or exact_start options.
         exact_start : bool, "auto" or float
@@ -578,9 +579,6 @@ class Mesh:
                                  "targets, unfolding or exact_start")
             return self._distance_exact(sources, max_distance, bar)
         windows = _args.method(method) == _lib.MFMM_METHOD_WINDOWS
-        if windows and cost is not None:
-            raise ValueError("method='windows' computes geodesic distance: it takes no cost "
-                             "(use method='fmm')")
         if _args.is_int(sources):  # the common case, kept cheap (bench/suite/bench_python.py)
             one = _lib.mfmm_source(_args.index(sources, "source"), -1)
             src_addr, n_src = ctypes.addressof(one), 1
@@ -803,8 +801,8 @@ class Mesh:
         source, target : int or SurfacePoint
             Vertex ids or points inside faces.
         method : {"fmm", "windows", "exact"}
-            The distances the path descends (:meth:`distance`; "windows"
-            and "exact" take no cost).
+            The distances the path descends (:meth:`distance`; "exact"
+            takes no cost).
         cost, cost_location, exact_start
             As in :meth:`distance`.
         max_points, straighten
@@ -866,7 +864,7 @@ class Mesh:
             As in :meth:`distance`.
         method : {"fmm", "windows"}
             The solve of each point (:meth:`distance`): "fmm" (default) or
-            "windows" (no cost; unfolding and exact_start do not apply).
+            "windows" (unfolding and exact_start do not apply).
             The points equal those of a loop of ``distance(...,
             method=method)`` solves. "exact" is not offered here.
         return_radii : bool
@@ -889,7 +887,7 @@ class Mesh:
         ------
         ValueError
             k out of range, a start out of range or in no face, a bad cost,
-            a method other than "fmm" or "windows", a cost with "windows".
+            a method other than "fmm" or "windows".
         """
         m = _args.solve_method(method, cost, "farthest_point_sampling")
         k = _args.index(k, "k")
@@ -1093,9 +1091,9 @@ class Mesh:
             As in :meth:`distance`. Every backend starts each row alike;
             OpenCL rows equal the serial rows bit for bit.
         method : {"fmm", "windows"}
-            As in :meth:`distance`, on every backend; "windows" takes no
-            cost, and "auto" runs it on threads (saying why in
-            :class:`MatrixInfo`). Rows equal ``distance(source,
+            As in :meth:`distance`, on every backend; "auto" runs
+            "windows" on threads (saying why in :class:`MatrixInfo`).
+            Rows equal ``distance(source,
             method=method)`` bit for bit in float64, with targets,
             max_distance and sparse rows alike. "exact" is not a matrix
             method (a ValueError): solve each row with

@@ -80,8 +80,8 @@ def zarr_parser() -> argparse.ArgumentParser:
     ap.add_argument("--method", choices=["fmm", "windows"], default="fmm", action=_Once,
                     help="fmm (default): the march; windows: window propagation, more "
                          "accurate, never below the geodesic distance, several times the "
-                         "time (no --cost, not --backend opencl); part of the job, so "
-                         "--resume refuses a store of the other method")
+                         "time (with --cost: windows within faces of one cost); part of the "
+                         "job, so --resume refuses a store of the other method")
     st = ap.add_mutually_exclusive_group()
     st.add_argument("--exact-start-radius", type=float, metavar="R", action=_Once,
                     help="radius of the exact start in mean edge lengths (default: the library's)")

@@ -341,9 +341,8 @@ def distance_matrix(mesh: Mesh, store: Any, sources: Any = None, targets: Any = 
         As in ``Mesh.distance``; the job records the exact start's radius,
         so a store computed with another one is a different job.
     method : {"fmm", "windows"}
-        The rows' method, as in ``Mesh.distance_matrix`` ("windows": no
-        cost, and not on the "opencl" backend; under "auto" the workers run
-        threads). The job records it: resuming a store with the other
+        The rows' method, as in ``Mesh.distance_matrix`` (under "auto"
+        the workers run "windows" on threads). The job records it: resuming a store with the other
         method is refused (:class:`StoreError`), never a mix of rows.
     n_workers : int, optional
         Processes of the LocalCluster started when `client` is None.

@@ -19,7 +19,8 @@
 #include "start/seed.h"
 
 /* the mesh's arrays (read-only), then a batch's workspaces (from MB_LABEL);
- * MB_FR to MB_FLAT and MB_WS: the window method's */
+ * MB_FR to MB_FLAT and MB_WS: the window method's, which also takes the
+ * records' costs in MB_UNIFORM and the vertices' in MB_COST */
 enum { MB_OFFSET, MB_CORNER, MB_CORNERS, MB_COST, MB_SOURCES, MB_STRIP, MB_UNIFORM, MB_TARGETS, MB_ORDER, MB_VIRTS, MB_STRIPOFF, MB_VFIRST, MB_SPOKEOFF, MB_SPOKES,
        MB_FR, MB_VFOFF, MB_VFCORNER, MB_FACEIN, MB_NMHE, MB_NMNEXT, MB_FLAT, MB_LABEL, MB_KEY, MB_VERT,
        MB_POS, MB_T, MB_WS, MB_OUT, MB_COUNT };
@@ -184,11 +185,15 @@ typedef struct run {
     mfmm_exact_ws *ews;
     seed_buf sb;
     uint8_t *flat;       /* the window method's flat flags (mfmm_slots_flat) */
+    double *fcost;       /* the window method's record costs (mfmm_slots_face_cost) */
+    double *vcost;       /* and vertex costs (per vertex), relative to cost_scale */
+    double cost_scale;   /* the least cost (1.0 without a cost) */
     cl_ulong ws_stride;  /* the window method's bytes per item */
 } run;
 
 /* The window method's arrays: the mesh's exact tables, built everywhere,
- * its flat flags, the job's sources, targets and vertex order. */
+ * its flat flags, the job's sources, targets and vertex order, and with a
+ * cost the records' costs and the vertices' (per vertex). */
 static mfmm_status run_upload_windows(run *r, mfmm_error *err)
 {
     const mfmm_rows_job *job = r->job;
@@ -235,6 +240,25 @@ static mfmm_status run_upload_windows(run *r, mfmm_error *err)
                                               &e);
     if (e == CL_SUCCESS)
         mem[MB_ORDER] = api->clCreateBuffer(c, ro, nv * sizeof(int32_t), mesh->to_internal, &e);
+    r->cost_scale = 1.0;
+    if (e == CL_SUCCESS && job->cost) {
+        r->fcost = malloc((nf + 1) * sizeof *r->fcost);
+        r->vcost = malloc((nv + 1) * sizeof *r->vcost);
+        if (!r->fcost || !r->vcost)
+            return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for %d costs",
+                             (int)(nf + nv));
+        r->cost_scale = mfmm_slots_face_cost(mesh, job->cost, job->cost_location, r->fcost,
+                                             r->vcost);
+    }
+    /* no cost: one value stands in for each cost array (unread) */
+    if (e == CL_SUCCESS)
+        mem[MB_UNIFORM] = api->clCreateBuffer(c, ro, (job->cost ? nf : 1) * sizeof(double),
+                                              job->cost ? (void *)r->fcost : (void *)&r->one, &e);
+    if (e == CL_SUCCESS) {
+        int per_vertex = job->cost && job->cost_location == 1;
+        mem[MB_COST] = api->clCreateBuffer(c, ro, (per_vertex ? nv : 1) * sizeof(double),
+                                           per_vertex ? (void *)r->vcost : (void *)&r->one, &e);
+    }
     if (e != CL_SUCCESS)
         return runtime_fail(err, "uploading the exact tables", e);
     return MFMM_OK;
@@ -252,8 +276,10 @@ static mfmm_status run_set_args_windows(run *r, mfmm_error *err)
     if (mfmm_slots_tables_of(job->mesh, &t) != MFMM_OK)
         return mfmm_fail(err, MFMM_ERR_OUT_OF_MEMORY, -1, "out of memory for the exact tables");
     cl_int nvi = (cl_int)r->nv, nfi = (cl_int)job->mesh->nf, n_nm = t.n_nm;
-    cl_double maxd = job->opt->max_distance;
+    /* the solve runs in units of the least cost (mfmm_slots_run) */
+    cl_double maxd = job->opt->max_distance / r->cost_scale, scale = r->cost_scale;
     cl_ulong stride = r->ws_stride;
+    cl_int loc = job->cost ? (cl_int)job->cost_location : 0;
     cl_int e = api->clSetKernelArg(k, 0, sizeof nvi, &nvi);
     e |= api->clSetKernelArg(k, 1, sizeof nfi, &nfi);
     e |= api->clSetKernelArg(k, 2, sizeof(cl_mem), &mem[MB_FR]);
@@ -272,6 +298,10 @@ static mfmm_status run_set_args_windows(run *r, mfmm_error *err)
     e |= api->clSetKernelArg(k, 17, sizeof(cl_mem), &mem[MB_WS]);
     e |= api->clSetKernelArg(k, 18, sizeof stride, &stride);
     e |= api->clSetKernelArg(k, 19, sizeof(cl_mem), &mem[MB_OUT]);
+    e |= api->clSetKernelArg(k, 20, sizeof(cl_mem), &mem[MB_UNIFORM]);
+    e |= api->clSetKernelArg(k, 21, sizeof(cl_mem), &mem[MB_COST]);
+    e |= api->clSetKernelArg(k, 22, sizeof loc, &loc);
+    e |= api->clSetKernelArg(k, 23, sizeof scale, &scale);
     if (e != CL_SUCCESS)
         return runtime_fail(err, "clSetKernelArg", e);
     return MFMM_OK;
@@ -592,6 +622,8 @@ static void run_release(run *r)
     free(r->host);
     free(r->uniform);
     free(r->flat);
+    free(r->fcost);
+    free(r->vcost);
     r->job->info->start_fallbacks += r->sb.fallbacks;
     free(r->sb.idx);
     free(r->sb.val);
