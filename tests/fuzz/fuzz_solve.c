@@ -192,10 +192,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (flags & 4)
         so.max_distance = next(&r) / 16.0;
     so.unfolding = (flags & 8) ? 0 : 1;
-#ifndef FUZZ_OPENCL
-    if (flags & 64) /* the window method (refused with a cost, and on OpenCL) */
+    if (flags & 64) /* the window method (on OpenCL too) */
         so.method = MFMM_METHOD_WINDOWS;
-#endif
     int32_t target = next(&r) % nv;
     double level = next(&r) / 16.0;
 
