@@ -14,6 +14,7 @@ struct mfmm_slots {
     const mfmm_exact_tables *t;
     const mfmm_mesh *mesh;
     sl_state c;
+    char *block;   /* sl_state's per-solve arrays (sl_attach), as the kernel lays them out */
     uint8_t *flat; /* (nv) sl_state's, owned here */
     double *fcost; /* (nf) the records' costs of the last run with a cost, relative */
     double *vcost; /* (nv) the vertices' costs of the last run per vertex, relative */
@@ -62,7 +63,7 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     mfmm_slots *s = calloc(1, sizeof *s);
     if (!s)
         return MFMM_ERR_OUT_OF_MEMORY;
-    size_t nv = (size_t)t->nv, nh = 3 * (size_t)t->nf;
+    size_t nv = (size_t)t->nv;
     sl_state *c = &s->c;
     s->t = t;
     s->mesh = mesh;
@@ -80,28 +81,12 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
     c->flat = s->flat;
     s->fcost = malloc(((size_t)t->nf + 1) * sizeof *s->fcost);
     s->vcost = malloc((nv + 1) * sizeof *s->vcost);
-    c->slot = malloc((2 * nh + 1) * sizeof *c->slot);
-    c->n_slot = malloc(nh + 1);
-    c->fresh = malloc(nh + 1);
-    c->d = malloc((nv + 1) * sizeof *c->d);
-    c->ray = malloc(nv + 1);
-    c->is_src = malloc(nv + 1);
-    c->is_tgt = malloc(nv + 1);
-    c->h.label = malloc(nv + 1);
-    c->h.heap_key = malloc((nv + 1) * sizeof(double));
-    c->h.heap_vertex = malloc((nv + 1) * sizeof(int32_t));
-    c->h.heap_pos = malloc((nv + 1) * sizeof(int32_t));
-    c->e.label = malloc(nh + 1);
-    c->e.heap_key = malloc((nh + 1) * sizeof(double));
-    c->e.heap_vertex = malloc((nh + 1) * sizeof(int32_t));
-    c->e.heap_pos = malloc((nh + 1) * sizeof(int32_t));
-    if (!s->flat || !s->fcost || !s->vcost || !c->slot || !c->n_slot || !c->fresh || !c->d ||
-        !c->ray || !c->is_src || !c->is_tgt || !c->h.label || !c->h.heap_key ||
-        !c->h.heap_vertex || !c->h.heap_pos || !c->e.label || !c->e.heap_key ||
-        !c->e.heap_vertex || !c->e.heap_pos) {
+    s->block = malloc(sl_block_bytes(t->nv, t->nf, c->K) + 8);
+    if (!s->flat || !s->fcost || !s->vcost || !s->block) {
         mfmm_slots_destroy(s);
         return MFMM_ERR_OUT_OF_MEMORY;
     }
+    sl_attach(c, s->block);
     mfmm_slots_flat(t, s->flat);
     *out = s;
     return MFMM_OK;
@@ -110,10 +95,9 @@ mfmm_status mfmm_slots_create(const mfmm_mesh *mesh, mfmm_slots **out)
 size_t mfmm_slots_bytes(const mfmm_mesh *mesh)
 {
     size_t nv = (size_t)mesh->nv, nh = 3 * (size_t)mesh->nf;
-    /* slots, count, fresh bits, label and heap per half-edge; distances,
-     * flags, heap and cost per vertex; a cost per face */
-    return nh * (2 * sizeof(sl_win) + 3 + sizeof(double) + 2 * sizeof(int32_t)) +
-           nv * (sizeof(double) + 5 + sizeof(double) + 2 * sizeof(int32_t) + sizeof(double)) +
+    /* one solve's block (K = 2); the flat flags and a cost per vertex; a
+     * cost per face */
+    return sl_block_bytes(mesh->nv, mesh->nf, 2) + nv * (1 + sizeof(double)) +
            (nh / 3) * sizeof(double);
 }
 
@@ -144,25 +128,10 @@ void mfmm_slots_destroy(mfmm_slots *s)
 {
     if (!s)
         return;
-    sl_state *c = &s->c;
     free(s->flat);
     free(s->fcost);
     free(s->vcost);
-    free(c->slot);
-    free(c->n_slot);
-    free(c->fresh);
-    free(c->d);
-    free(c->ray);
-    free(c->is_src);
-    free(c->is_tgt);
-    free(c->h.label);
-    free(c->h.heap_key);
-    free(c->h.heap_vertex);
-    free(c->h.heap_pos);
-    free(c->e.label);
-    free(c->e.heap_key);
-    free(c->e.heap_vertex);
-    free(c->e.heap_pos);
+    free(s->block);
     free(s);
 }
 
@@ -170,12 +139,13 @@ int mfmm_slots_set_k(mfmm_slots *s, int K)
 {
     if (K < 1 || K > 8)
         return 0;
-    sl_win *w = malloc(((size_t)K * 3 * (size_t)s->c.nf + 1) * sizeof *w);
-    if (!w)
+    char *block = malloc(sl_block_bytes(s->c.nv, s->c.nf, K) + 8);
+    if (!block)
         return 0;
-    free(s->c.slot);
-    s->c.slot = w;
+    free(s->block);
+    s->block = block;
     s->c.K = K;
+    sl_attach(&s->c, block);
     return 1;
 }
 
