@@ -292,7 +292,7 @@ MFMM_INLINE void sl_keep(sl_state *s, mfmm_i32 g, int fl, double L, double s0, d
      * vertex by its two sides, one window together (the rays between them,
      * cut by trims, are paths too). Pieces whose traced rays do not meet
      * stay apart: they may have come round a hole, whose rays are no paths. */
-    double tol = SL_SAME * (L + fabs(px) - py + sigma / cost);
+    double tol = SL_SAME * (L + fabs(px) - py + (cost != 1.0 ? sigma / cost : sigma));
     for (int i = 0; i < n; i++) {
         if (fabs(w[i].px - px) > tol || fabs(w[i].py - py) > tol ||
             fabs(w[i].sigma - sigma) > tol || g0 > w[i].g1 + tol || g1 < w[i].g0 - tol)
